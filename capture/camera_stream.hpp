@@ -1,0 +1,74 @@
+#pragma once
+// One camera's capture thread: reads its FrameSource into pooled frames and hands them over through
+// a bounded queue, so that a slow decoder or device never stalls the other cameras' threads.
+//
+// Back-pressure: the pool holds `poolFrames` buffers; when the consumer keeps all of them (queued
+// or in flight down the pipeline), the thread waits for one to come back instead of dropping —
+// replay stays lossless. A fault is logged and read again (sources may recover);
+// `maxConsecutiveFaults` in a row, or the end of the stream, ends the stream.
+//
+// Threads: the capture thread owns the source; the queue (mutex + condition variable) is the only
+// state it shares with the consumer.
+
+#include <atomic>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "capture/frame_source.hpp"
+
+namespace surroundd::capture {
+
+struct CameraStreamStats {
+  std::uint64_t frames = 0;  // delivered to the queue
+  std::uint64_t faults = 0;  // reads that failed
+};
+
+class CameraStream {
+ public:
+  enum class Next { kFrame, kEnded, kTimeout };
+
+  CameraStream(std::string name, std::unique_ptr<FrameSource> source, std::size_t poolFrames,
+               int maxConsecutiveFaults = 30);
+  ~CameraStream();  // stops and joins the thread
+  CameraStream(const CameraStream&) = delete;
+  CameraStream& operator=(const CameraStream&) = delete;
+
+  void start();
+  void stop();
+
+  // Waits up to `timeout` for the next frame. kEnded once the stream has ended and its queue is
+  // empty.
+  Next next(FrameRef& out, std::chrono::milliseconds timeout);
+
+  const std::string& name() const { return name_; }
+  cv::Size frameSize() const { return pool_.frameSize(); }
+  Timestamp nominalPeriod() const { return nominalPeriod_; }
+  CameraStreamStats stats() const;
+
+ private:
+  void run();
+  void push(FrameRef frame);
+
+  std::string name_;
+  std::unique_ptr<FrameSource> source_;
+  FramePool pool_;
+  Timestamp nominalPeriod_;  // read once: the source belongs to the capture thread once started
+  int maxConsecutiveFaults_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable ready_;
+  std::vector<FrameRef> queue_;  // ring of pool capacity, preallocated
+  std::size_t head_ = 0;
+  std::size_t size_ = 0;
+  bool ended_ = false;
+  CameraStreamStats stats_;
+
+  std::atomic<bool> stopping_{false};
+  std::thread thread_;
+};
+
+}  // namespace surroundd::capture

@@ -1,0 +1,46 @@
+#pragma once
+// A file-backed virtual camera: plays a video file (any container/codec FFmpeg decodes) or an image
+// sequence (printf pattern such as "front_%06d.png", FFmpeg's image2) as if it were a camera.
+//
+// Frames carry the file's presentation timestamps (nanoseconds from the first frame); when looping,
+// timestamps keep increasing across the loop so the stream stays monotonic. Real-time pacing sleeps
+// until each frame is due on the steady clock; kAsFastAsPossible returns frames as fast as decoding
+// allows (benchmarks, tests, lossless replay).
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "capture/frame_source.hpp"
+
+namespace surroundd::capture {
+
+enum class Pacing { kRealtime, kAsFastAsPossible };
+
+struct FileSourceSettings {
+  std::filesystem::path path;  // video file, or image-sequence pattern containing a printf %d
+  double sequenceFps = 30.0;   // frame rate of an image sequence; video files carry their own
+  bool loop = false;           // restart at the end instead of reporting kEndOfStream
+  Pacing pacing = Pacing::kRealtime;
+
+  bool operator==(const FileSourceSettings&) const = default;
+};
+
+class FileSource final : public FrameSource {
+ public:
+  // Opens and probes the file and decodes nothing yet. Throws CaptureError naming the camera and
+  // the file when it is missing, unreadable, not a video, or has no decodable video stream.
+  FileSource(std::string cameraName, FileSourceSettings settings);
+  ~FileSource() override;
+
+  cv::Size frameSize() const override;
+  Timestamp nominalPeriod() const override;
+  ReadStatus read(Frame& out) override;
+  const std::string& lastError() const override;
+
+ private:
+  struct Impl;  // FFmpeg state stays out of the header
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace surroundd::capture

@@ -1,0 +1,42 @@
+#pragma once
+// One interface for every camera: file replay now, V4L2 and libcamera later, fakes in tests.
+//
+// Error policy of capture/: constructors and open() throw CaptureError with a message that names
+// the camera and the device or file (start-up boundary). read() never throws: a fault at run time
+// is a ReadStatus plus lastError(), so a capture thread never unwinds through the pipeline.
+
+#include <stdexcept>
+#include <string>
+
+#include "capture/frame.hpp"
+
+namespace surroundd::capture {
+
+class CaptureError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class ReadStatus {
+  kFrame,        // `out` holds a new frame
+  kEndOfStream,  // a finite source ran out (and does not loop)
+  kFault,        // the source failed; lastError() says why. It may recover on a later read().
+};
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  FrameSource() = default;
+  FrameSource(const FrameSource&) = delete;
+  FrameSource& operator=(const FrameSource&) = delete;
+
+  // Size of the BGR frames this source delivers; known once the source is constructed.
+  virtual cv::Size frameSize() const = 0;
+  // Nominal frame period, used for pacing and health deadlines.
+  virtual Timestamp nominalPeriod() const = 0;
+  // Blocks until the next frame is decoded or captured into `out` (whose image has frameSize()).
+  virtual ReadStatus read(Frame& out) = 0;
+  virtual const std::string& lastError() const = 0;
+};
+
+}  // namespace surroundd::capture

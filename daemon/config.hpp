@@ -1,0 +1,112 @@
+#pragma once
+// Everything surroundd is configured with: one YAML file, read and validated by loadConfig().
+// config/surroundd.reference.yaml documents every key with its default and unit.
+//
+// The parts' settings are plain structs with units in their names; they are defined here until the
+// part that consumes them exists (processing/ and render/ never see YAML).
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <spdlog/common.h>
+
+#include "capture/file_source.hpp"
+#include "daemon/rig_yaml.hpp"
+
+namespace surroundd::daemon {
+
+struct CaptureConfig {
+  capture::Pacing pacing = capture::Pacing::kRealtime;
+  double syncToleranceMs = 10.0;  // frames further apart than this are not one set
+  int queueFrames = 4;  // frames buffered per camera between its thread and the synchronizer
+
+  bool operator==(const CaptureConfig&) const = default;
+};
+
+enum class PanoramaProjection { kSphere, kBowl };
+
+struct PanoramaConfig {
+  int widthPx = 2048;   // azimuth -180..180 degrees
+  int heightPx = 1024;  // elevation top..bottom
+  double elevationTopDeg = 30.0;
+  double elevationBottomDeg = -60.0;
+  PanoramaProjection projection = PanoramaProjection::kBowl;
+  double featherDeg = 4.0;  // blend width across a seam
+
+  bool operator==(const PanoramaConfig&) const = default;
+};
+
+enum class ColourMethod { kNone, kGain, kPoisson };
+enum class PoissonSolverKind { kAuto, kCholmod, kIterative, kRectangle };
+
+struct ColourCorrectionConfig {
+  ColourMethod method = ColourMethod::kPoisson;
+  double scale = 0.25;  // solve at this fraction of the panorama resolution
+  PoissonSolverKind solver = PoissonSolverKind::kAuto;
+  double tolerance = 1e-3;         // iterative solvers: relative residual
+  double temporalSmoothing = 0.0;  // 0 = none; 0.9 = heavy smoothing of the seam data over time
+
+  bool operator==(const ColourCorrectionConfig&) const = default;
+};
+
+enum class MeshModel { kFlat, kSphere360, kBowl };
+
+struct MeshConfig {
+  MeshModel model = MeshModel::kBowl;
+  double flatRadiusM = 9.0;       // flat disk
+  double sphereRadiusM = 10.0;    // 360-horizontal cropped sphere
+  double bowlFloorRadiusM = 5.0;  // bowl: flat floor, then the wall curves up
+  double bowlRadiusM = 10.0;      // bowl: outer radius at the rim
+  double bowlHeightM = 3.0;       // bowl: rim height above the ground
+  int rings = 48;                 // radial tessellation
+  int segments = 128;             // around the vehicle
+
+  bool operator==(const MeshConfig&) const = default;
+};
+
+enum class ViewKind { kTop, kPanorama360, kOrbit, kSplit };
+
+struct RenderConfig {
+  ViewKind view = ViewKind::kOrbit;
+  int widthPx = 1280;
+  int heightPx = 720;
+
+  bool operator==(const RenderConfig&) const = default;
+};
+
+// What an output shows. Only the camera mosaic exists so far; the surround views come with render/.
+enum class OutputStream { kMosaic };
+enum class OutputKind { kVideo, kSnapshot };
+
+struct OutputConfig {
+  OutputKind kind = OutputKind::kVideo;
+  OutputStream stream = OutputStream::kMosaic;
+  std::filesystem::path path;  // parent folders are created at start
+  // video
+  int crf = 23;
+  std::string preset = "veryfast";
+  std::string pixelFormat = "yuv420p";
+  // snapshot
+  double atSeconds = 1.0;  // stream time of the snapshot; the last frame if the run is shorter
+
+  bool operator==(const OutputConfig&) const = default;
+};
+
+struct Config {
+  std::filesystem::path file;
+  spdlog::level::level_enum logLevel = spdlog::level::info;
+  std::vector<RigCamera> cameras;
+  CaptureConfig capture;
+  PanoramaConfig panorama;
+  ColourCorrectionConfig colour;
+  MeshConfig mesh;
+  RenderConfig render;
+  std::vector<OutputConfig> outputs;
+};
+
+// Reads and validates the whole file; throws ConfigError with one line per problem. Every camera
+// must have a source.
+Config loadConfig(const std::filesystem::path& file);
+
+}  // namespace surroundd::daemon

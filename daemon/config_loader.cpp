@@ -1,0 +1,192 @@
+#include <set>
+
+#include <fmt/format.h>
+
+#include "daemon/config.hpp"
+#include "daemon/logging.hpp"
+
+namespace surroundd::daemon {
+namespace {
+
+void readRig(YamlObject& root, Config& config) {
+  auto rig = root.object("rig");
+  if (!rig) {
+    root.errorHere(
+        "missing key 'rig' (the cameras, inline as 'cameras:' or in a rig file as 'file:')");
+    return;
+  }
+  if (rig->has("file") && rig->has("cameras")) {
+    rig->errorHere("give either 'file' or 'cameras', not both");
+  } else if (rig->has("file")) {
+    if (const auto file = rig->existingFile("file")) {
+      try {
+        config.cameras = loadRigFile(*file);
+      } catch (const ConfigError& e) {
+        // The rig file's own messages already name it, its lines and keys.
+        for (const auto& message : e.messages()) rig->diagnostics().add(message);
+      }
+    }
+  } else {
+    config.cameras = readRigCameras(*rig);
+  }
+  rig->finish();
+  for (const auto& camera : config.cameras) {
+    if (!camera.source) {
+      rig->errorHere(fmt::format("camera '{}' has no 'source' (surroundd needs one per camera)",
+                                 camera.calibration.name));
+    }
+  }
+}
+
+void readCapture(YamlObject& section, CaptureConfig& c) {
+  c.pacing = section.choice("pacing", c.pacing,
+                            {{"realtime", capture::Pacing::kRealtime},
+                             {"as_fast_as_possible", capture::Pacing::kAsFastAsPossible}});
+  c.syncToleranceMs =
+      section.number("sync_tolerance_ms", c.syncToleranceMs, {0.0, 1000.0, false, "milliseconds"});
+  c.queueFrames = section.integer("queue_frames", c.queueFrames, 1, 64);
+  section.finish();
+}
+
+void readPanorama(YamlObject& section, PanoramaConfig& p) {
+  p.widthPx = section.integer("width_px", p.widthPx, 64, 16384);
+  p.heightPx = section.integer("height_px", p.heightPx, 32, 8192);
+  p.elevationTopDeg =
+      section.number("elevation_top_deg", p.elevationTopDeg, {-90.0, 90.0, false, "degrees"});
+  p.elevationBottomDeg =
+      section.number("elevation_bottom_deg", p.elevationBottomDeg, {-90.0, 90.0, false, "degrees"});
+  if (p.elevationBottomDeg >= p.elevationTopDeg) {
+    section.error("elevation_bottom_deg",
+                  fmt::format("expected less than elevation_top_deg ({:g}), got {:g}",
+                              p.elevationTopDeg, p.elevationBottomDeg));
+  }
+  p.projection = section.choice(
+      "projection", p.projection,
+      {{"sphere", PanoramaProjection::kSphere}, {"bowl", PanoramaProjection::kBowl}});
+  p.featherDeg = section.number("feather_deg", p.featherDeg, {0.0, 45.0, false, "degrees"});
+  section.finish();
+}
+
+void readColour(YamlObject& section, ColourCorrectionConfig& c) {
+  c.method = section.choice("method", c.method,
+                            {{"none", ColourMethod::kNone},
+                             {"gain", ColourMethod::kGain},
+                             {"poisson", ColourMethod::kPoisson}});
+  c.scale = section.number("scale", c.scale, {0.0, 1.0, true, "fraction of the panorama size"});
+  c.solver = section.choice("solver", c.solver,
+                            {{"auto", PoissonSolverKind::kAuto},
+                             {"cholmod", PoissonSolverKind::kCholmod},
+                             {"iterative", PoissonSolverKind::kIterative},
+                             {"rectangle", PoissonSolverKind::kRectangle}});
+  c.tolerance = section.number("tolerance", c.tolerance, {0.0, 0.5, true, "relative residual"});
+  c.temporalSmoothing = section.number("temporal_smoothing", c.temporalSmoothing,
+                                       {0.0, 0.99, false, "weight of the previous frame"});
+  section.finish();
+}
+
+void readMesh(YamlObject& section, MeshConfig& m) {
+  const NumberRange radius{0.5, 100.0, false, "metres"};
+  m.model = section.choice("model", m.model,
+                           {{"flat", MeshModel::kFlat},
+                            {"sphere360", MeshModel::kSphere360},
+                            {"bowl", MeshModel::kBowl}});
+  m.flatRadiusM = section.number("flat_radius_m", m.flatRadiusM, radius);
+  m.sphereRadiusM = section.number("sphere_radius_m", m.sphereRadiusM, radius);
+  m.bowlFloorRadiusM = section.number("bowl_floor_radius_m", m.bowlFloorRadiusM, radius);
+  m.bowlRadiusM = section.number("bowl_radius_m", m.bowlRadiusM, radius);
+  m.bowlHeightM = section.number("bowl_height_m", m.bowlHeightM, {0.1, 50.0, false, "metres"});
+  if (m.bowlFloorRadiusM >= m.bowlRadiusM) {
+    section.error("bowl_floor_radius_m",
+                  fmt::format("expected less than bowl_radius_m ({:g}), got {:g}", m.bowlRadiusM,
+                              m.bowlFloorRadiusM));
+  }
+  m.rings = section.integer("rings", m.rings, 2, 1024);
+  m.segments = section.integer("segments", m.segments, 8, 4096);
+  section.finish();
+}
+
+void readRender(YamlObject& section, RenderConfig& r) {
+  r.view = section.choice("view", r.view,
+                          {{"top", ViewKind::kTop},
+                           {"360", ViewKind::kPanorama360},
+                           {"orbit", ViewKind::kOrbit},
+                           {"split", ViewKind::kSplit}});
+  r.widthPx = section.integer("width_px", r.widthPx, 64, 7680);
+  r.heightPx = section.integer("height_px", r.heightPx, 64, 4320);
+  // H.264 in 4:2:0 needs even sizes; checked here so no encoder fails at run time.
+  if (r.widthPx % 2 != 0)
+    section.error("width_px", fmt::format("expected an even number, got {}", r.widthPx));
+  if (r.heightPx % 2 != 0)
+    section.error("height_px", fmt::format("expected an even number, got {}", r.heightPx));
+  section.finish();
+}
+
+OutputConfig readOutput(YamlObject& item) {
+  OutputConfig o;
+  o.kind = item.choice("type", o.kind,
+                       {{"video", OutputKind::kVideo}, {"snapshot", OutputKind::kSnapshot}});
+  if (!item.has("type")) item.errorHere("missing key 'type' (one of 'video' 'snapshot')");
+  o.stream = item.choice("stream", o.stream, {{"mosaic", OutputStream::kMosaic}});
+  o.path = item.outputPath("path").value_or("");
+  const auto extension = o.path.extension().string();
+  if (o.kind == OutputKind::kVideo) {
+    o.crf = item.integer("crf", o.crf, 0, 51);
+    o.preset = item.choice<std::string>("preset", o.preset,
+                                        {{"ultrafast", "ultrafast"},
+                                         {"superfast", "superfast"},
+                                         {"veryfast", "veryfast"},
+                                         {"faster", "faster"},
+                                         {"fast", "fast"},
+                                         {"medium", "medium"}});
+    o.pixelFormat = item.choice<std::string>("pixel_format", o.pixelFormat,
+                                             {{"yuv420p", "yuv420p"}, {"yuv444p", "yuv444p"}});
+    if (!o.path.empty() && extension != ".mp4" && extension != ".mkv") {
+      item.error("path",
+                 fmt::format("expected a file ending in .mp4 or .mkv, got '{}'", o.path.string()));
+    }
+  } else {
+    o.atSeconds = item.number("at_s", o.atSeconds, {0.0, 1e7, false, "seconds of stream time"});
+    if (!o.path.empty() && extension != ".png") {
+      item.error("path", fmt::format("expected a file ending in .png, got '{}'", o.path.string()));
+    }
+  }
+  item.finish();
+  return o;
+}
+
+}  // namespace
+
+Config loadConfig(const std::filesystem::path& file) {
+  Diagnostics diag;
+  Config config;
+  config.file = file;
+  YamlObject root(parseYamlFile(file), "", file, diag);
+  readRig(root, config);
+  const auto readSection = [&](std::string_view key, auto&& read) {
+    if (auto section = root.object(key)) read(*section);
+  };
+  readSection("logging", [&](YamlObject& s) {
+    config.logLevel = s.choice(
+        "level", config.logLevel,
+        std::span<const std::pair<std::string_view, spdlog::level::level_enum>>(kLogLevels));
+    s.finish();
+  });
+  readSection("capture", [&](YamlObject& s) { readCapture(s, config.capture); });
+  readSection("panorama", [&](YamlObject& s) { readPanorama(s, config.panorama); });
+  readSection("colour_correction", [&](YamlObject& s) { readColour(s, config.colour); });
+  readSection("mesh", [&](YamlObject& s) { readMesh(s, config.mesh); });
+  readSection("render", [&](YamlObject& s) { readRender(s, config.render); });
+  std::set<std::filesystem::path> paths;
+  for (auto& item : root.objectList("outputs", 1, 32)) {
+    auto output = readOutput(item);
+    if (!output.path.empty() && !paths.insert(output.path.lexically_normal()).second) {
+      item.error("path", fmt::format("two outputs write '{}'", output.path.string()));
+    }
+    config.outputs.push_back(std::move(output));
+  }
+  root.finish();
+  diag.throwIfAny();
+  return config;
+}
+
+}  // namespace surroundd::daemon

@@ -1,0 +1,155 @@
+#include "daemon/pipeline.hpp"
+
+#include <array>
+
+#include <spdlog/spdlog.h>
+
+#include "capture/file_source.hpp"
+
+namespace surroundd::daemon {
+namespace {
+
+// Between checks of the stop flag while a camera has nothing to deliver.
+constexpr std::chrono::milliseconds kCameraWait{200};
+constexpr std::chrono::seconds kProgressInterval{10};
+
+std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& config) {
+  // Each camera's queue, plus one frame waiting in the synchronizer and one being composed.
+  const auto poolFrames = static_cast<std::size_t>(config.capture.queueFrames) + 2;
+  std::vector<std::unique_ptr<capture::CameraStream>> cameras;
+  for (const auto& camera : config.cameras) {
+    auto settings = *camera.source;
+    settings.pacing = config.capture.pacing;
+    const auto& name = camera.calibration.name;
+    auto source = std::make_unique<capture::FileSource>(name, settings);
+    spdlog::info("camera '{}': {} ({}x{}, {:.2f} fps)", name, settings.path.string(),
+                 source->frameSize().width, source->frameSize().height,
+                 1e9 / static_cast<double>(source->nominalPeriod().count()));
+    cameras.push_back(std::make_unique<capture::CameraStream>(name, std::move(source), poolFrames));
+  }
+  return cameras;
+}
+
+std::vector<std::string> cameraNames(const Config& config) {
+  std::vector<std::string> names;
+  for (const auto& camera : config.cameras) names.push_back(camera.calibration.name);
+  return names;
+}
+
+std::unique_ptr<render::FrameSink> openSink(const OutputConfig& output, const Config& config,
+                                            double nominalFps) {
+  if (output.path.has_parent_path()) std::filesystem::create_directories(output.path.parent_path());
+  if (output.kind == OutputKind::kSnapshot) {
+    return std::make_unique<render::SnapshotSink>(
+        output.path, std::chrono::duration_cast<std::chrono::nanoseconds>(
+                         std::chrono::duration<double>(output.atSeconds)));
+  }
+  render::VideoEncoderSettings settings;
+  settings.path = output.path;
+  settings.size = {config.render.widthPx, config.render.heightPx};
+  settings.nominalFps = nominalFps;
+  settings.crf = output.crf;
+  settings.preset = output.preset;
+  settings.pixelFormat = output.pixelFormat;
+  return std::make_unique<render::VideoFileSink>(std::move(settings));
+}
+
+}  // namespace
+
+Pipeline::Pipeline(const Config& config)
+    : cameras_(openCameras(config)),
+      synchronizer_(cameras_.size(),
+                    std::chrono::duration_cast<capture::Timestamp>(
+                        std::chrono::duration<double, std::milli>(config.capture.syncToleranceMs))),
+      mosaic_(cv::Size(config.render.widthPx, config.render.heightPx), cameraNames(config)),
+      canvas_(mosaic_.outputSize(), CV_8UC3, cv::Scalar::all(0)) {
+  const double nominalFps = 1e9 / static_cast<double>(cameras_.front()->nominalPeriod().count());
+  for (const auto& output : config.outputs) sinks_.push_back(openSink(output, config, nominalFps));
+}
+
+Pipeline::~Pipeline() = default;
+
+RunSummary Pipeline::run(const std::atomic<bool>& stop) {
+  RunSummary summary;
+  for (auto& camera : cameras_) camera->start();
+  const auto start = std::chrono::steady_clock::now();
+  auto nextProgress = start + kProgressInterval;
+  while (!stop && !synchronizer_.finished()) {
+    fillNeeds(stop);
+    while (auto set = synchronizer_.pop()) {
+      render(*set);
+      ++summary.frameSets;
+    }
+    if (const auto now = std::chrono::steady_clock::now(); now >= nextProgress) {
+      nextProgress += kProgressInterval;
+      spdlog::info("{} frame sets, {:.1f} fps, {} frames dropped by sync", summary.frameSets,
+                   static_cast<double>(summary.frameSets) /
+                       std::chrono::duration<double>(now - start).count(),
+                   synchronizer_.stats().totalDropped());
+    }
+  }
+  if (stop) spdlog::info("stop requested: finalizing outputs");
+  summary.wallTime = std::chrono::steady_clock::now() - start;
+  finish(summary);
+  return summary;
+}
+
+void Pipeline::fillNeeds(const std::atomic<bool>& stop) {
+  for (std::size_t c = 0; c < cameras_.size() && !stop; ++c) {
+    if (!synchronizer_.needs(c)) continue;
+    capture::FrameRef frame;
+    switch (cameras_[c]->next(frame, kCameraWait)) {
+      case capture::CameraStream::Next::kFrame:
+        synchronizer_.offer(c, std::move(frame));
+        break;
+      case capture::CameraStream::Next::kEnded:
+        synchronizer_.end(c);
+        break;
+      case capture::CameraStream::Next::kTimeout:
+        break;
+    }
+  }
+}
+
+void Pipeline::render(const capture::FrameSet& set) {
+  std::array<const cv::Mat*, capture::kMaxCameras> images{};
+  for (std::size_t c = 0; c < set.cameraCount; ++c) {
+    images[c] = set.frame(c) != nullptr ? &set.frame(c)->image : nullptr;
+  }
+  mosaic_.compose(std::span(images.data(), set.cameraCount), canvas_);
+  if (!firstTimestamp_) firstTimestamp_ = set.timestamp;
+  const auto streamTime = set.timestamp - *firstTimestamp_;
+  for (auto& sink : sinks_) {
+    if (!sink) continue;
+    try {
+      sink->consume(canvas_, streamTime);
+    } catch (const std::exception& e) {
+      spdlog::error("output failed, dropping it: {}", e.what());
+      ++failedSinks_;
+      sink.reset();
+    }
+  }
+}
+
+void Pipeline::finish(RunSummary& summary) {
+  for (auto& camera : cameras_) camera->stop();
+  const cv::Mat lastFrame = firstTimestamp_ ? canvas_ : cv::Mat();
+  for (auto& sink : sinks_) {
+    if (!sink) continue;
+    try {
+      sink->finish(lastFrame);
+      summary.outputs.push_back(sink->describe());
+    } catch (const std::exception& e) {
+      spdlog::error("output failed to finish: {}", e.what());
+      ++failedSinks_;
+    }
+  }
+  summary.failedOutputs = failedSinks_;
+  summary.sync = synchronizer_.stats();
+  for (const auto& camera : cameras_) {
+    summary.cameraNames.push_back(camera->name());
+    summary.cameras.push_back(camera->stats());
+  }
+}
+
+}  // namespace surroundd::daemon

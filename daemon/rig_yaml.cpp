@@ -1,0 +1,244 @@
+#include "daemon/rig_yaml.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <set>
+
+#include <fmt/format.h>
+
+namespace surroundd::daemon {
+namespace {
+
+using processing::LensModel;
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+
+// An image sequence pattern ("front_%06d.png") names no single file; check that its first frame
+// exists, with FFmpeg's image2 default start numbers.
+bool sequenceExists(const std::filesystem::path& pattern) {
+  for (int index = 0; index <= 4; ++index) {
+    std::string name(pattern.string().size() + 32, '\0');
+    const int length = std::snprintf(name.data(), name.size(), pattern.c_str(), index);
+    if (length > 0 && std::filesystem::exists(name.substr(0, static_cast<std::size_t>(length)))) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// A source whose file is wrong is still returned (its error is already recorded), so that the
+// camera is not reported a second time as having no source.
+capture::FileSourceSettings readSource(YamlObject& source) {
+  capture::FileSourceSettings settings;
+  const auto path = source.outputPath("file");
+  settings.loop = source.boolean("loop", false);
+  settings.sequenceFps =
+      source.number("sequence_fps", 30.0, {0.0, 1000.0, true, "frames per second"});
+  source.finish();
+  if (!path) return settings;
+  settings.path = *path;
+  std::error_code ec;
+  if (path->string().find('%') != std::string::npos) {
+    if (!sequenceExists(*path)) {
+      source.error(
+          "file",
+          fmt::format("expected an image sequence, got '{}' (its first frame does not exist)",
+                      path->string()));
+    }
+  } else if (!std::filesystem::is_regular_file(*path, ec)) {
+    source.error(
+        "file",
+        fmt::format("expected an existing video file, got '{}' ({})", path->string(),
+                    std::filesystem::exists(*path, ec) ? "not a regular file" : "no such file"));
+  }
+  return settings;
+}
+
+processing::Intrinsics readLens(YamlObject& lens) {
+  processing::Intrinsics in;
+  in.model = lens.choice("model", LensModel::kPinhole,
+                         {{"pinhole", LensModel::kPinhole}, {"fisheye", LensModel::kFisheye}});
+  const int width = lens.requiredInteger("width_px", 16, 16384).value_or(0);
+  const int height = lens.requiredInteger("height_px", 16, 16384).value_or(0);
+  in.imageSize = cv::Size(width, height);
+  in.fx = lens.requiredNumber("fx_px", {0.0, 1e6, true, "pixels"}).value_or(1.0);
+  in.fy = lens.requiredNumber("fy_px", {0.0, 1e6, true, "pixels"}).value_or(1.0);
+  in.cx = lens.requiredNumber("cx_px",
+                              {0.0, std::max(width, 1) * 1.0, false, "pixels, inside the image"})
+              .value_or(0.0);
+  in.cy = lens.requiredNumber("cy_px",
+                              {0.0, std::max(height, 1) * 1.0, false, "pixels, inside the image"})
+              .value_or(0.0);
+  const bool fisheye = in.model == LensModel::kFisheye;
+  const auto distortion =
+      fisheye ? lens.numbers("distortion", {4}) : lens.numbers("distortion", {4, 5});
+  if (distortion) std::copy(distortion->begin(), distortion->end(), in.distortion.begin());
+  if (fisheye) {
+    in.maxFieldAngleRad =
+        lens.number("field_of_view_deg", 180.0, {0.0, 360.0, true, "degrees, full field"}) *
+        kDegToRad / 2;
+  } else if (lens.has("field_of_view_deg")) {
+    lens.error("field_of_view_deg",
+               "only a fisheye lens takes this key (a pinhole sees less than 180 degrees)");
+  }
+  lens.finish();
+  return in;
+}
+
+processing::Pose readMount(YamlObject& mount) {
+  processing::Pose pose;
+  const NumberRange metres{-100.0, 100.0, false, "metres, vehicle frame"};
+  pose.position = {mount.requiredNumber("x_m", metres).value_or(0.0),
+                   mount.requiredNumber("y_m", metres).value_or(0.0),
+                   mount.requiredNumber("z_m", metres).value_or(0.0)};
+  const bool angles = mount.has("yaw_deg") || mount.has("pitch_deg") || mount.has("roll_deg");
+  if (mount.has("quaternion_wxyz")) {
+    if (angles)
+      mount.errorHere("give either yaw_deg/pitch_deg/roll_deg or quaternion_wxyz, not both");
+    if (const auto q = mount.numbers("quaternion_wxyz", {4})) {
+      const double norm =
+          std::sqrt((*q)[0] * (*q)[0] + (*q)[1] * (*q)[1] + (*q)[2] * (*q)[2] + (*q)[3] * (*q)[3]);
+      if (std::abs(norm - 1.0) > 1e-3) {
+        mount.error("quaternion_wxyz",
+                    fmt::format("expected a unit quaternion (a rotation), got norm {:.6g}", norm));
+      } else {
+        const double w = (*q)[0] / norm, x = (*q)[1] / norm, y = (*q)[2] / norm, z = (*q)[3] / norm;
+        pose.rotation =
+            cv::Matx33d(1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+                        2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                        2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y));
+      }
+    }
+  } else {
+    const NumberRange degrees{-360.0, 360.0, false, "degrees"};
+    pose.rotation = processing::rotationFromMountAngles({mount.number("yaw_deg", 0.0, degrees),
+                                                         mount.number("pitch_deg", 0.0, degrees),
+                                                         mount.number("roll_deg", 0.0, degrees)});
+  }
+  mount.finish();
+  return pose;
+}
+
+// Default colour role: cameras looking mostly along the vehicle (front, back) are sources, the
+// sideways ones targets — the paper's arrangement.
+processing::ColourRole defaultRole(const processing::Pose& pose) {
+  const cv::Vec3d axis = pose.rotation * cv::Vec3d(0, 0, 1);
+  return std::abs(axis[0]) >= std::abs(axis[1]) ? processing::ColourRole::kSource
+                                                : processing::ColourRole::kTarget;
+}
+
+}  // namespace
+
+std::vector<RigCamera> readRigCameras(YamlObject& rig) {
+  std::vector<RigCamera> cameras;
+  std::set<std::string, std::less<>> names;
+  for (auto& entry : rig.objectList("cameras", 1, 8)) {
+    RigCamera camera;
+    auto& calibration = camera.calibration;
+    calibration.name = entry.requiredString("name").value_or("");
+    if (!calibration.name.empty() && !names.insert(calibration.name).second) {
+      entry.error("name", fmt::format("duplicate camera name '{}' (names must be unique)",
+                                      calibration.name));
+    }
+    if (auto lens = entry.object("lens")) {
+      calibration.intrinsics = readLens(*lens);
+    } else {
+      entry.errorHere("missing key 'lens' (model, size and intrinsics)");
+    }
+    if (auto mount = entry.object("mount")) {
+      calibration.pose = readMount(*mount);
+    } else {
+      entry.errorHere("missing key 'mount' (position and orientation on the vehicle)");
+    }
+    calibration.role = entry.choice(
+        "role", defaultRole(calibration.pose),
+        {{"source", processing::ColourRole::kSource}, {"target", processing::ColourRole::kTarget}});
+    if (auto source = entry.object("source")) camera.source = readSource(*source);
+    entry.finish();
+    cameras.push_back(std::move(camera));
+  }
+  return cameras;
+}
+
+std::vector<RigCamera> loadRigFile(const std::filesystem::path& file) {
+  Diagnostics diag;
+  YamlObject root(parseYamlFile(file), "", file, diag);
+  auto cameras = readRigCameras(root);
+  root.finish();
+  diag.throwIfAny();
+  return cameras;
+}
+
+namespace {
+
+void emitCamera(YAML::Emitter& out, const RigCamera& camera, const std::filesystem::path& folder) {
+  const auto& c = camera.calibration;
+  const auto& in = c.intrinsics;
+  const bool fisheye = in.model == LensModel::kFisheye;
+  out << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << c.name;
+  out << YAML::Key << "role" << YAML::Value
+      << (c.role == processing::ColourRole::kSource ? "source" : "target");
+  if (camera.source) {
+    const auto& path = camera.source->path;
+    const bool inside = path.parent_path() == folder;
+    out << YAML::Key << "source" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "file" << YAML::Value << (inside ? path.filename() : path).string();
+    if (camera.source->loop) out << YAML::Key << "loop" << YAML::Value << true;
+    out << YAML::EndMap;
+  }
+  out << YAML::Key << "lens" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "model" << YAML::Value << (fisheye ? "fisheye" : "pinhole");
+  out << YAML::Key << "width_px" << YAML::Value << in.imageSize.width;
+  out << YAML::Key << "height_px" << YAML::Value << in.imageSize.height;
+  out << YAML::Key << "fx_px" << YAML::Value << in.fx;
+  out << YAML::Key << "fy_px" << YAML::Value << in.fy;
+  out << YAML::Key << "cx_px" << YAML::Value << in.cx;
+  out << YAML::Key << "cy_px" << YAML::Value << in.cy;
+  out << YAML::Key << "distortion" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (std::size_t i = 0; i < (fisheye ? 4U : 5U); ++i) out << in.distortion[i];
+  out << YAML::EndSeq;
+  if (fisheye) {
+    out << YAML::Key << "field_of_view_deg" << YAML::Value
+        << in.maxFieldAngleRad * 2 * 180.0 / std::numbers::pi;
+  }
+  out << YAML::EndMap;
+  const auto angles = processing::mountAnglesFromRotation(c.pose.rotation);
+  out << YAML::Key << "mount" << YAML::Value << YAML::Flow << YAML::BeginMap;
+  out << YAML::Key << "x_m" << YAML::Value << c.pose.position[0];
+  out << YAML::Key << "y_m" << YAML::Value << c.pose.position[1];
+  out << YAML::Key << "z_m" << YAML::Value << c.pose.position[2];
+  out << YAML::Key << "yaw_deg" << YAML::Value << angles.yawDeg;
+  out << YAML::Key << "pitch_deg" << YAML::Value << angles.pitchDeg;
+  out << YAML::Key << "roll_deg" << YAML::Value << angles.rollDeg;
+  out << YAML::EndMap;
+  out << YAML::EndMap;
+}
+
+}  // namespace
+
+void writeRigFile(const std::filesystem::path& file, std::span<const RigCamera> cameras,
+                  std::string_view headerComment) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);  // shortest exact round trip of a double is at most 17 digits
+  if (!headerComment.empty()) out << YAML::Comment(std::string(headerComment));
+  out << YAML::BeginMap << YAML::Key << "cameras" << YAML::Value << YAML::BeginSeq;
+  for (const auto& camera : cameras) emitCamera(out, camera, file.parent_path());
+  out << YAML::EndSeq << YAML::EndMap;
+  if (!out.good())
+    throw ConfigError(
+        {fmt::format("{}: cannot write the rig: {}", file.string(), out.GetLastError())});
+  // Written beside and renamed, so a reader never sees half a rig.
+  const auto partial = std::filesystem::path(file.string() + ".part");
+  {
+    std::ofstream stream(partial, std::ios::trunc);
+    stream << out.c_str() << '\n';
+    if (!stream.flush())
+      throw ConfigError({fmt::format("{}: cannot write the file", partial.string())});
+  }
+  std::filesystem::rename(partial, file);
+}
+
+}  // namespace surroundd::daemon

@@ -1,0 +1,43 @@
+#pragma once
+// The rig in YAML: a list of cameras with lens, mount and (for surroundd) a source.
+//
+//   cameras:
+//     - name: front
+//       role: source                       # source | target (colour correction)
+//       source: {file: front.mkv}          # relative to the file that names it
+//       lens: {model: pinhole, width_px: 1280, height_px: 720, fx_px: .., fy_px: .., cx_px: ..,
+//              cy_px: .., distortion: [k1, k2, p1, p2, k3]}
+//       mount: {x_m: .., y_m: .., z_m: .., yaw_deg: .., pitch_deg: .., roll_deg: ..}
+//
+// The same schema is used inline in a config (`rig: {cameras: [...]}`) and in a rig file of its own
+// (`rig: {file: rig.yaml}`; the generator writes one next to its recordings).
+
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "capture/file_source.hpp"
+#include "daemon/yaml_reader.hpp"
+#include "processing/rig.hpp"
+
+namespace surroundd::daemon {
+
+struct RigCamera {
+  processing::CameraCalibration calibration;
+  std::optional<capture::FileSourceSettings> source;  // absent in rig presets (generator input)
+};
+
+// Reads and validates the `cameras` list of `rig`; errors go to the object's Diagnostics.
+std::vector<RigCamera> readRigCameras(YamlObject& rig);
+
+// A whole rig file; throws ConfigError listing every problem.
+std::vector<RigCamera> loadRigFile(const std::filesystem::path& file);
+
+// Writes a rig file that loadRigFile reads back to the same calibration (doubles round-trip
+// exactly). Source paths are written relative to the file's folder when they lie inside it.
+void writeRigFile(const std::filesystem::path& file, std::span<const RigCamera> cameras,
+                  std::string_view headerComment);
+
+}  // namespace surroundd::daemon

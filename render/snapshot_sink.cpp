@@ -1,0 +1,30 @@
+#include <fmt/format.h>
+
+#include "render/frame_sink.hpp"
+#include "render/image_file.hpp"
+
+namespace surroundd::render {
+
+SnapshotSink::SnapshotSink(std::filesystem::path path, std::chrono::nanoseconds at)
+    : path_(std::move(path)), at_(at) {}
+
+void SnapshotSink::consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) {
+  lastSeen_ = streamTime;
+  if (writtenAt_ || streamTime < at_) return;
+  writeImageFile(path_, bgr);
+  writtenAt_ = streamTime;
+}
+
+void SnapshotSink::finish(const cv::Mat& lastFrame) {
+  if (writtenAt_ || lastFrame.empty()) return;
+  writeImageFile(path_, lastFrame);
+  writtenAt_ = lastSeen_;
+}
+
+std::string SnapshotSink::describe() const {
+  if (!writtenAt_) return fmt::format("snapshot {} (not written: no frames)", path_.string());
+  return fmt::format("snapshot {} (at {:.3f} s)", path_.string(),
+                     std::chrono::duration<double>(*writtenAt_).count());
+}
+
+}  // namespace surroundd::render

@@ -1,0 +1,61 @@
+#pragma once
+// H.264 (libx264 through FFmpeg's libavcodec) into MP4 or MKV (chosen by the file extension).
+//
+// The file is written as "<path>.part" and renamed to <path> only when it has been finalized
+// (trailer written), so a finished name always plays and nothing half-written carries it. close()
+// finalizes; the destructor finalizes too if close() was not called (an exception or a signal on
+// the way out still leaves a playable file).
+//
+// Error policy: the constructor, write() and close() throw EncoderError with a message naming the
+// file; the caller decides whether to stop or drop the output.
+
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+namespace surroundd::render {
+
+class EncoderError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct VideoEncoderSettings {
+  std::filesystem::path path;  // .mp4 or .mkv
+  cv::Size size;               // frame size in pixels (even width and height)
+  double nominalFps = 30.0;    // rate hint for the container; timestamps decide the real timing
+  int crf = 20;                // x264 constant rate factor; 0 = lossless
+  std::string preset = "veryfast";  // x264 preset
+  std::string pixelFormat =
+      "yuv420p";          // yuv420p (plays everywhere) or yuv444p (camera-master quality)
+  int threads = 0;        // encoder threads; 0 = codec's choice. Fix it for identical bytes.
+  bool bitExact = false;  // leave out version strings so the same input gives the same bytes
+
+  bool operator==(const VideoEncoderSettings&) const = default;
+};
+
+class VideoEncoder {
+ public:
+  explicit VideoEncoder(VideoEncoderSettings settings);
+  ~VideoEncoder();
+  VideoEncoder(const VideoEncoder&) = delete;
+  VideoEncoder& operator=(const VideoEncoder&) = delete;
+
+  // `bgr` is 8-bit BGR of settings.size. Timestamps must increase; they are kept to the
+  // microsecond in the file.
+  void write(const cv::Mat& bgr, std::chrono::nanoseconds timestamp);
+  void close();
+
+  const std::filesystem::path& path() const;
+  std::uint64_t framesWritten() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace surroundd::render

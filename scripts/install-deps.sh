@@ -1,0 +1,38 @@
+#!/bin/sh
+# Installs the Debian 12 packages surroundd needs to build, test and run. Idempotent: installs only
+# what is missing and says what that is. Runs apt-get as root, or through sudo.
+set -eu
+
+PACKAGES="
+  build-essential cmake pkg-config
+  libopencv-dev libyaml-cpp-dev libspdlog-dev libfmt-dev
+  libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
+  libgtest-dev libgmock-dev
+"
+
+missing=""
+for package in $PACKAGES; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+    missing="$missing $package"
+  fi
+done
+
+if [ -z "$missing" ]; then
+  echo "install-deps: all packages present"
+  exit 0
+fi
+
+if [ "$(id -u)" -eq 0 ]; then
+  as_root=""
+elif command -v sudo >/dev/null 2>&1; then
+  as_root="sudo"
+else
+  echo "install-deps: need root or sudo to install:$missing" >&2
+  exit 1
+fi
+
+echo "install-deps: installing:$missing"
+export DEBIAN_FRONTEND=noninteractive
+$as_root apt-get update -q
+# shellcheck disable=SC2086 # the list is meant to split into words
+$as_root apt-get install -y -q --no-install-recommends $missing

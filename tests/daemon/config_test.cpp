@@ -1,0 +1,228 @@
+// Config validation: a good config loads to the expected values, and each class of mistake gives
+// one message that names the file, line, column, key path and what was expected.
+
+#include "daemon/config.hpp"
+
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "tests/support/temp_dir.hpp"
+
+namespace surroundd::daemon {
+namespace {
+
+using ::testing::HasSubstr;
+
+// Two cameras are enough for the schema; line numbers below refer to this text.
+constexpr std::string_view kGoodConfig = R"(logging:
+  level: debug
+rig:
+  cameras:
+    - name: front
+      source: {file: front.mkv}
+      lens: {model: pinhole, width_px: 640, height_px: 360, fx_px: 300, fy_px: 300, cx_px: 319.5, cy_px: 179.5}
+      mount: {x_m: 1.0, y_m: 0.0, z_m: 1.8, yaw_deg: 0, pitch_deg: -20}
+    - name: left
+      source: {file: left.mkv}
+      lens: {model: fisheye, width_px: 640, height_px: 360, fx_px: 200, fy_px: 200, cx_px: 320, cy_px: 180, distortion: [0.01, 0, 0, 0]}
+      mount: {x_m: 0.0, y_m: 0.9, z_m: 1.0, yaw_deg: 90, pitch_deg: -40}
+capture:
+  pacing: as_fast_as_possible
+  sync_tolerance_ms: 5
+render:
+  width_px: 640
+  height_px: 360
+outputs:
+  - {type: video, path: out/mosaic.mp4, crf: 18}
+  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}
+)";
+
+class ConfigTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_.write("front.mkv", "");
+    dir_.write("left.mkv", "");
+  }
+
+  // The good config with `from` replaced by `to` (which must occur).
+  std::filesystem::path configWith(std::string_view from, std::string_view to) {
+    std::string text(kGoodConfig);
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    return dir_.write("config.yaml", text);
+  }
+
+  // The messages loadConfig throws for `file`; empty if it loads.
+  static std::vector<std::string> errorsOf(const std::filesystem::path& file) {
+    try {
+      loadConfig(file);
+    } catch (const ConfigError& e) {
+      return e.messages();
+    }
+    return {};
+  }
+
+  // Exactly one message, which must contain every part.
+  void expectOneError(std::string_view from, std::string_view to,
+                      std::initializer_list<std::string_view> parts) {
+    const auto file = configWith(from, to);
+    const auto messages = errorsOf(file);
+    ASSERT_EQ(messages.size(), 1u) << ::testing::PrintToString(messages);
+    for (const auto part : parts) EXPECT_THAT(messages[0], HasSubstr(std::string(part)));
+  }
+
+  std::string where(int line, int column) const {
+    return (dir_ / "config.yaml").string() + ":" + std::to_string(line) + ":" +
+           std::to_string(column);
+  }
+
+  testing::TempDir dir_;
+};
+
+TEST_F(ConfigTest, GoodConfigLoads) {
+  const Config config = loadConfig(configWith("", ""));
+  EXPECT_EQ(config.logLevel, spdlog::level::debug);
+  ASSERT_EQ(config.cameras.size(), 2u);
+  const auto& front = config.cameras[0];
+  EXPECT_EQ(front.calibration.name, "front");
+  EXPECT_EQ(front.source->path, dir_ / "front.mkv");  // relative to the config's folder
+  EXPECT_EQ(front.calibration.role, processing::ColourRole::kSource);
+  EXPECT_EQ(config.cameras[1].calibration.role, processing::ColourRole::kTarget);
+  EXPECT_EQ(config.cameras[1].calibration.intrinsics.model, processing::LensModel::kFisheye);
+  // Pitched down 20 degrees, looking forward: the optical axis is (cos 20, 0, -sin 20).
+  const cv::Vec3d axis = front.calibration.pose.rotation * cv::Vec3d(0, 0, 1);
+  EXPECT_NEAR(axis[0], std::cos(20 * CV_PI / 180), 1e-12);
+  EXPECT_NEAR(axis[2], -std::sin(20 * CV_PI / 180), 1e-12);
+  EXPECT_EQ(config.capture.pacing, capture::Pacing::kAsFastAsPossible);
+  EXPECT_DOUBLE_EQ(config.capture.syncToleranceMs, 5.0);
+  ASSERT_EQ(config.outputs.size(), 2u);
+  EXPECT_EQ(config.outputs[0].path, dir_ / "out/mosaic.mp4");
+  EXPECT_EQ(config.outputs[0].crf, 18);
+  EXPECT_EQ(config.outputs[1].kind, OutputKind::kSnapshot);
+  EXPECT_DOUBLE_EQ(config.outputs[1].atSeconds, 0.5);
+  EXPECT_EQ(config.panorama.widthPx, PanoramaConfig{}.widthPx);  // absent sections keep defaults
+}
+
+TEST_F(ConfigTest, UnknownKey) {
+  expectOneError("  sync_tolerance_ms: 5", "  sync_tolerance_ms: 5\n  sync_tolerence_ms: 5",
+                 {where(16, 3),
+                  "capture.sync_tolerence_ms: unknown key (expected one of:", "sync_tolerance_ms"});
+}
+
+TEST_F(ConfigTest, WrongType) {
+  expectOneError("width_px: 640\n  height", "width_px: wide\n  height",
+                 {where(17, 13), "render.width_px: expected a whole number", "'wide'"});
+}
+
+TEST_F(ConfigTest, OutOfRange) {
+  expectOneError("sync_tolerance_ms: 5", "sync_tolerance_ms: -3",
+                 {where(15, 22), "capture.sync_tolerance_ms: expected a number in [0, 1000]",
+                  "milliseconds", "-3"});
+}
+
+TEST_F(ConfigTest, MissingFile) {
+  expectOneError("{file: left.mkv}", "{file: lfet.mkv}",
+                 {"rig.cameras[1].source.file: expected an existing video file",
+                  (dir_ / "lfet.mkv").string(), "no such file"});
+}
+
+TEST_F(ConfigTest, DuplicateCameraNames) {
+  expectOneError("- name: left", "- name: front",
+                 {where(9, 13), "rig.cameras[1].name: duplicate camera name 'front'"});
+}
+
+TEST_F(ConfigTest, MissingRequiredKey) {
+  expectOneError("fx_px: 300, ", "", {where(7, 13), "rig.cameras[0].lens: missing key 'fx_px'"});
+}
+
+TEST_F(ConfigTest, NotARotation) {
+  expectOneError("yaw_deg: 90, pitch_deg: -40", "quaternion_wxyz: [1, 0.2, 0, 0]",
+                 {"rig.cameras[1].mount.quaternion_wxyz: expected a unit quaternion (a rotation)"});
+}
+
+TEST_F(ConfigTest, WrongChoice) {
+  expectOneError("model: fisheye", "model: fishey",
+                 {"rig.cameras[1].lens.model: expected one of 'pinhole' 'fisheye'", "'fishey'"});
+}
+
+TEST_F(ConfigTest, OddFrameSize) {
+  expectOneError("width_px: 640\n  height", "width_px: 641\n  height",
+                 {"render.width_px: expected an even number, got 641"});
+}
+
+TEST_F(ConfigTest, TwoOutputsWriteOneFile) {
+  expectOneError("{type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "{type: video, path: out/../out/mosaic.mp4}",
+                 {where(21, 25), "outputs[1].path: two outputs write"});
+}
+
+TEST_F(ConfigTest, YamlSyntaxError) {
+  expectOneError("  level: debug", "  level: [debug", {"config.yaml:", "not valid YAML"});
+}
+
+TEST_F(ConfigTest, EveryProblemIsReportedAtOnce) {
+  std::string text(kGoodConfig);
+  text.replace(text.find("sync_tolerance_ms: 5"), 20, "sync_tolerance_ms: -1");
+  text.replace(text.find("{file: left.mkv}"), 16, "{file: gone.mkv}");
+  text += "colour: {}\n";
+  EXPECT_EQ(errorsOf(dir_.write("config.yaml", text)).size(), 3u);
+}
+
+TEST_F(ConfigTest, MissingConfigFile) {
+  const auto messages = errorsOf(dir_ / "absent.yaml");
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_THAT(messages[0], HasSubstr((dir_ / "absent.yaml").string()));
+  EXPECT_THAT(messages[0], HasSubstr("cannot open"));
+}
+
+TEST_F(ConfigTest, RigFileRoundTripsExactly) {
+  const Config config = loadConfig(configWith("", ""));
+  const auto rigFile = dir_ / "rig.yaml";
+  writeRigFile(rigFile, config.cameras, "written by config_test");
+  const auto cameras = loadRigFile(rigFile);
+  ASSERT_EQ(cameras.size(), config.cameras.size());
+  for (std::size_t i = 0; i < cameras.size(); ++i) {
+    const auto& a = cameras[i].calibration;
+    const auto& b = config.cameras[i].calibration;
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.role, b.role);
+    EXPECT_EQ(a.intrinsics, b.intrinsics);
+    EXPECT_EQ(a.pose.position, b.pose.position);
+    EXPECT_LT(cv::norm(a.pose.rotation - b.pose.rotation, cv::NORM_INF), 1e-12);
+    EXPECT_EQ(cameras[i].source->path, config.cameras[i].source->path);
+  }
+}
+
+// The reference config shows every key at its default: loading it must give the code's defaults.
+TEST(ReferenceConfig, DocumentsTheDefaults) {
+  const testing::TempDir dir;
+  std::filesystem::create_directories(dir / "config");
+  std::filesystem::copy_file(
+      std::filesystem::path(SURROUNDD_SOURCE_DIR) / "config/surroundd.reference.yaml",
+      dir / "config/surroundd.reference.yaml");
+  for (const auto* name : {"front", "right", "back", "left"}) {
+    dir.write(std::string("recordings/demo/") + name + ".mkv", "");
+  }
+  const Config config = loadConfig(dir / "config/surroundd.reference.yaml");
+  EXPECT_EQ(config.logLevel, spdlog::level::info);
+  EXPECT_EQ(config.cameras.size(), 4u);
+  EXPECT_EQ(config.capture, CaptureConfig{});
+  EXPECT_EQ(config.panorama, PanoramaConfig{});
+  EXPECT_EQ(config.colour, ColourCorrectionConfig{});
+  EXPECT_EQ(config.mesh, MeshConfig{});
+  EXPECT_EQ(config.render, RenderConfig{});
+  ASSERT_EQ(config.outputs.size(), 2u);
+  OutputConfig video;
+  video.path = config.outputs[0].path;
+  EXPECT_EQ(config.outputs[0], video);
+  OutputConfig snapshot;
+  snapshot.kind = OutputKind::kSnapshot;
+  snapshot.path = config.outputs[1].path;
+  EXPECT_EQ(config.outputs[1], snapshot);
+}
+
+}  // namespace
+}  // namespace surroundd::daemon

@@ -1,0 +1,120 @@
+// surroundd as a user runs it: replay a generated recording, decode the MP4 it wrote and compare it
+// with the mosaic of the source frames; stop it with SIGTERM; give it a bad config.
+
+#include <thread>
+
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "capture/file_source.hpp"
+#include "daemon/rig_yaml.hpp"
+#include "render/mosaic.hpp"
+#include "tests/support/child_process.hpp"
+#include "tests/support/temp_dir.hpp"
+
+namespace surroundd {
+namespace {
+
+using ::testing::HasSubstr;
+
+const std::filesystem::path kRecording =
+    std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
+const cv::Size kOutputSize(640, 360);
+
+std::filesystem::path writeConfig(const testing::TempDir& dir, std::string_view extra = "") {
+  return dir.write("config.yaml", fmt::format(R"(rig: {{file: {}}}
+render: {{width_px: {}, height_px: {}}}
+outputs:
+  - {{type: video, path: out/mosaic.mp4, crf: 16}}
+  - {{type: snapshot, path: out/mosaic.png, at_s: 0.5}}
+{})",
+                                              (kRecording / "rig.yaml").string(), kOutputSize.width,
+                                              kOutputSize.height, extra));
+}
+
+std::vector<cv::Mat> decodeAll(const std::filesystem::path& file) {
+  capture::FileSource source("check", {file, 30.0, false, capture::Pacing::kAsFastAsPossible});
+  capture::Frame frame;
+  frame.image.create(source.frameSize(), CV_8UC3);
+  std::vector<cv::Mat> frames;
+  while (source.read(frame) == capture::ReadStatus::kFrame) frames.push_back(frame.image.clone());
+  return frames;
+}
+
+TEST(EndToEnd, MosaicVideoMatchesTheSourceFrames) {
+  const testing::TempDir dir;
+  testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--config", writeConfig(dir).string(),
+                                   "--pacing", "as_fast_as_possible"},
+                                  dir / "log.txt");
+  ASSERT_EQ(surroundd.wait(), 0) << surroundd.output();
+
+  const auto rig = daemon::loadRigFile(kRecording / "rig.yaml");
+  std::vector<std::string> names;
+  std::vector<std::vector<cv::Mat>> sources;
+  for (const auto& camera : rig) {
+    names.push_back(camera.calibration.name);
+    sources.push_back(decodeAll(camera.source->path));
+  }
+  const auto video = decodeAll(dir / "out/mosaic.mp4");
+  ASSERT_EQ(video.size(),
+            sources[0].size());  // one frame set per frame: the recording drops nothing
+
+  const render::Mosaic mosaic(kOutputSize, names);
+  cv::Mat expected(kOutputSize, CV_8UC3);
+  for (const std::size_t k : {std::size_t{0}, video.size() / 2, video.size() - 1}) {
+    std::vector<const cv::Mat*> frames;
+    for (const auto& camera : sources) frames.push_back(&camera[k]);
+    mosaic.compose(frames, expected);
+    EXPECT_GE(cv::PSNR(expected, video[k]), 35.0) << "frame " << k;
+  }
+
+  const cv::Mat snapshot = cv::imread((dir / "out/mosaic.png").string());
+  EXPECT_EQ(snapshot.size(), kOutputSize);
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "out")) {
+    EXPECT_NE(entry.path().extension(), ".part") << entry.path();
+  }
+  EXPECT_THAT(surroundd.output(), HasSubstr("wrote video"));
+}
+
+TEST(EndToEnd, SigtermLeavesAPlayableFile) {
+  const testing::TempDir dir;
+  testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--config", writeConfig(dir).string()},
+                                  dir / "log.txt");
+  // Once the cameras are open (logged) the signal handlers are in place; then stop mid-recording.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (surroundd.output().find("camera 'left'") == std::string::npos &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  surroundd.signal(SIGTERM);
+  ASSERT_EQ(surroundd.wait(), 0) << surroundd.output();
+  const auto frames = decodeAll(dir / "out/mosaic.mp4");
+  EXPECT_GE(frames.size(), 1u);
+  EXPECT_FALSE(std::filesystem::exists(dir / "out/mosaic.mp4.part"));
+  EXPECT_TRUE(
+      std::filesystem::exists(dir / "out/mosaic.png"));  // the last frame, as the run was short
+}
+
+TEST(EndToEnd, BadConfigOpensNothing) {
+  const testing::TempDir dir;
+  testing::ChildProcess surroundd(
+      {SURROUNDD_EXECUTABLE, "--config", writeConfig(dir, "capture: {queue_frames: 0}").string()},
+      dir / "log.txt");
+  EXPECT_EQ(surroundd.wait(), 2);
+  EXPECT_THAT(surroundd.output(),
+              HasSubstr("config.yaml:6:25: capture.queue_frames: expected a whole number"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+}
+
+TEST(EndToEnd, UnknownOptionIsAUsageError) {
+  const testing::TempDir dir;
+  testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--confg", "x.yaml"}, dir / "log.txt");
+  EXPECT_EQ(surroundd.wait(), 2);
+  EXPECT_THAT(surroundd.output(), HasSubstr("unknown option '--confg'"));
+}
+
+}  // namespace
+}  // namespace surroundd

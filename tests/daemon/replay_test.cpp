@@ -1,0 +1,108 @@
+// Replay of a generated recording in which one camera drops frames: the file sources deliver the
+// recorded timestamps, and the pipeline loses exactly the frame sets that camera misses.
+
+#include <algorithm>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "capture/file_source.hpp"
+#include "daemon/pipeline.hpp"
+#include "daemon/rig_yaml.hpp"
+#include "tests/support/temp_dir.hpp"
+
+namespace surroundd::daemon {
+namespace {
+
+const std::filesystem::path kRecording =
+    std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_drop";
+
+std::vector<capture::Timestamp> timestampsOf(const std::filesystem::path& file) {
+  capture::FileSource source("check", {file, 30.0, false, capture::Pacing::kAsFastAsPossible});
+  capture::Frame frame;
+  frame.image.create(source.frameSize(), CV_8UC3);
+  std::vector<capture::Timestamp> timestamps;
+  while (source.read(frame) == capture::ReadStatus::kFrame) timestamps.push_back(frame.timestamp);
+  return timestamps;
+}
+
+class ReplayTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    config_.cameras = loadRigFile(kRecording / "rig.yaml");
+    for (const auto& camera : config_.cameras)
+      timestamps_.push_back(timestampsOf(camera.source->path));
+    const auto fewest =
+        std::min_element(timestamps_.begin(), timestamps_.end(),
+                         [](const auto& a, const auto& b) { return a.size() < b.size(); });
+    dropping_ = static_cast<std::size_t>(fewest - timestamps_.begin());
+  }
+
+  Config config_;
+  std::vector<std::vector<capture::Timestamp>> timestamps_;
+  std::size_t dropping_ = 0;
+};
+
+TEST_F(ReplayTest, TimestampsAreTheRecordedOnes) {
+  using std::chrono::milliseconds;
+  const auto period = std::chrono::nanoseconds(33'333'333);
+  for (std::size_t c = 0; c < timestamps_.size(); ++c) {
+    const auto& t = timestamps_[c];
+    ASSERT_GT(t.size(), 10u);
+    // Cameras start within a few milliseconds of each other, as a real rig does.
+    EXPECT_LT(std::chrono::abs(t.front() - timestamps_[0].front()), milliseconds(8)) << c;
+    int gaps = 0;
+    for (std::size_t i = 1; i < t.size(); ++i) {
+      const auto step = t[i] - t[i - 1];
+      const bool onePeriod = std::chrono::abs(step - period) <= milliseconds(3);
+      const bool twoPeriods = std::chrono::abs(step - 2 * period) <= milliseconds(3);
+      EXPECT_TRUE(onePeriod || twoPeriods) << "camera " << c << " frame " << i;
+      gaps += twoPeriods ? 1 : 0;
+    }
+    // Only the dropping camera has gaps, one per frame it left out (its last frame may be one).
+    const auto& other = timestamps_[(dropping_ + 1) % timestamps_.size()];
+    const auto missing = static_cast<int>(other.size() - t.size());
+    const int atTheEnd = static_cast<int>(std::lround((other.back() - t.back()) / period));
+    EXPECT_EQ(gaps + atTheEnd, missing) << "camera " << c;
+    if (c == dropping_) {
+      EXPECT_GT(gaps, 0);
+    }
+  }
+  EXPECT_GT(timestamps_[(dropping_ + 1) % timestamps_.size()].size(),
+            timestamps_[dropping_].size());
+}
+
+TEST_F(ReplayTest, PipelineLosesOnlyTheSetsOfTheDroppedFrames) {
+  const testing::TempDir dir;
+  config_.capture.pacing = capture::Pacing::kAsFastAsPossible;
+  config_.render = {ViewKind::kTop, 320, 180};
+  OutputConfig snapshot;
+  snapshot.kind = OutputKind::kSnapshot;
+  snapshot.path = dir / "last.png";
+  snapshot.atSeconds = 1e6;
+  config_.outputs = {snapshot};
+
+  Pipeline pipeline(config_);
+  const std::atomic<bool> stop{false};
+  const RunSummary summary = pipeline.run(stop);
+
+  // Each frame the camera left out while it ran costs one set; after its last frame the others go
+  // on with its slot empty.
+  const auto& dropping = timestamps_[dropping_];
+  std::size_t leftOut = 0;
+  for (std::size_t i = 1; i < dropping.size(); ++i) {
+    leftOut += dropping[i] - dropping[i - 1] > std::chrono::milliseconds(50) ? 1 : 0;
+  }
+  const std::size_t others = timestamps_[(dropping_ + 1) % timestamps_.size()].size();
+  EXPECT_EQ(summary.frameSets, others - leftOut);
+  for (std::size_t c = 0; c < timestamps_.size(); ++c) {
+    EXPECT_EQ(summary.cameras[c].frames, timestamps_[c].size()) << c;
+    EXPECT_EQ(summary.sync.unmatchedDropped[c], c == dropping_ ? 0 : leftOut) << c;
+    EXPECT_EQ(summary.sync.outOfOrderDropped[c], 0u);
+  }
+  EXPECT_LE(summary.sync.maxSpread, std::chrono::milliseconds(10));
+  EXPECT_TRUE(std::filesystem::exists(dir / "last.png"));
+}
+
+}  // namespace
+}  // namespace surroundd::daemon

@@ -1,0 +1,19 @@
+# Synthetic recordings shared by tests, made by the project's own generator once per test run.
+# surroundd_fixture(name ARGS...) adds a setup test that writes ${SURROUNDD_FIXTURE_DIR}/<name>;
+# tests that need it list FIXTURES <name>.
+function(surroundd_fixture name)
+  add_test(NAME fixture_${name}
+           COMMAND surround-synth --out ${SURROUNDD_FIXTURE_DIR}/${name} --force ${ARGN})
+  set_tests_properties(fixture_${name} PROPERTIES FIXTURES_SETUP ${name} LABELS fixtures)
+endfunction()
+
+set(paper ${PROJECT_SOURCE_DIR}/config/rigs/paper.yaml)
+set(fisheye ${PROJECT_SOURCE_DIR}/config/rigs/fisheye.yaml)
+set(small --size 320x180 --panorama-size 512x256)
+
+surroundd_fixture(synth_small --rig ${paper} ${small} --seconds 1 --seed 7)
+surroundd_fixture(synth_small_identity --rig ${paper} ${small} --seconds 1 --seed 7
+                  --photometrics identity)
+# One camera leaves out every third frame: for replay and synchronizer tests.
+surroundd_fixture(synth_drop --rig ${paper} ${small} --seconds 2 --seed 11 --drop-every right:3)
+surroundd_fixture(synth_fisheye --rig ${fisheye} ${small} --seconds 1 --seed 5)

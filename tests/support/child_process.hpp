@@ -1,0 +1,66 @@
+#pragma once
+// Runs one of the project's executables as a child process, with its stderr captured to a file, so
+// that tests can check exit codes, messages and signal handling the way a user would see them.
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace surroundd::testing {
+
+class ChildProcess {
+ public:
+  ChildProcess(std::vector<std::string> arguments, std::filesystem::path stderrFile)
+      : stderrFile_(std::move(stderrFile)) {
+    std::vector<char*> argv;
+    for (auto& argument : arguments) argv.push_back(argument.data());
+    argv.push_back(nullptr);
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      const int fd = ::open(stderrFile_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      ::dup2(fd, STDERR_FILENO);
+      ::dup2(fd, STDOUT_FILENO);
+      ::execv(argv[0], argv.data());
+      ::_exit(127);
+    }
+  }
+  ~ChildProcess() {
+    if (pid_ > 0 && !exited_) {
+      ::kill(pid_, SIGKILL);
+      wait();
+    }
+  }
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+
+  void signal(int number) const { ::kill(pid_, number); }
+
+  // Exit status, or 128 + signal number when it was killed.
+  int wait() {
+    int status = 0;
+    ::waitpid(pid_, &status, 0);
+    exited_ = true;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  }
+
+  std::string output() const {
+    std::ifstream file(stderrFile_);
+    std::stringstream text;
+    text << file.rdbuf();
+    return text.str();
+  }
+
+ private:
+  std::filesystem::path stderrFile_;
+  pid_t pid_ = -1;
+  bool exited_ = false;
+};
+
+}  // namespace surroundd::testing

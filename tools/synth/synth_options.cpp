@@ -1,0 +1,186 @@
+#include "tools/synth/synth_options.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+#include <fmt/format.h>
+
+namespace surroundd::synth {
+namespace {
+
+template <typename T>
+T parseNumber(std::string_view option, std::string_view text, T min, T max, std::string_view what) {
+  T value{};
+  const auto* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (ec != std::errc() || ptr != end || !(value >= min && value <= max)) {
+    throw UsageError(fmt::format("{}: expected {}, got '{}'", option, what, text));
+  }
+  return value;
+}
+
+cv::Size parseSize(std::string_view option, std::string_view text) {
+  const auto x = text.find('x');
+  const std::string what = "WIDTHxHEIGHT with even sides from 16 to 8192 (e.g. 1280x720)";
+  if (x == std::string_view::npos) {
+    throw UsageError(fmt::format("{}: expected {}, got '{}'", option, what, text));
+  }
+  try {
+    const int w = parseNumber<int>(option, text.substr(0, x), 16, 8192, what);
+    const int h = parseNumber<int>(option, text.substr(x + 1), 16, 8192, what);
+    // H.264 in 4:4:4 is fine with odd sizes, but players and the 4:2:0 outputs downstream are not.
+    if (w % 2 != 0 || h % 2 != 0) throw UsageError("");
+    return {w, h};
+  } catch (const UsageError&) {
+    throw UsageError(fmt::format("{}: expected {}, got '{}'", option, what, text));
+  }
+}
+
+std::vector<int> parseFrames(std::string_view option, std::string_view text) {
+  std::vector<int> frames;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const auto comma = text.find(',', start);
+    const auto item = text.substr(start, comma == std::string_view::npos ? text.npos : comma - start);
+    frames.push_back(parseNumber<int>(option, item, 0, 10'000'000,
+                                      "a comma-separated list of frame indices (e.g. 0,150,299)"));
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  return frames;
+}
+
+}  // namespace
+
+int SynthOptions::frameCount() const {
+  return std::max(1, static_cast<int>(std::lround(seconds * fps)));
+}
+
+std::string SynthOptions::canonical() const {
+  std::ostringstream s;
+  s << "size=" << (size ? fmt::format("{}x{}", size->width, size->height) : "preset")
+    << " seconds=" << fmt::format("{}", seconds) << " fps=" << fmt::format("{}", fps)
+    << " seed=" << seed << " photometrics=" << (randomPhotometrics ? "random" : "identity")
+    << " drift=" << drift << " noise_sigma=" << fmt::format("{}", noiseSigma) << " drop_every=";
+  for (const auto& [name, n] : dropEvery) s << name << ":" << n << ";";
+  s << " ground_truth_frames=";
+  if (groundTruthFrames) {
+    for (const int f : *groundTruthFrames) s << f << ";";
+  } else {
+    s << "default";
+  }
+  s << " panorama_size=" << panoramaSize.width << "x" << panoramaSize.height << " crf=" << crf;
+  return s.str();
+}
+
+bool wantsHelp(std::span<const std::string_view> arguments) {
+  for (const auto a : arguments) {
+    if (a == "--help" || a == "-h") return true;
+  }
+  return false;
+}
+
+SynthOptions parseSynthArguments(std::span<const std::string_view> arguments) {
+  SynthOptions o;
+  bool haveRig = false, haveOut = false;
+  for (std::size_t i = 0; i < arguments.size(); ++i) {
+    const std::string_view option = arguments[i];
+    const auto value = [&]() -> std::string_view {
+      if (i + 1 >= arguments.size()) throw UsageError(fmt::format("{}: missing its value", option));
+      return arguments[++i];
+    };
+    if (option == "--rig") {
+      o.rig = std::string(value());
+      haveRig = true;
+    } else if (option == "--out") {
+      o.out = std::string(value());
+      haveOut = true;
+    } else if (option == "--size") {
+      o.size = parseSize(option, value());
+    } else if (option == "--seconds") {
+      o.seconds = parseNumber<double>(option, value(), 0.01, 3600.0, "seconds from 0.01 to 3600");
+    } else if (option == "--fps") {
+      o.fps = parseNumber<double>(option, value(), 1.0, 240.0, "frames per second from 1 to 240");
+    } else if (option == "--seed") {
+      o.seed = parseNumber<std::uint64_t>(option, value(), 0, UINT64_MAX,
+                                          "a non-negative integer");
+    } else if (option == "--photometrics") {
+      const auto v = value();
+      if (v != "random" && v != "identity") {
+        throw UsageError(fmt::format("{}: expected 'random' or 'identity', got '{}'", option, v));
+      }
+      o.randomPhotometrics = v == "random";
+    } else if (option == "--no-drift") {
+      o.drift = false;
+    } else if (option == "--noise-sigma") {
+      o.noiseSigma = parseNumber<double>(option, value(), 0.0, 64.0, "8-bit levels from 0 to 64");
+    } else if (option == "--drop-every") {
+      const auto v = value();
+      const auto colon = v.rfind(':');
+      if (colon == std::string_view::npos || colon == 0) {
+        throw UsageError(
+            fmt::format("{}: expected CAMERA:N (e.g. right:3), got '{}'", option, v));
+      }
+      o.dropEvery.emplace_back(std::string(v.substr(0, colon)),
+                               parseNumber<int>(option, v.substr(colon + 1), 2, 1'000'000,
+                                                "CAMERA:N with N >= 2 (e.g. right:3)"));
+    } else if (option == "--ground-truth-frames") {
+      o.groundTruthFrames = parseFrames(option, value());
+    } else if (option == "--panorama-size") {
+      o.panoramaSize = parseSize(option, value());
+    } else if (option == "--crf") {
+      o.crf = parseNumber<int>(option, value(), 0, 51, "an x264 CRF from 0 (lossless) to 51");
+    } else if (option == "--force") {
+      o.force = true;
+    } else {
+      throw UsageError(fmt::format("unknown option '{}' (see --help)", option));
+    }
+  }
+  if (!haveRig) throw UsageError("--rig: missing (the rig preset YAML to render)");
+  if (!haveOut) throw UsageError("--out: missing (the folder to write the recording to)");
+  if (!o.randomPhotometrics) {
+    // Identity means neutral sensors: no noise, no drift, whatever else was asked.
+    o.noiseSigma = 0;
+    o.drift = false;
+  }
+  const int frames = o.frameCount();
+  if (o.groundTruthFrames) {
+    for (const int f : *o.groundTruthFrames) {
+      if (f >= frames) {
+        throw UsageError(fmt::format("--ground-truth-frames: frame {} is past the last frame {}",
+                                     f, frames - 1));
+      }
+    }
+  }
+  return o;
+}
+
+std::string synthUsage() {
+  return R"(surround-synth: renders a synthetic four-camera recording with ground truth.
+
+usage: surround-synth --rig FILE --out DIR [options]
+
+  --rig FILE                 rig preset YAML (cameras, lenses, mounts; sources not needed)
+  --out DIR                  output folder: <camera>.mkv, rig.yaml, ground_truth.yaml,
+                             ground_truth/*.png, manifest.yaml (written atomically)
+  --size WxH                 image size of every camera (intrinsics scaled; default: preset's)
+  --seconds S                length (default 10)
+  --fps F                    frame rate (default 30)
+  --seed N                   scene, photometrics, noise and timing (default 1)
+  --photometrics MODE        random (default) or identity (neutral, no noise, no drift)
+  --no-drift                 no slow exposure drift
+  --noise-sigma X            sensor noise in 8-bit levels (default 1.5)
+  --drop-every NAME:N        omit every Nth frame of camera NAME (repeatable)
+  --ground-truth-frames LIST frames with ground truth images (default: first, middle, last)
+  --panorama-size WxH        ground-truth panorama size (default 2048x1024)
+  --crf N                    x264 CRF of the videos (default 14, visually lossless)
+  --force                    replace DIR if it exists (a DIR made by the same arguments, rig and
+                             generator is kept as it is: "up to date")
+  --help                     this text
+
+exit status: 0 done or up to date, 1 failed while writing, 2 bad arguments or rig
+)";
+}
+
+}  // namespace surroundd::synth

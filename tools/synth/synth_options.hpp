@@ -1,0 +1,51 @@
+#pragma once
+// Command line of surround-synth: what to render and where. Parsing validates every value and
+// throws UsageError with one message naming the option (main prints it and exits 2).
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace surroundd::synth {
+
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct SynthOptions {
+  std::filesystem::path rig;           // rig preset YAML (sources not needed)
+  std::filesystem::path out;           // output folder
+  std::optional<cv::Size> size;        // per-camera image size; default: the preset's
+  double seconds = 10;                 // recording length
+  double fps = 30;                     // nominal frame rate
+  std::uint64_t seed = 1;
+  bool randomPhotometrics = true;      // false: identity (neutral, noise 0, no drift)
+  bool drift = true;                   // slow exposure drift
+  double noiseSigma = 1.5;             // sensor noise, 8-bit levels
+  std::vector<std::pair<std::string, int>> dropEvery;  // camera name, N: omit every Nth frame
+  std::optional<std::vector<int>> groundTruthFrames;   // default: first, middle, last
+  cv::Size panoramaSize{2048, 1024};
+  int crf = 14;                        // x264 CRF: visually lossless camera masters
+  bool force = false;                  // replace an existing output folder
+
+  int frameCount() const;
+  // Everything that decides the recording's content (not --out or --force), in a fixed order:
+  // part of the cache key and of the manifest.
+  std::string canonical() const;
+};
+
+// `arguments` excludes the program name. Throws UsageError.
+SynthOptions parseSynthArguments(std::span<const std::string_view> arguments);
+bool wantsHelp(std::span<const std::string_view> arguments);
+std::string synthUsage();
+
+}  // namespace surroundd::synth
