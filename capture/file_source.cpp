@@ -1,5 +1,7 @@
 #include "capture/file_source.hpp"
 
+#include <cctype>
+#include <cmath>
 #include <optional>
 #include <thread>
 
@@ -7,13 +9,44 @@
 
 #include "common/ffmpeg_util.hpp"
 
+extern "C" {
+#include <libavutil/pixdesc.h>
+}
+
 namespace surroundd::capture {
 namespace {
 
 constexpr AVRational kNanoseconds{1, 1'000'000'000};
+constexpr int kSwsFlags = SWS_BICUBIC | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT;
+// A file cannot heal: after this many faults in a row without a frame, report the end instead of
+// letting a caller that retries on kFault spin forever.
+constexpr int kMaxConsecutiveFaults = 100;
 
-bool isImageSequence(const std::filesystem::path& path) {
-  return path.string().find('%') != std::string::npos;
+// A printf integer conversion ("%d", "%06d"): FFmpeg's image2 pattern. A lone '%' in a file name
+// is not one.
+bool isImageSequence(const std::string& path) {
+  for (auto at = path.find('%'); at != std::string::npos; at = path.find('%', at + 1)) {
+    auto end = at + 1;
+    while (end < path.size() && std::isdigit(static_cast<unsigned char>(path[end])) != 0) ++end;
+    if (end < path.size() && path[end] == 'd') return true;
+  }
+  return false;
+}
+
+int swsColorspaceOf(AVColorSpace space) {
+  switch (space) {
+    case AVCOL_SPC_BT709:
+      return SWS_CS_ITU709;
+    case AVCOL_SPC_FCC:
+      return SWS_CS_FCC;
+    case AVCOL_SPC_SMPTE240M:
+      return SWS_CS_SMPTE240M;
+    case AVCOL_SPC_BT2020_NCL:
+    case AVCOL_SPC_BT2020_CL:
+      return SWS_CS_BT2020;
+    default:  // BT.601 (BT470BG, SMPTE170M) and untagged streams
+      return SWS_CS_ITU601;
+  }
 }
 
 }  // namespace
@@ -32,31 +65,45 @@ struct FileSource::Impl {
   Timestamp period{};
   std::string lastError;
 
-  bool haveDecoded = false;  // `decoded` holds a frame not yet returned (the one probed at start)
-  bool draining = false;     // the demuxer is exhausted; the decoder is being flushed
-  std::uint64_t framesRead = 0;
-  Timestamp loopOffset{0};  // added to timestamps after each loop so they keep increasing
-  Timestamp firstTimestamp{0};
-  Timestamp lastTimestamp{0};
-  std::optional<std::chrono::steady_clock::time_point> pacingStart;
+  // What `sws` was built and set up for; a frame that differs updates it.
+  AVPixelFormat swsFormat = AV_PIX_FMT_NONE;
+  int swsDefaultRange = 0;  // swscale's own guess for the format (full range for yuvj and gray)
   AVColorSpace swsColorspace = AVCOL_SPC_UNSPECIFIED;
   AVColorRange swsRange = AVCOL_RANGE_UNSPECIFIED;
+
+  bool haveDecoded = false;  // `decoded` holds a frame not yet returned (the one probed at start)
+  bool draining = false;     // the demuxer is done; the decoder is being flushed
+  std::uint64_t framesRead = 0;  // since the start, across loops
+  int consecutiveFaults = 0;
+  Timestamp loopOffset{0};  // added to timestamps after each loop so they keep increasing
+  Timestamp firstTimestamp{0};
+  Timestamp lastTimestamp{0};  // latest of this pass through the file, without loopOffset
+  std::optional<std::chrono::steady_clock::time_point> pacingStart;
 
   std::string describe(std::string_view what, int error) const {
     return fmt::format("camera '{}': {} '{}': {}", camera, what, settings.path.string(),
                        ffmpeg::errorText(error));
   }
+  [[noreturn]] void fail(std::string_view what) const {
+    throw CaptureError(fmt::format("camera '{}': '{}' {}", camera, settings.path.string(), what));
+  }
 
   void open();
-  // Decodes the next frame into `decoded`. 1: a frame, 0: end of stream, <0: an FFmpeg error.
+  // Decodes the next frame into `decoded`. 1: a frame, 0: end of stream, <0: an FFmpeg error after
+  // which decoding can go on.
   int decodeNext();
   bool restart();
   bool convert(Frame& out);
+  bool setUpConverter(const AVFrame& frame);
   Timestamp timestampOf(const AVFrame& frame) const;
+  ReadStatus fault(std::string message);
 };
 
 void FileSource::Impl::open() {
-  const bool sequence = isImageSequence(settings.path);
+  const bool sequence = isImageSequence(settings.path.string());
+  if (sequence && !(settings.sequenceFps > 0 && std::isfinite(settings.sequenceFps))) {
+    fail(fmt::format("needs a positive frame rate, got {}", settings.sequenceFps));
+  }
   AVDictionary* options = nullptr;
   const AVInputFormat* input = nullptr;
   if (sequence) {
@@ -73,41 +120,43 @@ void FileSource::Impl::open() {
   }
   const AVCodec* decoder = nullptr;
   streamIndex = av_find_best_stream(format.get(), AVMEDIA_TYPE_VIDEO, -1, -1, &decoder, 0);
-  if (streamIndex < 0 || decoder == nullptr) {
-    throw CaptureError(fmt::format("camera '{}': '{}' has no video stream that can be decoded",
-                                   camera, settings.path.string()));
+  if (streamIndex == AVERROR_DECODER_NOT_FOUND || (streamIndex >= 0 && decoder == nullptr)) {
+    fail("has a video stream, but this FFmpeg has no decoder for its codec");
   }
+  if (streamIndex < 0) fail("has no video stream");
   const AVStream* stream = format->streams[streamIndex];
   timeBase = stream->time_base;
   codec.reset(avcodec_alloc_context3(decoder));
-  avcodec_parameters_to_context(codec.get(), stream->codecpar);
+  if (!codec) fail("cannot be decoded: out of memory");
+  if (const int error = avcodec_parameters_to_context(codec.get(), stream->codecpar); error < 0) {
+    throw CaptureError(describe("cannot set up the decoder for", error));
+  }
   // One decoding thread: the pipeline already runs one capture thread per camera.
   codec->thread_count = 1;
   if (const int error = avcodec_open2(codec.get(), decoder, nullptr); error < 0) {
     throw CaptureError(describe("cannot open the decoder for", error));
   }
   size = {codec->width, codec->height};
-  if (size.width <= 0 || size.height <= 0) {
-    throw CaptureError(
-        fmt::format("camera '{}': '{}' has no frame size", camera, settings.path.string()));
-  }
+  if (size.width <= 0 || size.height <= 0) fail("has no frame size");
   AVRational rate = stream->avg_frame_rate;
   if (rate.num <= 0 || rate.den <= 0) rate = stream->r_frame_rate;
   const double fps =
       sequence || rate.num <= 0 || rate.den <= 0 ? settings.sequenceFps : av_q2d(rate);
-  period = std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / fps));
+  if (!(fps > 0 && std::isfinite(fps))) fail("has no frame rate, and sequenceFps is not positive");
+  period = std::chrono::nanoseconds(std::llround(1e9 / fps));
+  lastTimestamp = -period;  // an untimed first frame is at 0
   packet.reset(av_packet_alloc());
   decoded.reset(av_frame_alloc());
+  if (!packet || !decoded) fail("cannot be decoded: out of memory");
 
   // Decode the first frame now: a file whose header parses but whose data does not fails at start.
   const int first = decodeNext();
-  if (first <= 0) {
-    throw CaptureError(
-        first == 0 ? fmt::format("camera '{}': '{}' has no frames", camera, settings.path.string())
-                   : describe("cannot decode the first frame of", first));
-  }
+  if (first == 0) fail("has no frames");
+  if (first < 0) throw CaptureError(describe("cannot decode the first frame of", first));
+  if (!setUpConverter(*decoded)) fail("has a pixel format that cannot be converted to BGR");
   haveDecoded = true;
   firstTimestamp = timestampOf(*decoded);
+  lastTimestamp = firstTimestamp - period;
 }
 
 int FileSource::Impl::decodeNext() {
@@ -116,74 +165,108 @@ int FileSource::Impl::decodeNext() {
     if (received == 0) return 1;
     if (received == AVERROR_EOF) return 0;
     if (received != AVERROR(EAGAIN)) return received;
-    if (draining) return 0;
+    if (draining) return 0;  // a decoder that says EAGAIN after the flush has nothing more
     const int read = av_read_frame(format.get(), packet.get());
-    if (read == AVERROR_EOF) {
+    if (read < 0) {
+      // The end, or a demuxer that cannot go on (truncated file, I/O error): either way, flush
+      // what the decoder still holds. The error is reported once.
       draining = true;
       avcodec_send_packet(codec.get(), nullptr);
-      continue;
+      if (read == AVERROR_EOF) continue;
+      return read;
     }
-    if (read < 0) return read;
     if (packet->stream_index != streamIndex) {
       av_packet_unref(packet.get());
       continue;
     }
     const int sent = avcodec_send_packet(codec.get(), packet.get());
     av_packet_unref(packet.get());
-    if (sent < 0 && sent != AVERROR(EAGAIN)) return sent;
+    // The packet is consumed even when it does not decode, so the next call moves on.
+    if (sent < 0) return sent;
   }
 }
 
 bool FileSource::Impl::restart() {
-  if (av_seek_frame(format.get(), streamIndex,
-                    format->streams[streamIndex]->start_time == AV_NOPTS_VALUE
-                        ? 0
-                        : format->streams[streamIndex]->start_time,
-                    AVSEEK_FLAG_BACKWARD) < 0) {
+  const AVStream* stream = format->streams[streamIndex];
+  const std::int64_t start = stream->start_time == AV_NOPTS_VALUE ? 0 : stream->start_time;
+  if (const int error = av_seek_frame(format.get(), streamIndex, start, AVSEEK_FLAG_BACKWARD);
+      error < 0) {
+    lastError = describe("cannot seek back to the start of", error);
     return false;
   }
   avcodec_flush_buffers(codec.get());
   draining = false;
-  loopOffset += lastTimestamp + period - firstTimestamp;
+  loopOffset += lastTimestamp - firstTimestamp + period;
+  lastTimestamp = firstTimestamp - period;
   return true;
 }
 
 Timestamp FileSource::Impl::timestampOf(const AVFrame& frame) const {
   const std::int64_t pts = frame.best_effort_timestamp;
-  if (pts == AV_NOPTS_VALUE) return firstTimestamp + static_cast<std::int64_t>(framesRead) * period;
+  // Untimed frames (some raw streams) are placed one period after the previous one.
+  if (pts == AV_NOPTS_VALUE) return lastTimestamp + period;
   return Timestamp(av_rescale_q(pts, timeBase, kNanoseconds));
+}
+
+bool FileSource::Impl::setUpConverter(const AVFrame& frame) {
+  const auto pixelFormat = static_cast<AVPixelFormat>(frame.format);
+  if (pixelFormat != swsFormat) {
+    // Built once at start; again only if the stream changes its pixel format.
+    sws.reset(sws_getContext(size.width, size.height, pixelFormat, size.width, size.height,
+                             AV_PIX_FMT_BGR24, kSwsFlags, nullptr, nullptr, nullptr));
+    swsFormat = sws ? pixelFormat : AV_PIX_FMT_NONE;
+    if (!sws) return false;
+    int* inverse = nullptr;
+    int* table = nullptr;
+    int targetRange = 0, brightness = 0, contrast = 0, saturation = 0;
+    sws_getColorspaceDetails(sws.get(), &inverse, &swsDefaultRange, &table, &targetRange,
+                             &brightness, &contrast, &saturation);
+    swsColorspace = AVCOL_SPC_NB;  // forces the set-up below
+  }
+  if (frame.colorspace == swsColorspace && frame.color_range == swsRange) return true;
+  swsColorspace = frame.colorspace;
+  swsRange = frame.color_range;
+  // An untagged range keeps swscale's guess for the format: full for JPEG-style yuvj and for gray,
+  // limited for other YUV. RGB sources ignore it.
+  const int sourceRange = swsRange == AVCOL_RANGE_JPEG   ? 1
+                          : swsRange == AVCOL_RANGE_MPEG ? 0
+                                                         : swsDefaultRange;
+  const int* matrix = sws_getCoefficients(swsColorspaceOf(swsColorspace));
+  sws_setColorspaceDetails(sws.get(), matrix, sourceRange, sws_getCoefficients(SWS_CS_DEFAULT), 1,
+                           0, 1 << 16, 1 << 16);
+  return true;
 }
 
 bool FileSource::Impl::convert(Frame& out) {
   if (decoded->width != size.width || decoded->height != size.height) {
-    lastError = fmt::format("camera '{}': frame size changed to {}x{} in '{}' (expected {}x{})",
-                            camera, decoded->width, decoded->height, settings.path.string(),
-                            size.width, size.height);
+    lastError =
+        fmt::format("camera '{}': frame {} of '{}' is {}x{}, but the stream started at {}x{}",
+                    camera, framesRead, settings.path.string(), decoded->width, decoded->height,
+                    size.width, size.height);
     return false;
   }
-  const auto pixelFormat = static_cast<AVPixelFormat>(decoded->format);
-  // Built once for the stream's format; rebuilt only if the file changes it.
-  sws.reset(sws_getCachedContext(sws.release(), size.width, size.height, pixelFormat, size.width,
-                                 size.height, AV_PIX_FMT_BGR24,
-                                 SWS_BICUBIC | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT, nullptr,
-                                 nullptr, nullptr));
-  if (!sws) {
-    lastError = fmt::format("camera '{}': cannot convert pixel format {} of '{}'", camera,
-                            static_cast<int>(pixelFormat), settings.path.string());
+  if (!setUpConverter(*decoded)) {
+    const char* name = av_get_pix_fmt_name(static_cast<AVPixelFormat>(decoded->format));
+    lastError = fmt::format(
+        "camera '{}': frame {} of '{}' has pixel format {}, which cannot be "
+        "converted to BGR",
+        camera, framesRead, settings.path.string(), name != nullptr ? name : "(unknown)");
     return false;
   }
-  if (decoded->colorspace != swsColorspace || decoded->color_range != swsRange) {
-    swsColorspace = decoded->colorspace;
-    swsRange = decoded->color_range;
-    const int standard = swsColorspace == AVCOL_SPC_BT709 ? SWS_CS_ITU709 : SWS_CS_ITU601;
-    sws_setColorspaceDetails(sws.get(), sws_getCoefficients(standard),
-                             swsRange == AVCOL_RANGE_JPEG ? 1 : 0,
-                             sws_getCoefficients(SWS_CS_DEFAULT), 1, 0, 1 << 16, 1 << 16);
-  }
+  // Straight into the caller's buffer: no copy and no allocation per frame.
   std::uint8_t* target[] = {out.image.data};
   const int targetStride[] = {static_cast<int>(out.image.step[0])};
   sws_scale(sws.get(), decoded->data, decoded->linesize, 0, size.height, target, targetStride);
   return true;
+}
+
+ReadStatus FileSource::Impl::fault(std::string message) {
+  lastError = std::move(message);
+  if (++consecutiveFaults < kMaxConsecutiveFaults) return ReadStatus::kFault;
+  // Give up on the file: its tail is skipped and the next read reports the end.
+  draining = true;
+  avcodec_send_packet(codec.get(), nullptr);
+  return ReadStatus::kFault;
 }
 
 FileSource::FileSource(std::string cameraName, FileSourceSettings settings)
@@ -205,22 +288,26 @@ ReadStatus FileSource::read(Frame& out) {
   auto& s = *impl_;
   if (!s.haveDecoded) {
     int status = s.decodeNext();
+    // A fresh pass that yields nothing (an unseekable or empty file) ends instead of looping.
     if (status == 0 && s.settings.loop && s.framesRead > 0 && s.restart()) status = s.decodeNext();
     if (status == 0) return ReadStatus::kEndOfStream;
     if (status < 0) {
-      s.lastError = s.describe(fmt::format("decoding frame {} failed in", s.framesRead), status);
-      // A demuxer error that repeats would fault forever: skip to the end instead.
-      if (status != AVERROR_INVALIDDATA) s.draining = true;
-      return ReadStatus::kFault;
+      return s.fault(s.describe(fmt::format("decode error at frame {} of", s.framesRead), status));
     }
   }
   s.haveDecoded = false;
-  if (out.image.size() != s.size || out.image.type() != CV_8UC3) out.image.create(s.size, CV_8UC3);
-  if (!s.convert(out)) return ReadStatus::kFault;
-  out.timestamp = s.timestampOf(*s.decoded) + s.loopOffset;
-  s.lastTimestamp = out.timestamp - s.loopOffset;
-  ++s.framesRead;
+  if (out.image.size() != s.size || out.image.type() != CV_8UC3) {
+    // The caller's pool should match frameSize(); rather than write out of bounds, fix it once.
+    out.image.create(s.size, CV_8UC3);
+  }
+  if (!s.convert(out)) return s.fault(s.lastError);
+  s.consecutiveFaults = 0;
+  const Timestamp fileTimestamp = s.timestampOf(*s.decoded);
+  s.lastTimestamp = std::max(s.lastTimestamp, fileTimestamp);
+  out.timestamp = fileTimestamp + s.loopOffset;
+  out.sequence = s.framesRead++;
   if (s.settings.pacing == Pacing::kRealtime) {
+    // Frame k is due (its timestamp - the first's) after the first read, on the steady clock.
     const auto now = std::chrono::steady_clock::now();
     if (!s.pacingStart) s.pacingStart = now - (out.timestamp - s.firstTimestamp);
     std::this_thread::sleep_until(*s.pacingStart + (out.timestamp - s.firstTimestamp));

@@ -2,10 +2,11 @@
 // A file-backed virtual camera: plays a video file (any container/codec FFmpeg decodes) or an image
 // sequence (printf pattern such as "front_%06d.png", FFmpeg's image2) as if it were a camera.
 //
-// Frames carry the file's presentation timestamps (nanoseconds from the first frame); when looping,
-// timestamps keep increasing across the loop so the stream stays monotonic. Real-time pacing sleeps
-// until each frame is due on the steady clock; kAsFastAsPossible returns frames as fast as decoding
-// allows (benchmarks, tests, lossless replay).
+// Frames carry the file's own presentation timestamps in nanoseconds (not rebased, so that the four
+// files of one recording stay aligned with each other); when looping, timestamps keep increasing
+// across the loop so the stream stays monotonic. Real-time pacing sleeps until each frame is due on
+// the steady clock; kAsFastAsPossible returns frames as fast as decoding allows (benchmarks, tests,
+// lossless replay).
 
 #include <filesystem>
 #include <memory>
@@ -28,8 +29,9 @@ struct FileSourceSettings {
 
 class FileSource final : public FrameSource {
  public:
-  // Opens and probes the file and decodes nothing yet. Throws CaptureError naming the camera and
-  // the file when it is missing, unreadable, not a video, or has no decodable video stream.
+  // Opens the file and decodes its first frame, so that a file that cannot deliver one fails here.
+  // Throws CaptureError naming the camera and the file when it is missing, unreadable, not a video,
+  // or has no decodable video stream.
   FileSource(std::string cameraName, FileSourceSettings settings);
   ~FileSource() override;
 

@@ -16,8 +16,11 @@ namespace surroundd::render {
 namespace {
 
 // Encoder time base: microseconds, so that timestamps keep their precision in MP4. Matroska stores
-// milliseconds; its muxer rescales.
+// milliseconds whatever is asked (its muxer forces 1/1000 on the stream); packets are rescaled.
 constexpr AVRational kMicroseconds{1, 1'000'000};
+// MP4 writes a first timestamp other than zero as an edit list in the movie timescale, which
+// defaults to milliseconds: the whole file would then be shifted by up to 1 ms.
+constexpr const char* kMp4MovieTimescale = "1000000";
 
 }  // namespace
 
@@ -58,6 +61,12 @@ void VideoEncoder::Impl::open() {
   if (pixelFormat != AV_PIX_FMT_YUV420P && pixelFormat != AV_PIX_FMT_YUV444P) {
     fail(fmt::format("pixel format must be yuv420p or yuv444p, got '{}'", settings.pixelFormat));
   }
+  if (!(settings.nominalFps > 0 && settings.nominalFps <= 1000)) {
+    fail(fmt::format("nominal frame rate must be in (0, 1000], got {}", settings.nominalFps));
+  }
+  if (settings.crf < 0 || settings.crf > 51) {
+    fail(fmt::format("crf must be in 0..51 (0 = lossless), got {}", settings.crf));
+  }
   const AVCodec* encoder = avcodec_find_encoder_by_name("libx264");
   if (encoder == nullptr) fail("this FFmpeg has no libx264 encoder");
 
@@ -72,11 +81,13 @@ void VideoEncoder::Impl::open() {
   format.reset(rawFormat);
 
   codec.reset(avcodec_alloc_context3(encoder));
+  if (!codec) fail("out of memory");
   codec->width = settings.size.width;
   codec->height = settings.size.height;
   codec->pix_fmt = pixelFormat;
   codec->time_base = kMicroseconds;
-  codec->framerate = av_d2q(settings.nominalFps, 1000);
+  // A large bound keeps NTSC rates exact (29.97 -> 30000/1001).
+  codec->framerate = av_d2q(settings.nominalFps, 1 << 16);
   codec->thread_count = settings.threads;
   // BT.601 limited range, tagged, so that every decoder converts back the way sws converted here.
   codec->colorspace = AVCOL_SPC_SMPTE170M;
@@ -92,8 +103,11 @@ void VideoEncoder::Impl::open() {
   // with x264 164 r3095); without mbtree the same input gives the same bytes on every CPU.
   if (settings.bitExact) av_opt_set(codec->priv_data, "x264-params", "mbtree=0", 0);
   if (pixelFormat == AV_PIX_FMT_YUV444P) av_opt_set(codec->priv_data, "profile", "high444", 0);
+  // x264 checks the preset only here.
   if (const int error = avcodec_open2(codec.get(), encoder, nullptr); error < 0) {
-    fail("cannot open the H.264 encoder", error);
+    fail(fmt::format("cannot open the H.264 encoder (preset '{}', crf {}, {})", settings.preset,
+                     settings.crf, settings.pixelFormat),
+         error);
   }
 
   stream = avformat_new_stream(format.get(), nullptr);
@@ -108,17 +122,20 @@ void VideoEncoder::Impl::open() {
   if (const int error = avio_open(&format->pb, partPath.c_str(), AVIO_FLAG_WRITE); error < 0) {
     fail(fmt::format("cannot create '{}'", partPath.string()), error);
   }
-  if (const int error = avformat_write_header(format.get(), nullptr); error < 0) {
-    fail("cannot write the container header", error);
-  }
+  AVDictionary* muxerOptions = nullptr;
+  if (extension == ".mp4") av_dict_set(&muxerOptions, "movie_timescale", kMp4MovieTimescale, 0);
+  const int headerError = avformat_write_header(format.get(), &muxerOptions);
+  av_dict_free(&muxerOptions);
+  if (headerError < 0) fail("cannot write the container header", headerError);
 
   frame.reset(av_frame_alloc());
+  packet.reset(av_packet_alloc());
+  if (!frame || !packet) fail("out of memory");
   frame->format = pixelFormat;
   frame->width = settings.size.width;
   frame->height = settings.size.height;
   if (const int error = av_frame_get_buffer(frame.get(), 0); error < 0)
     fail("out of memory", error);
-  packet.reset(av_packet_alloc());
   sws.reset(sws_getContext(settings.size.width, settings.size.height, AV_PIX_FMT_BGR24,
                            settings.size.width, settings.size.height, pixelFormat,
                            SWS_BICUBIC | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT | SWS_BITEXACT,
@@ -217,7 +234,13 @@ void VideoEncoder::close() {
     discard();
     throw;
   }
-  std::filesystem::rename(s.partPath, s.settings.path);
+  std::error_code renamed;
+  std::filesystem::rename(s.partPath, s.settings.path, renamed);
+  // The finished file is kept under its .part name rather than lost.
+  if (renamed) {
+    s.fail(fmt::format("finished, but cannot rename '{}' to the final name: {}",
+                       s.partPath.string(), renamed.message()));
+  }
 }
 
 const std::filesystem::path& VideoEncoder::path() const { return impl_->settings.path; }

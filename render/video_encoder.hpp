@@ -6,8 +6,15 @@
 // finalizes; the destructor finalizes too if close() was not called (an exception or a signal on
 // the way out still leaves a playable file).
 //
+// A ".part" left by an earlier crash is overwritten. If construction fails, nothing is left behind.
+//
+// Timestamps are written as given (not moved to start at zero), so files of several cameras keep
+// their relative start offsets. MP4 keeps them to the microsecond; Matroska to the millisecond (its
+// muxer forces a 1/1000 time base), so frames there must be at least 1 ms apart.
+//
 // Error policy: the constructor, write() and close() throw EncoderError with a message naming the
-// file; the caller decides whether to stop or drop the output.
+// file; the caller decides whether to stop or drop the output. close() after zero frames throws
+// ("no frames written") and leaves no file: an empty video is not a useful output.
 
 #include <chrono>
 #include <filesystem>
@@ -45,9 +52,10 @@ class VideoEncoder {
   VideoEncoder(const VideoEncoder&) = delete;
   VideoEncoder& operator=(const VideoEncoder&) = delete;
 
-  // `bgr` is 8-bit BGR of settings.size. Timestamps must increase; they are kept to the
-  // microsecond in the file.
+  // `bgr` is 8-bit BGR of settings.size. Timestamps must increase at the file's precision (see
+  // above); converted as BT.601 limited range, and tagged so, so that decoders convert back alike.
   void write(const cv::Mat& bgr, std::chrono::nanoseconds timestamp);
+  // Flushes, finalizes and renames the file. Idempotent; the destructor calls it and logs errors.
   void close();
 
   const std::filesystem::path& path() const;

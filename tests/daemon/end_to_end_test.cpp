@@ -13,6 +13,7 @@
 #include "render/mosaic.hpp"
 #include "tests/support/child_process.hpp"
 #include "tests/support/temp_dir.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace surroundd {
 namespace {
@@ -34,15 +35,6 @@ outputs:
                                               kOutputSize.height, extra));
 }
 
-std::vector<cv::Mat> decodeAll(const std::filesystem::path& file) {
-  capture::FileSource source("check", {file, 30.0, false, capture::Pacing::kAsFastAsPossible});
-  capture::Frame frame;
-  frame.image.create(source.frameSize(), CV_8UC3);
-  std::vector<cv::Mat> frames;
-  while (source.read(frame) == capture::ReadStatus::kFrame) frames.push_back(frame.image.clone());
-  return frames;
-}
-
 TEST(EndToEnd, MosaicVideoMatchesTheSourceFrames) {
   const testing::TempDir dir;
   testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--config", writeConfig(dir).string(),
@@ -55,9 +47,9 @@ TEST(EndToEnd, MosaicVideoMatchesTheSourceFrames) {
   std::vector<std::vector<cv::Mat>> sources;
   for (const auto& camera : rig) {
     names.push_back(camera.calibration.name);
-    sources.push_back(decodeAll(camera.source->path));
+    sources.push_back(testing::decodeAll(camera.source->path).images);
   }
-  const auto video = decodeAll(dir / "out/mosaic.mp4");
+  const auto video = testing::decodeAll(dir / "out/mosaic.mp4").images;
   ASSERT_EQ(video.size(),
             sources[0].size());  // one frame set per frame: the recording drops nothing
 
@@ -91,7 +83,7 @@ TEST(EndToEnd, SigtermLeavesAPlayableFile) {
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   surroundd.signal(SIGTERM);
   ASSERT_EQ(surroundd.wait(), 0) << surroundd.output();
-  const auto frames = decodeAll(dir / "out/mosaic.mp4");
+  const auto frames = testing::decodeAll(dir / "out/mosaic.mp4").images;
   EXPECT_GE(frames.size(), 1u);
   EXPECT_FALSE(std::filesystem::exists(dir / "out/mosaic.mp4.part"));
   EXPECT_TRUE(

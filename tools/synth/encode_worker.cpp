@@ -25,7 +25,6 @@ cv::Mat& EncodeWorker::acquire() {
   std::unique_lock lock(mutex_);
   changed_.wait(lock, [&] { return queued_ < slots_.size() || error_; });
   rethrowIfFailed();
-  acquired_ = true;
   return slots_[head_].image;
 }
 
@@ -36,7 +35,6 @@ void EncodeWorker::submit(std::chrono::nanoseconds timestamp) {
     slots_[head_].timestamp = timestamp;
     head_ = (head_ + 1) % slots_.size();
     ++queued_;
-    acquired_ = false;
   }
   changed_.notify_all();
 }

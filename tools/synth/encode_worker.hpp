@@ -45,10 +45,9 @@ class EncodeWorker {
 
   render::VideoEncoderSettings settings_;
   std::vector<Slot> slots_;
-  std::size_t head_ = 0;   // next slot to fill (caller)
-  std::size_t tail_ = 0;   // next slot to encode (worker)
+  std::size_t head_ = 0;  // next slot to fill (caller)
+  std::size_t tail_ = 0;  // next slot to encode (worker)
   std::size_t queued_ = 0;
-  bool acquired_ = false;
   bool closing_ = false;
   std::exception_ptr error_;
   std::mutex mutex_;

@@ -3,9 +3,9 @@
 //
 // Why a pyramid: the cameras see the ground from a few centimetres to tens of metres away, so one
 // pixel covers anything from a fraction of a texel to thousands of texels. Point-sampling the fine
-// asphalt grain would alias into crawling noise that no real lens produces; sampling the level whose
-// texel matches the pixel's footprint (the caller computes lod = log2(footprint / texel)) keeps every
-// camera, and the ground-truth panorama, seeing the same band-limited surface.
+// asphalt grain would alias into crawling noise that no real lens produces; sampling the level
+// whose texel matches the pixel's footprint (the caller computes lod = log2(footprint / texel))
+// keeps every camera, and the ground-truth panorama, seeing the same band-limited surface.
 //
 // Texture coordinates are in level-0 texels, texel i covering [i, i + 1). Width and height must be
 // powers of two so that wrapping is a mask. Colours are BGR, 0..255, as floats.

@@ -39,8 +39,8 @@ const std::array<float, 1 << kGaussianBits>& gaussianTable() {
 
 double CameraPhotometrics::exposureAt(double seconds) const {
   if (driftAmplitude == 0 || driftPeriodS <= 0) return 1.0;
-  return 1.0 + driftAmplitude * std::sin(2 * std::numbers::pi * seconds / driftPeriodS +
-                                         driftPhaseRad);
+  return 1.0 +
+         driftAmplitude * std::sin(2 * std::numbers::pi * seconds / driftPeriodS + driftPhaseRad);
 }
 
 double CameraPhotometrics::vignetteAt(double offAxisRad, bool fisheye) const {
@@ -126,9 +126,9 @@ void PhotometricCamera::convertRow(const Frame& frame, const cv::Vec3f* radiance
     }
     // SplitMix64 on the pixel counter: independent per (frame key, pixel), 12 bits per channel.
     const std::uint64_t bits =
-        noiseSigma_ > 0
-            ? mix64(frame.noiseKey + static_cast<std::uint64_t>(pixelIndex + i) * 0x9e3779b97f4a7c15ULL)
-            : 0;
+        noiseSigma_ > 0 ? mix64(frame.noiseKey +
+                                static_cast<std::uint64_t>(pixelIndex + i) * 0x9e3779b97f4a7c15ULL)
+                        : 0;
     for (int c = 0; c < 3; ++c) {
       float x = std::min(radiance[i][c] * frame.channelGain[c] * v, kMaxX);
       if (lut != nullptr) x = lut[static_cast<int>(x * kLutSteps + 0.5f)];

@@ -1,8 +1,8 @@
 #pragma once
 // What each synthetic camera does to the light before it becomes an 8-bit pixel:
 //
-//   x     = L_c * gain * whiteBalance_c * exposure(t) * vignette(pixel)      (L: scene radiance, 0..255)
-//   value = clamp(round(255 * (min(x, 511.9) / 255)^gamma + N(0, noiseSigma^2)), 0, 255)
+//   x     = L_c * gain * whiteBalance_c * exposure(t) * vignette(pixel)      (L: scene radiance,
+//   0..255) value = clamp(round(255 * (min(x, 511.9) / 255)^gamma + N(0, noiseSigma^2)), 0, 255)
 //   exposure(t) = 1 + driftAmplitude * sin(2 pi t / driftPeriod + driftPhase)
 //   vignette    = 1 - vignetting * (1 - cos^4(theta')), theta' = the ray's angle off the optical
 //                 axis (halved for a fisheye, whose lens compensates much of the natural falloff)
@@ -19,13 +19,13 @@
 namespace surroundd::synth {
 
 struct CameraPhotometrics {
-  double gain = 1;                        // 0.7 .. 1.3 when random
-  cv::Vec3d whiteBalance{1, 1, 1};        // B, G, R multipliers, 0.85 .. 1.15
-  double gamma = 1;                       // 0.9 .. 1.1
-  double vignetting = 0;                  // strength, 0 .. 0.4
-  double noiseSigma = 0;                  // 8-bit levels
-  double driftAmplitude = 0;              // relative, up to 0.1 (+-10 %)
-  double driftPeriodS = 0;                // 6 .. 12 s
+  double gain = 1;                  // 0.7 .. 1.3 when random
+  cv::Vec3d whiteBalance{1, 1, 1};  // B, G, R multipliers, 0.85 .. 1.15
+  double gamma = 1;                 // 0.9 .. 1.1
+  double vignetting = 0;            // strength, 0 .. 0.4
+  double noiseSigma = 0;            // 8-bit levels
+  double driftAmplitude = 0;        // relative, up to 0.1 (+-10 %)
+  double driftPeriodS = 0;          // 6 .. 12 s
   double driftPhaseRad = 0;
 
   double exposureAt(double seconds) const;
@@ -35,8 +35,7 @@ struct CameraPhotometrics {
 
 CameraPhotometrics identityPhotometrics();
 // Random parameters for camera `index`, deterministic from the seed.
-CameraPhotometrics randomPhotometrics(std::uint64_t seed, int index, double noiseSigma,
-                                      bool drift);
+CameraPhotometrics randomPhotometrics(std::uint64_t seed, int index, double noiseSigma, bool drift);
 
 // The per-camera part that does not change from frame to frame (gamma table, vignette image), and
 // the per-pixel conversion. One per camera, built before the first frame.
@@ -67,7 +66,7 @@ class PhotometricCamera {
   CameraPhotometrics parameters_;
   std::uint64_t seed_;
   int index_;
-  cv::Mat vignette_;  // CV_32F: the vignette factor, 0 outside the lens
+  cv::Mat vignette_;             // CV_32F: the vignette factor, 0 outside the lens
   std::vector<float> gammaLut_;  // empty when gamma == 1
   float noiseSigma_;
 };

@@ -56,9 +56,9 @@ bool RecordingPlan::dropped(std::size_t camera, int frame) const {
 }
 
 std::chrono::microseconds RecordingPlan::timestamp(std::size_t camera, int frame) const {
-  const double jitter =
-      kJitterS * (2 * unitFromHash(hash64(options.seed, kJitterStream, camera,
-                                          static_cast<std::uint64_t>(frame))) - 1);
+  const double jitter = kJitterS * (2 * unitFromHash(hash64(options.seed, kJitterStream, camera,
+                                                            static_cast<std::uint64_t>(frame))) -
+                                    1);
   const double t = frameTime(frame) + cameras[camera].startOffsetS + jitter;
   return std::chrono::microseconds(std::max<std::int64_t>(0, std::llround(t * 1e6)));
 }
@@ -68,10 +68,9 @@ RecordingPlan planRecording(const SynthOptions& options) {
   plan.options = options;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(options.rig, ec)) {
-    throw UsageError(fmt::format("--rig: expected a rig YAML file, got '{}' ({})",
-                                 options.rig.string(),
-                                 std::filesystem::exists(options.rig, ec) ? "not a regular file"
-                                                                          : "no such file"));
+    throw UsageError(fmt::format(
+        "--rig: expected a rig YAML file, got '{}' ({})", options.rig.string(),
+        std::filesystem::exists(options.rig, ec) ? "not a regular file" : "no such file"));
   }
   plan.rigText = readFile(options.rig);
   std::vector<daemon::RigCamera> rig;
@@ -94,19 +93,18 @@ RecordingPlan planRecording(const SynthOptions& options) {
                                    intrinsics.imageSize.height));
     }
     const int index = static_cast<int>(i);
-    camera.photometrics = options.randomPhotometrics
-                              ? randomPhotometrics(options.seed, index, options.noiseSigma,
-                                                   options.drift)
-                              : identityPhotometrics();
+    camera.photometrics =
+        options.randomPhotometrics
+            ? randomPhotometrics(options.seed, index, options.noiseSigma, options.drift)
+            : identityPhotometrics();
     HashRng timing(options.seed, kTimingStream * 1000 + i);
     camera.startOffsetS = timing.uniform(0, 0.004);
     heightSum += camera.camera.calibration.pose.position[2];
     plan.cameras.push_back(std::move(camera));
   }
   for (const auto& [name, n] : options.dropEvery) {
-    const auto it = std::find_if(plan.cameras.begin(), plan.cameras.end(), [&](const auto& c) {
-      return c.camera.calibration.name == name;
-    });
+    const auto it = std::find_if(plan.cameras.begin(), plan.cameras.end(),
+                                 [&](const auto& c) { return c.camera.calibration.name == name; });
     if (it == plan.cameras.end()) {
       throw UsageError(fmt::format("--drop-every: the rig has no camera named '{}'", name));
     }
@@ -119,8 +117,7 @@ RecordingPlan planRecording(const SynthOptions& options) {
   plan.groundTruthFrames.assign(unique.begin(), unique.end());
   plan.virtualCentre = {0, 0, heightSum / static_cast<double>(plan.cameras.size())};
   const std::uint64_t key =
-      fnv1a(plan.rigText, fnv1a(options.canonical(),
-                                fnv1a(kGeneratorVersion, executableHash())));
+      fnv1a(plan.rigText, fnv1a(options.canonical(), fnv1a(kGeneratorVersion, executableHash())));
   plan.key = fmt::format("{:016x}", key);
   return plan;
 }

@@ -20,20 +20,20 @@ namespace surroundd::synth {
 inline constexpr std::string_view kGeneratorVersion = "1";
 
 struct CameraPlan {
-  daemon::RigCamera camera;          // calibration scaled to the output size
+  daemon::RigCamera camera;  // calibration scaled to the output size
   CameraPhotometrics photometrics;
-  double startOffsetS = 0;           // 0 .. 4 ms: cameras are not triggered together
-  int dropEvery = 0;                 // 0: none; N: frames N-1, 2N-1, ... are not recorded
+  double startOffsetS = 0;  // 0 .. 4 ms: cameras are not triggered together
+  int dropEvery = 0;        // 0: none; N: frames N-1, 2N-1, ... are not recorded
 };
 
 struct RecordingPlan {
   SynthOptions options;
-  std::string rigText;               // the preset as read (part of the key)
+  std::string rigText;  // the preset as read (part of the key)
   std::vector<CameraPlan> cameras;
   int frames = 0;
   std::vector<int> groundTruthFrames;  // sorted, unique
-  cv::Vec3d virtualCentre;           // panorama centre, vehicle frame: (0, 0, mean camera height)
-  std::string key;                   // cache key, hex
+  cv::Vec3d virtualCentre;             // panorama centre, vehicle frame: (0, 0, mean camera height)
+  std::string key;                     // cache key, hex
 
   static constexpr double kJitterS = 0.001;  // per-frame timestamp jitter, +-
 

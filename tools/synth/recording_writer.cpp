@@ -48,7 +48,8 @@ class TemporaryFolder {
   // Replaces `target` (if any) with this folder. The old one is moved aside first, so `target`
   // names either the old or the new complete recording, never a mixture.
   void publish(const std::filesystem::path& target) {
-    const auto aside = std::filesystem::path(target.string() + ".old-" + std::to_string(::getpid()));
+    const auto aside =
+        std::filesystem::path(target.string() + ".old-" + std::to_string(::getpid()));
     const bool existed = std::filesystem::exists(target);
     if (existed) std::filesystem::rename(target, aside);
     std::filesystem::rename(path_, target);
@@ -85,7 +86,8 @@ RecordingResult writeRecording(const SynthOptions& options, std::ostream& log) {
     }
   }
   const auto outAbsolute = std::filesystem::absolute(options.out);
-  if (!outAbsolute.parent_path().empty()) std::filesystem::create_directories(outAbsolute.parent_path());
+  if (!outAbsolute.parent_path().empty())
+    std::filesystem::create_directories(outAbsolute.parent_path());
   TemporaryFolder folder(outAbsolute.string() + ".tmp-" + std::to_string(::getpid()));
   std::map<std::string, double> durations;
 
@@ -140,8 +142,8 @@ RecordingResult writeRecording(const SynthOptions& options, std::ostream& log) {
     jobs.clear();
     for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
       if (plan.dropped(c, k)) continue;
-      jobs.push_back({rays[c].get(), sensors[c].get(), sensors[c]->frame(k, t),
-                      &encoders[c]->acquire()});
+      jobs.push_back(
+          {rays[c].get(), sensors[c].get(), sensors[c]->frame(k, t), &encoders[c]->acquire()});
     }
     renderer.render(pose, jobs);
     for (std::size_t c = 0; c < plan.cameras.size(); ++c) {

@@ -11,10 +11,10 @@
 namespace surroundd::synth {
 
 struct RecordingResult {
-  bool upToDate = false;       // the folder already held this recording; nothing was done
+  bool upToDate = false;  // the folder already held this recording; nothing was done
   std::filesystem::path folder;
   int frames = 0;
-  double seconds = 0;          // wall time of the whole run
+  double seconds = 0;  // wall time of the whole run
 };
 
 // Throws UsageError for bad input (rig, camera names, an existing folder without --force) and

@@ -50,10 +50,9 @@ void writeGroundTruthYaml(const std::filesystem::path& file, const RecordingPlan
   out << YAML::Key << "seed" << YAML::Value << plan.options.seed;
   out << YAML::Key << "fps" << YAML::Value << plan.options.fps;
   out << YAML::Key << "frames" << YAML::Value << plan.frames;
-  out << YAML::Key << "vehicle_path" << YAML::Value << YAML::Flow << YAML::BeginMap
-      << YAML::Key << "speed_mps" << YAML::Value << VehiclePath::kSpeedMps << YAML::Key
-      << "yaw_rate_deg_per_s" << YAML::Value << VehiclePath::kYawRateRadPerS * kRadToDeg
-      << YAML::EndMap;
+  out << YAML::Key << "vehicle_path" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
+      << "speed_mps" << YAML::Value << VehiclePath::kSpeedMps << YAML::Key << "yaw_rate_deg_per_s"
+      << YAML::Value << VehiclePath::kYawRateRadPerS * kRadToDeg << YAML::EndMap;
   out << YAML::Key << "virtual_centre_m" << YAML::Value << YAML::Flow << YAML::BeginSeq
       << plan.virtualCentre[0] << plan.virtualCentre[1] << plan.virtualCentre[2] << YAML::EndSeq;
   out << YAML::Key << "panorama" << YAML::Value << YAML::Flow << YAML::BeginMap;
@@ -103,18 +102,17 @@ void writeGroundTruthYaml(const std::filesystem::path& file, const RecordingPlan
     out << YAML::BeginMap;
     out << YAML::Key << "frame" << YAML::Value << k;
     out << YAML::Key << "time_s" << YAML::Value << t;
-    out << YAML::Key << "vehicle_pose" << YAML::Value << YAML::Flow << YAML::BeginMap
-        << YAML::Key << "x_m" << YAML::Value << pose.x << YAML::Key << "y_m" << YAML::Value
-        << pose.y << YAML::Key << "yaw_deg" << YAML::Value << pose.yaw * kRadToDeg
-        << YAML::EndMap;
+    out << YAML::Key << "vehicle_pose" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
+        << "x_m" << YAML::Value << pose.x << YAML::Key << "y_m" << YAML::Value << pose.y
+        << YAML::Key << "yaw_deg" << YAML::Value << pose.yaw * kRadToDeg << YAML::EndMap;
     out << YAML::Key << "panorama" << YAML::Value << panoramaName(k);
     out << YAML::Key << "cameras" << YAML::Value << YAML::BeginMap;
     for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
       const auto& name = plan.cameras[c].camera.calibration.name;
       out << YAML::Key << name << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
           << "image" << YAML::Value << cameraImageName(name, k) << YAML::Key << "exposure"
-          << YAML::Value << plan.cameras[c].photometrics.exposureAt(t) << YAML::Key
-          << "recorded" << YAML::Value << !plan.dropped(c, k) << YAML::EndMap;
+          << YAML::Value << plan.cameras[c].photometrics.exposureAt(t) << YAML::Key << "recorded"
+          << YAML::Value << !plan.dropped(c, k) << YAML::EndMap;
     }
     out << YAML::EndMap;
     out << YAML::EndMap;

@@ -21,9 +21,7 @@ constexpr std::uint64_t kLayoutStream = 11;
 // Fixed sun, so faces of boxes and walls differ in brightness as real surfaces do.
 const cv::Vec3f kSun = cv::normalize(cv::Vec3f(0.45f, 0.3f, 0.84f));
 
-float shadeFor(const cv::Vec3f& normal) {
-  return 0.5f + 0.5f * std::max(0.0f, normal.dot(kSun));
-}
+float shadeFor(const cv::Vec3f& normal) { return 0.5f + 0.5f * std::max(0.0f, normal.dot(kSun)); }
 
 // Fraction of [x - w/2, x + w/2] on the "on" half of a square wave of `period`: the stripe
 // pattern box-filtered over the pixel footprint, so boxes stay free of aliasing at any range.
@@ -89,9 +87,9 @@ std::vector<SceneBox> makeBoxes(HashRng& rng, double seconds) {
       box.halfSize = {static_cast<float>(rng.uniform(2.1, 2.4)),
                       static_cast<float>(rng.uniform(0.85, 0.95)),
                       static_cast<float>(rng.uniform(1.4, 1.6))};
-      box.boundingRadius = std::sqrt(box.halfSize[0] * box.halfSize[0] +
-                                     box.halfSize[1] * box.halfSize[1] +
-                                     box.halfSize[2] * box.halfSize[2] * 0.25f);
+      box.boundingRadius =
+          std::sqrt(box.halfSize[0] * box.halfSize[0] + box.halfSize[1] * box.halfSize[1] +
+                    box.halfSize[2] * box.halfSize[2] * 0.25f);
       const bool clear = std::all_of(boxes.begin(), boxes.end(), [&](const SceneBox& other) {
         return cv::norm(other.centre - box.centre) > 5.5;
       });
@@ -165,8 +163,8 @@ Hit Scene::trace(const RayQuery& q) const {
   const cv::Vec3f& o = q.origin;
   const cv::Vec3f& d = q.direction;
   Hit hit;
-  hit.distance = q.groundDistance >= 0 ? q.groundDistance
-                                       : (d[2] < 0 && o[2] > 0 ? -o[2] / d[2] : kInfinity);
+  hit.distance =
+      q.groundDistance >= 0 ? q.groundDistance : (d[2] < 0 && o[2] > 0 ? -o[2] / d[2] : kInfinity);
   hit.surface = std::isfinite(hit.distance) ? Surface::kGround : Surface::kSky;
   // A ground point inside the yard is nearer than any wall (the yard is convex and holds the
   // origin), which saves the wall test for most pixels.
@@ -202,9 +200,8 @@ cv::Vec3f Scene::radiance(const RayQuery& q) const {
   const Hit hit = trace(q);
   switch (hit.surface) {
     case Surface::kGround: {
-      const float lod = q.groundLod >= 0
-                            ? q.groundLod
-                            : groundLodFor(hit.distance, q.pixelAngle, q.direction[2]);
+      const float lod =
+          q.groundLod >= 0 ? q.groundLod : groundLodFor(hit.distance, q.pixelAngle, q.direction[2]);
       return groundAt(q.origin[0] + hit.distance * q.direction[0],
                       q.origin[1] + hit.distance * q.direction[1], lod);
     }
@@ -220,8 +217,8 @@ cv::Vec3f Scene::radiance(const RayQuery& q) const {
   return shadeSky(q.direction);
 }
 
-cv::Vec3f Scene::shadeBox(const SceneBox& b, const cv::Vec3f& o, const cv::Vec3f& d,
-                          float distance, float footprint) const {
+cv::Vec3f Scene::shadeBox(const SceneBox& b, const cv::Vec3f& o, const cv::Vec3f& d, float distance,
+                          float footprint) const {
   const cv::Vec3f p = o + distance * d;
   const float rx = p[0] - b.centre.x, ry = p[1] - b.centre.y;
   const float lx = b.cosYaw * rx + b.sinYaw * ry, ly = -b.sinYaw * rx + b.cosYaw * ry;
@@ -237,14 +234,16 @@ cv::Vec3f Scene::shadeBox(const SceneBox& b, const cv::Vec3f& o, const cv::Vec3f
     pattern = filteredSquare((lx + ly) * 0.7071f, 0.5f, footprint);
   } else if (ex >= ey) {  // ends
     normalLocal = {lx > 0 ? 1.0f : -1.0f, 0, 0};
-    pattern = stripesOnEnds ? filteredSquare(lz, 0.3f, footprint)
-                            : std::abs(filteredSquare(ly, 0.6f, footprint) -
-                                       filteredSquare(lz, 0.6f, footprint));
+    pattern =
+        stripesOnEnds
+            ? filteredSquare(lz, 0.3f, footprint)
+            : std::abs(filteredSquare(ly, 0.6f, footprint) - filteredSquare(lz, 0.6f, footprint));
   } else {  // long sides
     normalLocal = {0, ly > 0 ? 1.0f : -1.0f, 0};
-    pattern = stripesOnEnds ? std::abs(filteredSquare(lx, 0.6f, footprint) -
-                                       filteredSquare(lz, 0.6f, footprint))
-                            : filteredSquare(lx, 0.4f, footprint);
+    pattern =
+        stripesOnEnds
+            ? std::abs(filteredSquare(lx, 0.6f, footprint) - filteredSquare(lz, 0.6f, footprint))
+            : filteredSquare(lx, 0.4f, footprint);
   }
   const cv::Vec3f normal(b.cosYaw * normalLocal[0] - b.sinYaw * normalLocal[1],
                          b.sinYaw * normalLocal[0] + b.cosYaw * normalLocal[1], normalLocal[2]);

@@ -31,32 +31,32 @@ struct SceneBox {
   cv::Point2f centre;  // world, metres
   float yaw = 0;       // radians
   float cosYaw = 1, sinYaw = 0;
-  cv::Vec3f halfSize;  // half length, half width, full height (metres)
-  cv::Vec3f colour;    // BGR albedo, 0..255
-  int pattern = 0;     // which face gets stripes and which the checker
+  cv::Vec3f halfSize;        // half length, half width, full height (metres)
+  cv::Vec3f colour;          // BGR albedo, 0..255
+  int pattern = 0;           // which face gets stripes and which the checker
   float boundingRadius = 0;  // sphere around the box centre at half height
 };
 
 // Axis-aligned yard walls facing inwards: x = xMin / xMax, y = yMin / yMax.
 struct SceneWalls {
   float xMin = -20, xMax = 20, yMin = -20, yMax = 20;
-  std::array<float, 4> height{};     // order: xMax, xMin, yMax, yMin
-  std::array<cv::Vec3f, 4> tint{};   // per-wall colour multiplier
+  std::array<float, 4> height{};    // order: xMax, xMin, yMax, yMin
+  std::array<cv::Vec3f, 4> tint{};  // per-wall colour multiplier
 };
 
 // One ray to shade, with what the caller may already know about it.
 struct RayQuery {
-  cv::Vec3f origin;           // world, metres
-  cv::Vec3f direction;        // world, unit length
-  float pixelAngle = 1e-3f;   // angular size of the pixel, radians (texture filtering)
-  float groundDistance = -1;  // distance to z = 0 along the ray if known (< 0: compute)
-  float groundLod = -1;       // ground mip level if known (< 0: compute)
+  cv::Vec3f origin;             // world, metres
+  cv::Vec3f direction;          // world, unit length
+  float pixelAngle = 1e-3f;     // angular size of the pixel, radians (texture filtering)
+  float groundDistance = -1;    // distance to z = 0 along the ray if known (< 0: compute)
+  float groundLod = -1;         // ground mip level if known (< 0: compute)
   std::uint32_t boxMask = ~0U;  // boxes that may be hit (bit i = box i); a superset is fine
 };
 
 class Scene {
  public:
-  static constexpr int kGroundSize = 4096;        // texels: the ground repeats every 81.92 m
+  static constexpr int kGroundSize = 4096;  // texels: the ground repeats every 81.92 m
   static constexpr float kGroundTexelM = 0.02f;
   static constexpr float kFacadeTexelM = 0.01f;
   static constexpr int kMaxBoxes = 32;
@@ -106,8 +106,8 @@ class Scene {
  private:
   cv::Vec3f shadeBox(const SceneBox& box, const cv::Vec3f& origin, const cv::Vec3f& direction,
                      float distance, float footprint) const;
-  cv::Vec3f shadeWall(int wall, const cv::Vec3f& point, const cv::Vec3f& direction,
-                      float distance, float pixelAngle) const;
+  cv::Vec3f shadeWall(int wall, const cv::Vec3f& point, const cv::Vec3f& direction, float distance,
+                      float pixelAngle) const;
   cv::Vec3f shadeSky(const cv::Vec3f& direction) const;
   Hit trace(const RayQuery& query) const;
   // Nearest box hit along the ray among `mask`; index -1 when none.

@@ -59,7 +59,8 @@ CameraRays::CameraRays(const processing::CameraCalibration& camera)
       if (p.pixelAngle < 0) continue;
       float angle = 0;
       for (const auto& [nx, ny] : {std::pair{x + 1, y}, {x - 1, y}, {x, y + 1}, {x, y - 1}}) {
-        if (const Pixel* n = at(nx, ny)) angle = std::max(angle, angleBetween(p.direction, n->direction));
+        if (const Pixel* n = at(nx, ny))
+          angle = std::max(angle, angleBetween(p.direction, n->direction));
       }
       p.pixelAngle = angle > 0 ? angle : fallbackAngle;
       if (p.direction[2] < -1e-6f && height > 0) {
@@ -94,7 +95,8 @@ CameraRays::CameraRays(const processing::CameraCalibration& camera)
       float half = 0;
       for (int y = ty * kTileSize; y < y1; ++y) {
         for (int x = tx * kTileSize; x < x1; ++x) {
-          if (const Pixel* p = at(x, y)) half = std::max(half, angleBetween(tile.axis, p->direction));
+          if (const Pixel* p = at(x, y))
+            half = std::max(half, angleBetween(tile.axis, p->direction));
         }
       }
       half = std::min(half + 2 * widest, static_cast<float>(std::numbers::pi));
@@ -160,8 +162,8 @@ void SceneRenderer::render(const VehiclePose& pose, std::vector<CameraJob>& jobs
       const int width = job.rays->size().width;
       const CameraRays::Pixel* pixels = job.rays->row(y);
       const std::uint32_t* masks =
-          tileMasks_[j].data() + static_cast<std::ptrdiff_t>(y / CameraRays::kTileSize) *
-                                     job.rays->tilesX();
+          tileMasks_[j].data() +
+          static_cast<std::ptrdiff_t>(y / CameraRays::kTileSize) * job.rays->tilesX();
       auto* out = job.out->ptr<cv::Vec3b>(y);
       RayQuery query;
       query.origin = origins[j];
@@ -215,9 +217,9 @@ cv::Mat SceneRenderer::panorama(const VehiclePose& pose, const cv::Vec3d& centre
         query.pixelAngle = static_cast<float>(
             std::max(2 * pi / size.width * std::cos(elevation), pi / 2 / size.height));
         const cv::Vec3f radiance = scene_.radiance(query);
-        px[u] = cv::Vec3b(cv::saturate_cast<uchar>(radiance[0]),
-                          cv::saturate_cast<uchar>(radiance[1]),
-                          cv::saturate_cast<uchar>(radiance[2]));
+        px[u] =
+            cv::Vec3b(cv::saturate_cast<uchar>(radiance[0]), cv::saturate_cast<uchar>(radiance[1]),
+                      cv::saturate_cast<uchar>(radiance[2]));
       }
     }
   });

@@ -24,10 +24,10 @@ class CameraRays {
   explicit CameraRays(const processing::CameraCalibration& camera);
 
   struct Pixel {
-    cv::Vec3f direction;       // unit, vehicle frame
-    float groundDistance;      // along the ray to z = 0; < 0 when it never gets there
-    float groundLod;           // mip level of the ground texture for this pixel
-    float pixelAngle;          // radians; < 0 for a pixel outside the lens (rendered black)
+    cv::Vec3f direction;   // unit, vehicle frame
+    float groundDistance;  // along the ray to z = 0; < 0 when it never gets there
+    float groundLod;       // mip level of the ground texture for this pixel
+    float pixelAngle;      // radians; < 0 for a pixel outside the lens (rendered black)
   };
   struct Tile {
     cv::Vec3f axis;  // vehicle frame
@@ -38,7 +38,9 @@ class CameraRays {
 
   cv::Size size() const { return size_; }
   const cv::Vec3f& position() const { return position_; }
-  const Pixel* row(int y) const { return pixels_.data() + static_cast<std::ptrdiff_t>(y) * size_.width; }
+  const Pixel* row(int y) const {
+    return pixels_.data() + static_cast<std::ptrdiff_t>(y) * size_.width;
+  }
   int tilesX() const { return tilesX_; }
   const std::vector<Tile>& tiles() const { return tiles_; }
   // Angle of each pixel's ray off the optical axis (for vignetting), CV_32F; -1 outside the lens.
@@ -67,8 +69,8 @@ class SceneRenderer {
  public:
   explicit SceneRenderer(const Scene& scene) : scene_(scene) {}
 
-  // Renders all jobs at one vehicle pose, in parallel over rows (cv::parallel_for_). The result does
-  // not depend on the number of threads.
+  // Renders all jobs at one vehicle pose, in parallel over rows (cv::parallel_for_). The result
+  // does not depend on the number of threads.
   void render(const VehiclePose& pose, std::vector<CameraJob>& jobs);
 
   // The true panorama (DESIGN.md §4 convention) seen from `centre` (vehicle frame), 8-bit BGR,

@@ -16,8 +16,8 @@ cv::Mat whiteNoise(cv::Size size, std::uint64_t seed, std::uint64_t stream) {
   for (int r = 0; r < size.height; ++r) {
     float* row = out.ptr<float>(r);
     for (int c = 0; c < size.width; ++c) {
-      row[c] = static_cast<float>(unitFromHash(hash64(seed, stream, static_cast<std::uint64_t>(r),
-                                                       static_cast<std::uint64_t>(c))));
+      row[c] = static_cast<float>(unitFromHash(
+          hash64(seed, stream, static_cast<std::uint64_t>(r), static_cast<std::uint64_t>(c))));
     }
   }
   return out;
@@ -52,7 +52,8 @@ struct GroundPainter {
 };
 
 void paintMarkings(cv::Mat& white, cv::Mat& yellow, int size, float texel) {
-  const double half = static_cast<double>(size) * texel / 2;  // the texture spans [-half, half) in x and y
+  const double half =
+      static_cast<double>(size) * texel / 2;  // the texture spans [-half, half) in x and y
   const GroundPainter w{white, size, texel};
   const GroundPainter y{yellow, size, texel};
   // Double yellow centre line just right of the start position, along the whole texture.
@@ -68,8 +69,8 @@ void paintMarkings(cv::Mat& white, cv::Mat& yellow, int size, float texel) {
   // Angled bays on the left beyond the edge line.
   for (double x = -24.0; x <= 36.0; x += 3.0) {
     std::vector<cv::Point> poly;
-    for (const auto& [px, py] : {std::pair{x, 5.55}, {x + 0.14, 5.55}, {x + 2.64, 10.5},
-                                 {x + 2.5, 10.5}}) {
+    for (const auto& [px, py] :
+         {std::pair{x, 5.55}, {x + 0.14, 5.55}, {x + 2.64, 10.5}, {x + 2.5, 10.5}}) {
       poly.emplace_back(static_cast<int>(std::lround(px / texel)) + size / 2,
                         static_cast<int>(std::lround(py / texel)) + size / 2);
     }
@@ -115,9 +116,9 @@ cv::Mat makeGroundTexture(std::uint64_t seed, int size, float texelM) {
       const uchar* ym = yellow.ptr<uchar>(r);
       auto* px = out.ptr<cv::Vec3b>(r);
       for (int c = 0; c < size; ++c) {
-        double grey = 92 + 40 * (l[c] - 0.5) + 22 * (m[c] - 0.5) + 18 * (f[c] - 0.5) +
-                      26 * (g[c] - 0.5);
-        if (g[c] > 0.985f) grey += 45;  // light pebbles in the mix
+        double grey =
+            92 + 40 * (l[c] - 0.5) + 22 * (m[c] - 0.5) + 18 * (f[c] - 0.5) + 26 * (g[c] - 0.5);
+        if (g[c] > 0.985f) grey += 45;   // light pebbles in the mix
         if (l[c] < 0.22f) grey *= 0.75;  // old patches / oil stains
         const double warm = 6 * (t[c] - 0.5);
         double b = grey - warm, gg = grey, rr = grey + warm;
@@ -148,8 +149,9 @@ cv::Mat makeFacadeTexture(std::uint64_t seed, cv::Size size, float texelM) {
   for (int course = 0; course * brickH < size.height; ++course) {
     const int shift = (course % 2) * brickW / 2;
     for (int col = -1; col * brickW < size.width; ++col) {
-      const double v = 0.8 + 0.4 * unitFromHash(hash64(seed, 201, static_cast<std::uint64_t>(course),
-                                                        static_cast<std::uint64_t>(col + 1)));
+      const double v =
+          0.8 + 0.4 * unitFromHash(hash64(seed, 201, static_cast<std::uint64_t>(course),
+                                          static_cast<std::uint64_t>(col + 1)));
       const int x0 = col * brickW + shift;
       cv::rectangle(out, cv::Point(x0, course * brickH),
                     cv::Point(x0 + brickW - mortar - 1, (course + 1) * brickH - mortar - 1),
@@ -166,14 +168,15 @@ cv::Mat makeFacadeTexture(std::uint64_t seed, cv::Size size, float texelM) {
     if (y0 + height >= size.height) break;
     for (int i = 0; i < 8; ++i) {
       const int x0 = i * period + (period - texels(1.2)) / 2;
-      cv::rectangle(out, cv::Rect(x0 - texels(0.08), y0 - texels(0.1), texels(1.36), height +
-                                  texels(0.18)), cv::Scalar(215, 215, 210), cv::FILLED);
+      cv::rectangle(
+          out, cv::Rect(x0 - texels(0.08), y0 - texels(0.1), texels(1.36), height + texels(0.18)),
+          cv::Scalar(215, 215, 210), cv::FILLED);
       const double lit = unitFromHash(hash64(seed, 202, static_cast<std::uint64_t>(floor * 8 + i)));
       for (int r = 0; r < height; ++r) {
         const double s = 0.7 + 0.5 * r / height;  // sky reflected brighter towards the top
-        cv::line(out, cv::Point(x0, y0 + r), cv::Point(x0 + texels(1.2) - 1, y0 + r),
-                 lit > 0.8 ? cv::Scalar(90 * s, 170 * s, 210 * s)
-                           : cv::Scalar(105 * s, 80 * s, 55 * s));
+        cv::line(
+            out, cv::Point(x0, y0 + r), cv::Point(x0 + texels(1.2) - 1, y0 + r),
+            lit > 0.8 ? cv::Scalar(90 * s, 170 * s, 210 * s) : cv::Scalar(105 * s, 80 * s, 55 * s));
       }
       cv::rectangle(out, cv::Rect(x0 + texels(0.58), y0, texels(0.04), height),
                     cv::Scalar(215, 215, 210), cv::FILLED);  // mullion

@@ -9,7 +9,8 @@
 namespace surroundd::synth {
 
 // Asphalt (multi-octave value noise plus per-texel grain) with lane markings, parking bays and
-// crosswalks painted on. Texel (col, row) covers world x = (col - size/2) * texel, y = (row - size/2)
+// crosswalks painted on. Texel (col, row) covers world x = (col - size/2) * texel, y = (row -
+// size/2)
 // * texel.
 cv::Mat makeGroundTexture(std::uint64_t seed, int size, float texelM);
 

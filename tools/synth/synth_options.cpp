@@ -42,7 +42,8 @@ std::vector<int> parseFrames(std::string_view option, std::string_view text) {
   std::size_t start = 0;
   while (start <= text.size()) {
     const auto comma = text.find(',', start);
-    const auto item = text.substr(start, comma == std::string_view::npos ? text.npos : comma - start);
+    const auto item =
+        text.substr(start, comma == std::string_view::npos ? text.npos : comma - start);
     frames.push_back(parseNumber<int>(option, item, 0, 10'000'000,
                                       "a comma-separated list of frame indices (e.g. 0,150,299)"));
     if (comma == std::string_view::npos) break;
@@ -103,8 +104,7 @@ SynthOptions parseSynthArguments(std::span<const std::string_view> arguments) {
     } else if (option == "--fps") {
       o.fps = parseNumber<double>(option, value(), 1.0, 240.0, "frames per second from 1 to 240");
     } else if (option == "--seed") {
-      o.seed = parseNumber<std::uint64_t>(option, value(), 0, UINT64_MAX,
-                                          "a non-negative integer");
+      o.seed = parseNumber<std::uint64_t>(option, value(), 0, UINT64_MAX, "a non-negative integer");
     } else if (option == "--photometrics") {
       const auto v = value();
       if (v != "random" && v != "identity") {
@@ -119,8 +119,7 @@ SynthOptions parseSynthArguments(std::span<const std::string_view> arguments) {
       const auto v = value();
       const auto colon = v.rfind(':');
       if (colon == std::string_view::npos || colon == 0) {
-        throw UsageError(
-            fmt::format("{}: expected CAMERA:N (e.g. right:3), got '{}'", option, v));
+        throw UsageError(fmt::format("{}: expected CAMERA:N (e.g. right:3), got '{}'", option, v));
       }
       o.dropEvery.emplace_back(std::string(v.substr(0, colon)),
                                parseNumber<int>(option, v.substr(colon + 1), 2, 1'000'000,
@@ -148,8 +147,8 @@ SynthOptions parseSynthArguments(std::span<const std::string_view> arguments) {
   if (o.groundTruthFrames) {
     for (const int f : *o.groundTruthFrames) {
       if (f >= frames) {
-        throw UsageError(fmt::format("--ground-truth-frames: frame {} is past the last frame {}",
-                                     f, frames - 1));
+        throw UsageError(fmt::format("--ground-truth-frames: frame {} is past the last frame {}", f,
+                                     frames - 1));
       }
     }
   }

@@ -22,20 +22,20 @@ class UsageError : public std::runtime_error {
 };
 
 struct SynthOptions {
-  std::filesystem::path rig;           // rig preset YAML (sources not needed)
-  std::filesystem::path out;           // output folder
-  std::optional<cv::Size> size;        // per-camera image size; default: the preset's
-  double seconds = 10;                 // recording length
-  double fps = 30;                     // nominal frame rate
+  std::filesystem::path rig;     // rig preset YAML (sources not needed)
+  std::filesystem::path out;     // output folder
+  std::optional<cv::Size> size;  // per-camera image size; default: the preset's
+  double seconds = 10;           // recording length
+  double fps = 30;               // nominal frame rate
   std::uint64_t seed = 1;
-  bool randomPhotometrics = true;      // false: identity (neutral, noise 0, no drift)
-  bool drift = true;                   // slow exposure drift
-  double noiseSigma = 1.5;             // sensor noise, 8-bit levels
+  bool randomPhotometrics = true;  // false: identity (neutral, noise 0, no drift)
+  bool drift = true;               // slow exposure drift
+  double noiseSigma = 1.5;         // sensor noise, 8-bit levels
   std::vector<std::pair<std::string, int>> dropEvery;  // camera name, N: omit every Nth frame
   std::optional<std::vector<int>> groundTruthFrames;   // default: first, middle, last
   cv::Size panoramaSize{2048, 1024};
-  int crf = 14;                        // x264 CRF: visually lossless camera masters
-  bool force = false;                  // replace an existing output folder
+  int crf = 14;        // x264 CRF: visually lossless camera masters
+  bool force = false;  // replace an existing output folder
 
   int frameCount() const;
   // Everything that decides the recording's content (not --out or --force), in a fixed order:

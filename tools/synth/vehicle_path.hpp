@@ -40,8 +40,8 @@ struct VehiclePose {
 
 class VehiclePath {
  public:
-  static constexpr double kSpeedMps = 1.5;          // walking pace: motion stays sub-pixel per frame
-  static constexpr double kYawRateRadPerS = 0.04;   // turning radius 37.5 m
+  static constexpr double kSpeedMps = 1.5;         // walking pace: motion stays sub-pixel per frame
+  static constexpr double kYawRateRadPerS = 0.04;  // turning radius 37.5 m
 
   static VehiclePose poseAt(double seconds) {
     const double yaw = kYawRateRadPerS * seconds;
