@@ -13,6 +13,7 @@
 
 #include "capture/file_source.hpp"
 #include "daemon/rig_yaml.hpp"
+#include "processing/panorama_lut.hpp"
 
 namespace surroundd::daemon {
 
@@ -24,7 +25,14 @@ struct CaptureConfig {
   bool operator==(const CaptureConfig&) const = default;
 };
 
-enum class PanoramaProjection { kSphere, kBowl };
+struct PipelineConfig {
+  int threads = 0;  // workers for the per-frame stages (stitch, ...), counting the pipeline thread;
+                    // 0 = one per core
+
+  bool operator==(const PipelineConfig&) const = default;
+};
+
+using processing::PanoramaProjection;
 
 struct PanoramaConfig {
   int widthPx = 2048;   // azimuth -180..180 degrees
@@ -33,6 +41,9 @@ struct PanoramaConfig {
   double elevationBottomDeg = -60.0;
   PanoramaProjection projection = PanoramaProjection::kBowl;
   double featherDeg = 4.0;  // blend width across a seam
+  // Where built LUTs are kept; empty: $STATE_DIRECTORY (systemd), else $XDG_CACHE_HOME/surroundd,
+  // else ~/.cache/surroundd.
+  std::filesystem::path cacheDir;
 
   bool operator==(const PanoramaConfig&) const = default;
 };
@@ -75,8 +86,9 @@ struct RenderConfig {
   bool operator==(const RenderConfig&) const = default;
 };
 
-// What an output shows. Only the camera mosaic exists so far; the surround views come with render/.
-enum class OutputStream { kMosaic };
+// What an output shows: the labelled camera grid, or the stitched panorama. The surround views
+// come with render/.
+enum class OutputStream { kMosaic, kPanorama };
 enum class OutputKind { kVideo, kSnapshot };
 
 struct OutputConfig {
@@ -98,6 +110,7 @@ struct Config {
   spdlog::level::level_enum logLevel = spdlog::level::info;
   std::vector<RigCamera> cameras;
   CaptureConfig capture;
+  PipelineConfig pipeline;
   PanoramaConfig panorama;
   ColourCorrectionConfig colour;
   MeshConfig mesh;

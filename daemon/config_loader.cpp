@@ -38,6 +38,16 @@ void readRig(YamlObject& root, Config& config) {
   }
 }
 
+// H.264 in 4:2:0 needs even sizes; checked here so that no encoder fails at run time.
+void requireEven(YamlObject& section, std::string_view key, int value) {
+  if (value % 2 != 0) section.error(key, fmt::format("expected an even number, got {}", value));
+}
+
+void readPipeline(YamlObject& section, PipelineConfig& p) {
+  p.threads = section.integer("threads", p.threads, 0, 256);
+  section.finish();
+}
+
 void readCapture(YamlObject& section, CaptureConfig& c) {
   c.pacing = section.choice("pacing", c.pacing,
                             {{"realtime", capture::Pacing::kRealtime},
@@ -51,6 +61,8 @@ void readCapture(YamlObject& section, CaptureConfig& c) {
 void readPanorama(YamlObject& section, PanoramaConfig& p) {
   p.widthPx = section.integer("width_px", p.widthPx, 64, 16384);
   p.heightPx = section.integer("height_px", p.heightPx, 32, 8192);
+  requireEven(section, "width_px", p.widthPx);
+  requireEven(section, "height_px", p.heightPx);
   p.elevationTopDeg =
       section.number("elevation_top_deg", p.elevationTopDeg, {-90.0, 90.0, false, "degrees"});
   p.elevationBottomDeg =
@@ -64,6 +76,7 @@ void readPanorama(YamlObject& section, PanoramaConfig& p) {
       "projection", p.projection,
       {{"sphere", PanoramaProjection::kSphere}, {"bowl", PanoramaProjection::kBowl}});
   p.featherDeg = section.number("feather_deg", p.featherDeg, {0.0, 45.0, false, "degrees"});
+  if (section.has("cache_dir")) p.cacheDir = section.outputPath("cache_dir").value_or("");
   section.finish();
 }
 
@@ -113,11 +126,8 @@ void readRender(YamlObject& section, RenderConfig& r) {
                            {"split", ViewKind::kSplit}});
   r.widthPx = section.integer("width_px", r.widthPx, 64, 7680);
   r.heightPx = section.integer("height_px", r.heightPx, 64, 4320);
-  // H.264 in 4:2:0 needs even sizes; checked here so no encoder fails at run time.
-  if (r.widthPx % 2 != 0)
-    section.error("width_px", fmt::format("expected an even number, got {}", r.widthPx));
-  if (r.heightPx % 2 != 0)
-    section.error("height_px", fmt::format("expected an even number, got {}", r.heightPx));
+  requireEven(section, "width_px", r.widthPx);
+  requireEven(section, "height_px", r.heightPx);
   section.finish();
 }
 
@@ -126,7 +136,9 @@ OutputConfig readOutput(YamlObject& item) {
   o.kind = item.choice("type", o.kind,
                        {{"video", OutputKind::kVideo}, {"snapshot", OutputKind::kSnapshot}});
   if (!item.has("type")) item.errorHere("missing key 'type' (one of 'video' 'snapshot')");
-  o.stream = item.choice("stream", o.stream, {{"mosaic", OutputStream::kMosaic}});
+  o.stream =
+      item.choice("stream", o.stream,
+                  {{"mosaic", OutputStream::kMosaic}, {"panorama", OutputStream::kPanorama}});
   o.path = item.outputPath("path").value_or("");
   const auto extension = o.path.extension().string();
   if (o.kind == OutputKind::kVideo) {
@@ -172,6 +184,7 @@ Config loadConfig(const std::filesystem::path& file) {
     s.finish();
   });
   readSection("capture", [&](YamlObject& s) { readCapture(s, config.capture); });
+  readSection("pipeline", [&](YamlObject& s) { readPipeline(s, config.pipeline); });
   readSection("panorama", [&](YamlObject& s) { readPanorama(s, config.panorama); });
   readSection("colour_correction", [&](YamlObject& s) { readColour(s, config.colour); });
   readSection("mesh", [&](YamlObject& s) { readMesh(s, config.mesh); });

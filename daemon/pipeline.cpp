@@ -1,10 +1,12 @@
 #include "daemon/pipeline.hpp"
 
+#include <algorithm>
 #include <array>
 
 #include <spdlog/spdlog.h>
 
 #include "capture/file_source.hpp"
+#include "daemon/panorama_setup.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -22,6 +24,13 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
     settings.pacing = config.capture.pacing;
     const auto& name = camera.calibration.name;
     auto source = std::make_unique<capture::FileSource>(name, settings);
+    const cv::Size calibrated = camera.calibration.intrinsics.imageSize;
+    if (source->frameSize() != calibrated) {
+      throw std::runtime_error(
+          fmt::format("camera '{}': {} has {}x{} frames but the lens is calibrated for {}x{}", name,
+                      settings.path.string(), source->frameSize().width, source->frameSize().height,
+                      calibrated.width, calibrated.height));
+    }
     spdlog::info("camera '{}': {} ({}x{}, {:.2f} fps)", name, settings.path.string(),
                  source->frameSize().width, source->frameSize().height,
                  1e9 / static_cast<double>(source->nominalPeriod().count()));
@@ -36,7 +45,7 @@ std::vector<std::string> cameraNames(const Config& config) {
   return names;
 }
 
-std::unique_ptr<render::FrameSink> openSink(const OutputConfig& output, const Config& config,
+std::unique_ptr<render::FrameSink> openSink(const OutputConfig& output, cv::Size videoSize,
                                             double nominalFps) {
   if (output.path.has_parent_path()) std::filesystem::create_directories(output.path.parent_path());
   if (output.kind == OutputKind::kSnapshot) {
@@ -46,7 +55,7 @@ std::unique_ptr<render::FrameSink> openSink(const OutputConfig& output, const Co
   }
   render::VideoEncoderSettings settings;
   settings.path = output.path;
-  settings.size = {config.render.widthPx, config.render.heightPx};
+  settings.size = videoSize;
   settings.nominalFps = nominalFps;
   settings.crf = output.crf;
   settings.preset = output.preset;
@@ -61,10 +70,31 @@ Pipeline::Pipeline(const Config& config)
       synchronizer_(cameras_.size(),
                     std::chrono::duration_cast<capture::Timestamp>(
                         std::chrono::duration<double, std::milli>(config.capture.syncToleranceMs))),
+      pool_(config.pipeline.threads),
       mosaic_(cv::Size(config.render.widthPx, config.render.heightPx), cameraNames(config)),
       canvas_(mosaic_.outputSize(), CV_8UC3, cv::Scalar::all(0)) {
+  const bool wantPanorama = std::ranges::any_of(
+      config.outputs, [](const auto& o) { return o.stream == OutputStream::kPanorama; });
+  wantMosaic_ = std::ranges::any_of(
+      config.outputs, [](const auto& o) { return o.stream == OutputStream::kMosaic; });
+  if (wantPanorama) {
+    lut_ = std::make_unique<processing::PanoramaLut>(obtainPanoramaLut(config, pool_));
+    stitcher_ = std::make_unique<processing::Stitcher>(*lut_, pool_);
+    panorama_.create(lut_->size, CV_8UC3);
+    for (const auto& size : lut_->cameraSizes)
+      blackFrames_.emplace_back(size, CV_8UC3, cv::Scalar::all(0));
+    stitchInputs_.resize(cameras_.size());
+  }
   const double nominalFps = 1e9 / static_cast<double>(cameras_.front()->nominalPeriod().count());
-  for (const auto& output : config.outputs) sinks_.push_back(openSink(output, config, nominalFps));
+  for (const auto& output : config.outputs) {
+    const cv::Size size =
+        output.stream == OutputStream::kPanorama ? lut_->size : mosaic_.outputSize();
+    outputs_.push_back({output.stream, openSink(output, size, nominalFps)});
+  }
+}
+
+const cv::Mat& Pipeline::imageOf(OutputStream stream) const {
+  return stream == OutputStream::kPanorama ? panorama_ : canvas_;
 }
 
 Pipeline::~Pipeline() = default;
@@ -116,29 +146,34 @@ void Pipeline::render(const capture::FrameSet& set) {
   for (std::size_t c = 0; c < set.cameraCount; ++c) {
     images[c] = set.frame(c) != nullptr ? &set.frame(c)->image : nullptr;
   }
-  mosaic_.compose(std::span(images.data(), set.cameraCount), canvas_);
+  if (wantMosaic_) mosaic_.compose(std::span(images.data(), set.cameraCount), canvas_);
+  if (stitcher_) {
+    for (std::size_t c = 0; c < set.cameraCount; ++c) {
+      stitchInputs_[c] = images[c] != nullptr ? *images[c] : blackFrames_[c];
+    }
+    stitcher_->stitch(stitchInputs_, panorama_);
+  }
   if (!firstTimestamp_) firstTimestamp_ = set.timestamp;
   const auto streamTime = set.timestamp - *firstTimestamp_;
-  for (auto& sink : sinks_) {
-    if (!sink) continue;
+  for (auto& output : outputs_) {
+    if (!output.sink) continue;
     try {
-      sink->consume(canvas_, streamTime);
+      output.sink->consume(imageOf(output.stream), streamTime);
     } catch (const std::exception& e) {
       spdlog::error("output failed, dropping it: {}", e.what());
       ++failedSinks_;
-      sink.reset();
+      output.sink.reset();
     }
   }
 }
 
 void Pipeline::finish(RunSummary& summary) {
   for (auto& camera : cameras_) camera->stop();
-  const cv::Mat lastFrame = firstTimestamp_ ? canvas_ : cv::Mat();
-  for (auto& sink : sinks_) {
-    if (!sink) continue;
+  for (auto& output : outputs_) {
+    if (!output.sink) continue;
     try {
-      sink->finish(lastFrame);
-      summary.outputs.push_back(sink->describe());
+      output.sink->finish(firstTimestamp_ ? imageOf(output.stream) : cv::Mat());
+      summary.outputs.push_back(output.sink->describe());
     } catch (const std::exception& e) {
       spdlog::error("output failed to finish: {}", e.what());
       ++failedSinks_;

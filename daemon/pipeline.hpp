@@ -1,8 +1,9 @@
 #pragma once
-// The replay pipeline as it stands: cameras -> synchronizer -> mosaic -> outputs.
+// The replay pipeline as it stands: cameras -> synchronizer -> mosaic and/or panorama -> outputs.
 //
-// One capture thread per camera (CameraStream); this thread synchronizes, composes and feeds the
-// outputs. Construction opens every source and output and throws (CaptureError, EncoderError,
+// One capture thread per camera (CameraStream); this thread synchronizes, composes the mosaic,
+// stitches the panorama (on the work pool, only when an output shows it) and feeds the outputs.
+// Construction opens every source and output and throws (CaptureError, EncoderError,
 // std::runtime_error) with a message naming the camera or file; run() does not throw for faults of
 // single cameras or outputs: a failing camera ends its stream, a failing output is logged and
 // dropped, the rest go on.
@@ -16,7 +17,9 @@
 
 #include "capture/camera_stream.hpp"
 #include "capture/synchronizer.hpp"
+#include "common/work_pool.hpp"
 #include "daemon/config.hpp"
+#include "processing/stitcher.hpp"
 #include "render/frame_sink.hpp"
 #include "render/mosaic.hpp"
 
@@ -51,11 +54,24 @@ class Pipeline {
   void render(const capture::FrameSet& set);
   void finish(RunSummary& summary);
 
+  struct Output {
+    OutputStream stream;
+    std::unique_ptr<render::FrameSink> sink;  // null once it failed
+  };
+  const cv::Mat& imageOf(OutputStream stream) const;
+
   std::vector<std::unique_ptr<capture::CameraStream>> cameras_;
   capture::Synchronizer synchronizer_;
+  WorkPool pool_;
   render::Mosaic mosaic_;
-  cv::Mat canvas_;  // the composed frame; reused for every set
-  std::vector<std::unique_ptr<render::FrameSink>> sinks_;
+  cv::Mat canvas_;                                  // the composed mosaic; reused for every set
+  std::unique_ptr<processing::PanoramaLut> lut_;    // set when an output shows the panorama
+  std::unique_ptr<processing::Stitcher> stitcher_;  // borrows *lut_ and pool_
+  std::vector<cv::Mat> stitchInputs_;  // this set's images (headers only), one per camera
+  std::vector<cv::Mat> blackFrames_;   // stand in for a camera missing from a set
+  cv::Mat panorama_;
+  bool wantMosaic_ = false;
+  std::vector<Output> outputs_;
   std::uint64_t failedSinks_ = 0;
   std::optional<capture::Timestamp> firstTimestamp_;
 };

@@ -5,7 +5,7 @@ set -eu
 
 PACKAGES="
   build-essential cmake pkg-config
-  libopencv-dev libyaml-cpp-dev libspdlog-dev libfmt-dev
+  libopencv-dev libyaml-cpp-dev libspdlog-dev libfmt-dev zlib1g-dev
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   libgtest-dev libgmock-dev
 "

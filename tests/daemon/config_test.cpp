@@ -210,6 +210,7 @@ TEST(ReferenceConfig, DocumentsTheDefaults) {
   EXPECT_EQ(config.logLevel, spdlog::level::info);
   EXPECT_EQ(config.cameras.size(), 4u);
   EXPECT_EQ(config.capture, CaptureConfig{});
+  EXPECT_EQ(config.pipeline, PipelineConfig{});
   EXPECT_EQ(config.panorama, PanoramaConfig{});
   EXPECT_EQ(config.colour, ColourCorrectionConfig{});
   EXPECT_EQ(config.mesh, MeshConfig{});

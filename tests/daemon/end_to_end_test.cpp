@@ -9,7 +9,10 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "capture/file_source.hpp"
+#include "common/work_pool.hpp"
+#include "daemon/panorama_setup.hpp"
 #include "daemon/rig_yaml.hpp"
+#include "processing/stitcher.hpp"
 #include "render/mosaic.hpp"
 #include "tests/support/child_process.hpp"
 #include "tests/support/temp_dir.hpp"
@@ -68,6 +71,51 @@ TEST(EndToEnd, MosaicVideoMatchesTheSourceFrames) {
     EXPECT_NE(entry.path().extension(), ".part") << entry.path();
   }
   EXPECT_THAT(surroundd.output(), HasSubstr("wrote video"));
+}
+
+// The panorama output: the video shows the stitch of the source frames; the LUT is built on the
+// first run, loaded on the next, and rebuilt when its cache file is damaged.
+TEST(EndToEnd, PanoramaVideoMatchesTheStitchedSourceFramesAndTheLutIsCached) {
+  const testing::TempDir dir;
+  const auto config = dir.write("config.yaml", fmt::format(R"(rig: {{file: {}}}
+capture: {{pacing: as_fast_as_possible}}
+pipeline: {{threads: 2}}
+panorama: {{width_px: 512, height_px: 256, cache_dir: lut-cache}}
+outputs:
+  - {{type: video, stream: panorama, path: out/panorama.mp4, crf: 12}}
+  - {{type: snapshot, stream: panorama, path: out/panorama.png, at_s: 0.5}}
+)",
+                                                           (kRecording / "rig.yaml").string()));
+  const auto run = [&](std::string_view expectedLog) {
+    testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--config", config.string()},
+                                    dir / "log.txt");
+    EXPECT_EQ(surroundd.wait(), 0) << surroundd.output();
+    EXPECT_THAT(surroundd.output(), HasSubstr(expectedLog));
+  };
+  run("panorama LUT 512x256 (bowl projection): building");
+  run("panorama LUT 512x256: loaded");
+  const auto cached = *std::filesystem::directory_iterator(dir / "lut-cache");
+  std::filesystem::resize_file(cached.path(), 1000);
+  run("is corrupt (checksum mismatch); rebuilding");
+
+  const daemon::Config loaded = daemon::loadConfig(config);
+  WorkPool pool(2);
+  const processing::PanoramaLut lut = daemon::obtainPanoramaLut(loaded, pool);
+  processing::Stitcher stitcher(lut, pool);
+  std::vector<std::vector<cv::Mat>> sources;
+  for (const auto& camera : loaded.cameras) {
+    sources.push_back(testing::decodeAll(camera.source->path).images);
+  }
+  const auto video = testing::decodeAll(dir / "out/panorama.mp4").images;
+  ASSERT_EQ(video.size(), sources[0].size());
+  cv::Mat expected;
+  for (const std::size_t k : {std::size_t{0}, video.size() - 1}) {
+    std::vector<cv::Mat> frames;
+    for (const auto& camera : sources) frames.push_back(camera[k]);
+    stitcher.stitch(frames, expected);
+    EXPECT_GE(cv::PSNR(expected, video[k]), 35.0) << "frame " << k;
+  }
+  EXPECT_EQ(cv::imread((dir / "out/panorama.png").string()).size(), lut.size);
 }
 
 TEST(EndToEnd, SigtermLeavesAPlayableFile) {

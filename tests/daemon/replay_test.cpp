@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "capture/file_source.hpp"
@@ -102,6 +103,17 @@ TEST_F(ReplayTest, PipelineLosesOnlyTheSetsOfTheDroppedFrames) {
   }
   EXPECT_LE(summary.sync.maxSpread, std::chrono::milliseconds(10));
   EXPECT_TRUE(std::filesystem::exists(dir / "last.png"));
+}
+
+TEST_F(ReplayTest, AVideoOfAnotherSizeThanItsCalibrationIsRefused) {
+  config_.cameras[1].calibration.intrinsics.imageSize = {640, 360};
+  try {
+    Pipeline pipeline(config_);
+    FAIL() << "a 320x180 video with a 640x360 calibration was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("has 320x180 frames but the lens is calibrated for "
+                                               "640x360"));
+  }
 }
 
 }  // namespace

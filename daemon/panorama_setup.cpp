@@ -1,0 +1,94 @@
+#include "daemon/panorama_setup.hpp"
+
+#include <chrono>
+#include <cstdlib>
+#include <numbers>
+
+#include <spdlog/spdlog.h>
+
+#include "processing/panorama_lut_cache.hpp"
+
+namespace surroundd::daemon {
+namespace {
+
+constexpr double kDegToRad = std::numbers::pi / 180;
+
+// Set and non-empty, or nullptr.
+const char* environment(const char* name) {
+  // Read once at start-up; surroundd never changes its environment.
+  const char* value = std::getenv(name);  // NOLINT(concurrency-mt-unsafe)
+  return value != nullptr && *value != '\0' ? value : nullptr;
+}
+
+}  // namespace
+
+processing::Rig rigOf(const Config& config) {
+  processing::Rig rig;
+  for (const auto& camera : config.cameras) rig.cameras.push_back(camera.calibration);
+  return rig;
+}
+
+processing::PanoramaSettings panoramaSettings(const Config& config) {
+  processing::PanoramaSettings settings;
+  const auto& p = config.panorama;
+  settings.geometry.size = {p.widthPx, p.heightPx};
+  settings.geometry.elevationTopRad = p.elevationTopDeg * kDegToRad;
+  settings.geometry.elevationBottomRad = p.elevationBottomDeg * kDegToRad;
+  double height = 0;
+  for (const auto& camera : config.cameras) height += camera.calibration.pose.position[2];
+  settings.geometry.centre = {0, 0, height / static_cast<double>(config.cameras.size())};
+  settings.projection = p.projection;
+  settings.featherRad = p.featherDeg * kDegToRad;
+  settings.bowl = {config.mesh.bowlFloorRadiusM, config.mesh.bowlRadiusM, config.mesh.bowlHeightM};
+  return settings;
+}
+
+std::filesystem::path lutCacheDir(const Config& config) {
+  if (!config.panorama.cacheDir.empty()) return config.panorama.cacheDir;
+  if (const char* state = environment("STATE_DIRECTORY")) return state;
+  if (const char* cache = environment("XDG_CACHE_HOME")) {
+    return std::filesystem::path(cache) / "surroundd";
+  }
+  if (const char* home = environment("HOME"))
+    return std::filesystem::path(home) / ".cache" / "surroundd";
+  return std::filesystem::temp_directory_path() / "surroundd";
+}
+
+processing::PanoramaLut obtainPanoramaLut(const Config& config, WorkPool& pool) {
+  const processing::Rig rig = rigOf(config);
+  const processing::PanoramaSettings settings = panoramaSettings(config);
+  const std::string key = processing::panoramaLutKey(rig, settings);
+  const processing::PanoramaLutCache cache(lutCacheDir(config));
+  auto lookup = cache.load(key);
+  if (lookup.lut) {
+    spdlog::info("panorama LUT {}x{}: loaded {}", settings.geometry.size.width,
+                 settings.geometry.size.height, cache.fileFor(key).string());
+    return std::move(*lookup.lut);
+  }
+  if (lookup.problem != "absent")
+    spdlog::warn("panorama LUT cache: {}; rebuilding", lookup.problem);
+  spdlog::info("panorama LUT {}x{} ({} projection): building", settings.geometry.size.width,
+               settings.geometry.size.height,
+               settings.projection == processing::PanoramaProjection::kBowl ? "bowl" : "sphere");
+  const auto start = std::chrono::steady_clock::now();
+  processing::PanoramaLut lut;
+  try {
+    lut = processing::buildPanoramaLut(rig, settings, pool, [](double done) {
+      spdlog::info("panorama LUT: {:.0f} %", done * 100);
+    });
+  } catch (const processing::RigError& e) {
+    throw std::runtime_error(fmt::format("{}: rig: {}", config.file.string(), e.what()));
+  }
+  spdlog::info("panorama LUT built in {:.2f} s ({} blend taps)",
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+               lut.blendTaps.size());
+  try {
+    cache.store(key, lut);
+    spdlog::info("panorama LUT stored in {}", cache.fileFor(key).string());
+  } catch (const std::exception& e) {
+    spdlog::warn("panorama LUT not cached: {}", e.what());
+  }
+  return lut;
+}
+
+}  // namespace surroundd::daemon

@@ -1,0 +1,29 @@
+#pragma once
+// The panorama the config asks for: its settings, and its LUT, taken from the on-disk cache when
+// one was built for exactly these inputs, or built (progress in the log) and stored there.
+
+#include <filesystem>
+
+#include "daemon/config.hpp"
+#include "processing/panorama_lut.hpp"
+
+namespace surroundd {
+class WorkPool;
+}
+
+namespace surroundd::daemon {
+
+processing::Rig rigOf(const Config& config);
+
+// The panorama is seen from (0, 0, mean camera height): the rig's virtual centre, where the
+// generator's ground truth is rendered from too.
+processing::PanoramaSettings panoramaSettings(const Config& config);
+
+// panorama.cache_dir, or the default it documents.
+std::filesystem::path lutCacheDir(const Config& config);
+
+// Throws std::runtime_error naming the config for a rig that cannot make a panorama. A cache that
+// cannot be written is logged and skipped.
+processing::PanoramaLut obtainPanoramaLut(const Config& config, WorkPool& pool);
+
+}  // namespace surroundd::daemon

@@ -1,0 +1,22 @@
+#!/bin/sh
+# The benchmarks: installs what is missing, builds (release), makes the benchmark recordings (the
+# paper rig at 4 x 854x480, 1280x720 and 1920x1080, with ground truth; once, then cached in
+# recordings/bench/), and runs surround-bench on them. Extra arguments go to surround-bench, e.g.
+# --json, --threads 1, --repeats 100.
+set -eu
+cd "$(dirname "$0")/.."
+scripts/install-deps.sh
+cmake --preset release
+cmake --build --preset release --target surround-synth surround-bench
+synth=build/release/tools/synth/surround-synth
+# name, camera size, panorama size (about the cameras' angular resolution, capped at 2048 wide)
+while read -r name size panorama; do
+  "$synth" --rig config/rigs/paper.yaml --out "recordings/bench/$name" --size "$size" \
+    --panorama-size "$panorama" --seconds 0.2 --seed 3
+done <<INPUTS
+480p 854x480 1024x512
+720p 1280x720 1536x768
+1080p 1920x1080 2048x1024
+INPUTS
+exec build/release/tools/bench/surround-bench stitch "$@" \
+  recordings/bench/480p recordings/bench/720p recordings/bench/1080p

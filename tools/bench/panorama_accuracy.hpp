@@ -1,0 +1,37 @@
+#pragma once
+// How well a panorama LUT matches the world it was built for.
+//
+// Seam alignment is geometric and exact: at every seam pixel that both neighbours sample, each
+// camera's sample position is cast back onto the true ground (z = 0) through that camera's lens
+// and pose; the two ground points, seen from the panorama centre, should fall on one panorama
+// pixel. Their distance in panorama pixels is the misalignment a viewer sees as a doubled or
+// broken lane marking. Image error compares a stitched panorama with the generator's true one,
+// over the pixels where the true scene is ground inside the bowl's floor.
+
+#include <opencv2/core.hpp>
+
+#include "processing/panorama_lut.hpp"
+#include "tools/bench/recording_truth.hpp"
+#include "tools/synth/scene.hpp"
+
+namespace surroundd::bench {
+
+struct SeamAlignment {
+  double meanPx = 0;
+  double maxPx = 0;
+  int samples = 0;  // seam pixels on the ground that both cameras sample
+};
+
+SeamAlignment measureGroundSeams(const processing::Rig& rig,
+                                 const processing::PanoramaSettings& settings,
+                                 const processing::PanoramaLut& lut);
+
+// CV_8U, 255 where the ray from the panorama centre first meets the ground (no box or wall in
+// front) within the bowl's floor radius, with the vehicle at `pose` in the recording's scene.
+cv::Mat trueGroundMask(const synth::Scene& scene, const synth::VehiclePose& pose,
+                       const processing::PanoramaSettings& settings);
+
+// Mean absolute difference over the mask and the channels, 8-bit levels.
+double meanAbsoluteError(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask);
+
+}  // namespace surroundd::bench

@@ -1,0 +1,196 @@
+#include "tools/bench/stitch_benchmark.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include <fmt/format.h>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <unistd.h>
+
+#include "common/work_pool.hpp"
+#include "processing/panorama_lut_cache.hpp"
+#include "processing/stitcher.hpp"
+#include "tools/bench/panorama_accuracy.hpp"
+#include "tools/bench/recording_truth.hpp"
+#include "tools/bench/remap_baseline.hpp"
+#include "tools/bench/timing.hpp"
+
+namespace surroundd::bench {
+namespace {
+
+struct Accuracy {
+  SeamAlignment seams;
+  double groundError = 0;  // levels, mean over the ground-truth frames
+};
+
+struct ThreadTiming {
+  int threads = 0;
+  double stitchMs = 0;
+  double remapMs = 0;
+};
+
+struct InputReport {
+  std::string name;
+  cv::Size camera;
+  cv::Size panorama;
+  double lutBuildS = 0;
+  double lutLoadS = 0;
+  std::size_t lutBytes = 0;
+  std::vector<ThreadTiming> timings;
+  Accuracy bowl;
+  Accuracy sphere;
+};
+
+cv::Mat readImage(const std::filesystem::path& path) {
+  cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
+  if (image.empty()) throw std::runtime_error(fmt::format("cannot read {}", path.string()));
+  return image;
+}
+
+processing::PanoramaSettings settingsFor(const RecordingTruth& truth,
+                                         processing::PanoramaProjection projection) {
+  processing::PanoramaSettings settings;
+  settings.geometry = truth.panorama;
+  settings.projection = projection;
+  return settings;
+}
+
+Accuracy measureAccuracy(const RecordingTruth& truth, const synth::Scene& scene,
+                         const processing::PanoramaSettings& settings, WorkPool& pool) {
+  const processing::PanoramaLut lut = processing::buildPanoramaLut(truth.rig, settings, pool);
+  processing::Stitcher stitcher(lut, pool);
+  Accuracy accuracy;
+  accuracy.seams = measureGroundSeams(truth.rig, settings, lut);
+  cv::Mat panorama;
+  for (const auto& frame : truth.frames) {
+    std::vector<cv::Mat> images;
+    for (const auto& path : frame.images) images.push_back(readImage(path));
+    stitcher.stitch(images, panorama);
+    // Pixels no camera sees are not the stitcher's error.
+    const cv::Mat ground = trueGroundMask(scene, frame.pose, settings) & lut.validMask();
+    accuracy.groundError += meanAbsoluteError(panorama, readImage(frame.panorama), ground);
+  }
+  accuracy.groundError /= static_cast<double>(truth.frames.size());
+  return accuracy;
+}
+
+InputReport measure(const std::filesystem::path& folder, int threads, int repeats) {
+  const RecordingTruth truth = loadRecordingTruth(folder);
+  InputReport report;
+  report.name = folder.filename().string();
+  report.camera = truth.rig.cameras.front().intrinsics.imageSize;
+  report.panorama = truth.panorama.size;
+
+  WorkPool pool(threads);
+  const auto bowlSettings = settingsFor(truth, processing::PanoramaProjection::kBowl);
+  processing::PanoramaLut lut;
+  report.lutBuildS =
+      millisecondsOf([&] { lut = processing::buildPanoramaLut(truth.rig, bowlSettings, pool); }) /
+      1000;
+  const auto cacheDir = std::filesystem::temp_directory_path() /
+                        fmt::format("surround-bench-{}", static_cast<long>(::getpid()));
+  const processing::PanoramaLutCache cache(cacheDir);
+  const std::string key = processing::panoramaLutKey(truth.rig, bowlSettings);
+  cache.store(key, lut);
+  report.lutBytes = std::filesystem::file_size(cache.fileFor(key));
+  report.lutLoadS = millisecondsOf([&] { (void)cache.load(key); }) / 1000;
+  std::filesystem::remove_all(cacheDir);
+
+  std::vector<cv::Mat> images;
+  for (const auto& path : truth.frames.front().images) images.push_back(readImage(path));
+  const RemapBaseline baseline(lut);
+  cv::Mat ours(lut.size, CV_8UC3);
+  cv::Mat theirs(lut.size, CV_8UC3);
+  for (const int t : threads > 1 ? std::vector<int>{1, threads} : std::vector<int>{1}) {
+    WorkPool timedPool(t);
+    processing::Stitcher stitcher(lut, timedPool);
+    cv::setNumThreads(t);
+    const auto medians = interleavedMedians(
+        {[&] { stitcher.stitch(images, ours); }, [&] { baseline.stitch(images, theirs); }},
+        repeats);
+    report.timings.push_back({t, medians[0], medians[1]});
+  }
+  cv::setNumThreads(-1);
+
+  const synth::Scene scene(truth.seed, truth.seconds);
+  report.bowl = measureAccuracy(truth, scene, bowlSettings, pool);
+  report.sphere = measureAccuracy(
+      truth, scene, settingsFor(truth, processing::PanoramaProjection::kSphere), pool);
+  return report;
+}
+
+void printText(const std::vector<InputReport>& reports) {
+  fmt::print(
+      "surround-bench stitch: the LUT stitcher against cv::remap on the same maps (median "
+      "ms, same run)\n\n");
+  for (const auto& r : reports) {
+    fmt::print("{}: 4 x {}x{} -> panorama {}x{}\n", r.name, r.camera.width, r.camera.height,
+               r.panorama.width, r.panorama.height);
+    fmt::print("  LUT (bowl): build {:.2f} s, cache load {:.3f} s, {:.1f} MB on disk\n",
+               r.lutBuildS, r.lutLoadS, static_cast<double>(r.lutBytes) / 1e6);
+    for (const auto& t : r.timings) {
+      fmt::print(
+          "  {} thread{}: stitch {:6.2f} ms ({:5.0f} fps)   cv::remap {:6.2f} ms   "
+          "ratio {:.2f}x\n",
+          t.threads, t.threads > 1 ? "s" : " ", t.stitchMs, 1000 / t.stitchMs, t.remapMs,
+          t.stitchMs / t.remapMs);
+    }
+    for (const auto& [name, a] : {std::pair{"bowl  ", r.bowl}, std::pair{"sphere", r.sphere}}) {
+      fmt::print(
+          "  {}: ground seams {:.2f} px mean, {:.2f} px max ({} seam pixels); error vs "
+          "true panorama over the ground {:.2f} levels\n",
+          name, a.seams.meanPx, a.seams.maxPx, a.seams.samples, a.groundError);
+    }
+    fmt::print("\n");
+  }
+}
+
+void printJson(const std::vector<InputReport>& reports) {
+  fmt::print("{{\"stitch\": [");
+  for (std::size_t i = 0; i < reports.size(); ++i) {
+    const auto& r = reports[i];
+    std::string timings;
+    for (const auto& t : r.timings) {
+      timings += fmt::format(
+          "{}{{\"threads\": {}, \"stitch_ms\": {:.4f}, \"remap_ms\": {:.4f}, "
+          "\"ratio\": {:.4f}}}",
+          timings.empty() ? "" : ", ", t.threads, t.stitchMs, t.remapMs, t.stitchMs / t.remapMs);
+    }
+    const auto accuracy = [](const Accuracy& a) {
+      return fmt::format(
+          "{{\"seam_mean_px\": {:.4f}, \"seam_max_px\": {:.4f}, \"seam_samples\": "
+          "{}, \"ground_mae_levels\": {:.4f}}}",
+          a.seams.meanPx, a.seams.maxPx, a.seams.samples, a.groundError);
+    };
+    fmt::print(
+        "{}\n  {{\"input\": \"{}\", \"camera\": [{}, {}], \"panorama\": [{}, {}], "
+        "\"lut_build_s\": {:.4f}, \"lut_load_s\": {:.4f}, \"lut_bytes\": {}, "
+        "\"timings\": [{}], \"bowl\": {}, \"sphere\": {}}}",
+        i == 0 ? "" : ",", r.name, r.camera.width, r.camera.height, r.panorama.width,
+        r.panorama.height, r.lutBuildS, r.lutLoadS, r.lutBytes, timings, accuracy(r.bowl),
+        accuracy(r.sphere));
+  }
+  fmt::print("\n]}}\n");
+}
+
+}  // namespace
+
+int runStitchBenchmark(const StitchBenchmarkOptions& options) {
+  std::vector<InputReport> reports;
+  for (const auto& folder : options.recordings) {
+    if (!options.json) std::fprintf(stderr, "measuring %s ...\n", folder.string().c_str());
+    reports.push_back(measure(folder, options.threads, options.repeats));
+  }
+  if (options.json) {
+    printJson(reports);
+  } else {
+    printText(reports);
+  }
+  return 0;
+}
+
+}  // namespace surroundd::bench
