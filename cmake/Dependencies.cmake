@@ -7,3 +7,18 @@ find_package(spdlog REQUIRED)
 find_package(fmt REQUIRED)
 find_package(ZLIB REQUIRED)
 pkg_check_modules(FFMPEG REQUIRED IMPORTED_TARGET libavformat libavcodec libavutil libswscale)
+
+# SuiteSparse CHOLMOD (libsuitesparse-dev). SuiteSparse 7 installs a CMake config with this
+# target; Debian 12's 5.12 has neither that nor a pkg-config file, so look for it directly.
+find_package(CHOLMOD CONFIG QUIET)
+if(NOT TARGET SuiteSparse::CHOLMOD)
+  find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
+  find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
+  # cholmod.h includes SuiteSparse_config.h, whose symbols (the allocator hooks) live here.
+  find_library(SUITESPARSE_CONFIG_LIBRARY suitesparseconfig REQUIRED)
+  add_library(SuiteSparse::CHOLMOD UNKNOWN IMPORTED)
+  set_target_properties(SuiteSparse::CHOLMOD PROPERTIES
+    IMPORTED_LOCATION "${CHOLMOD_LIBRARY}"
+    INTERFACE_INCLUDE_DIRECTORIES "${CHOLMOD_INCLUDE_DIR}"
+    INTERFACE_LINK_LIBRARIES "${SUITESPARSE_CONFIG_LIBRARY}")
+endif()

@@ -14,6 +14,7 @@
 #include "capture/file_source.hpp"
 #include "daemon/rig_yaml.hpp"
 #include "processing/panorama_lut.hpp"
+#include "processing/poisson_solver.hpp"
 
 namespace surroundd::daemon {
 
@@ -49,7 +50,7 @@ struct PanoramaConfig {
 };
 
 enum class ColourMethod { kNone, kGain, kPoisson };
-enum class PoissonSolverKind { kAuto, kCholmod, kIterative, kRectangle };
+using processing::PoissonSolverKind;
 
 struct ColourCorrectionConfig {
   ColourMethod method = ColourMethod::kPoisson;

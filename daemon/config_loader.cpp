@@ -1,3 +1,4 @@
+#include <cmath>
 #include <set>
 
 #include <fmt/format.h>
@@ -187,6 +188,21 @@ Config loadConfig(const std::filesystem::path& file) {
   readSection("pipeline", [&](YamlObject& s) { readPipeline(s, config.pipeline); });
   readSection("panorama", [&](YamlObject& s) { readPanorama(s, config.panorama); });
   readSection("colour_correction", [&](YamlObject& s) { readColour(s, config.colour); });
+  // The correction field is solved on blocks of 1 / scale pixels, which must tile the panorama.
+  const double blocksPerPixel = 1 / config.colour.scale;
+  const auto block = std::lround(blocksPerPixel);
+  if (std::abs(blocksPerPixel - static_cast<double>(block)) > 1e-9 ||
+      config.panorama.widthPx % block != 0 || config.panorama.heightPx % block != 0) {
+    const auto message = fmt::format(
+        "colour_correction.scale must be 1/N with N dividing the panorama's {}x{} pixels (e.g. "
+        "0.25 or 0.125), got {:g}",
+        config.panorama.widthPx, config.panorama.heightPx, config.colour.scale);
+    if (auto section = root.object("colour_correction")) {
+      section->error("scale", message);
+    } else {
+      root.error("panorama", message);
+    }
+  }
   readSection("mesh", [&](YamlObject& s) { readMesh(s, config.mesh); });
   readSection("render", [&](YamlObject& s) { readRender(s, config.render); });
   std::set<std::filesystem::path> paths;

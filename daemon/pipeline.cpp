@@ -81,15 +81,35 @@ Pipeline::Pipeline(const Config& config)
     lut_ = std::make_unique<processing::PanoramaLut>(obtainPanoramaLut(config, pool_));
     stitcher_ = std::make_unique<processing::Stitcher>(*lut_, pool_);
     panorama_.create(lut_->size, CV_8UC3);
-    for (const auto& size : lut_->cameraSizes)
+    for (const auto& size : lut_->cameraSizes) {
       blackFrames_.emplace_back(size, CV_8UC3, cv::Scalar::all(0));
+    }
+    frames_.resize(cameras_.size());
     stitchInputs_.resize(cameras_.size());
+    setUpColourCorrection(config);
   }
   const double nominalFps = 1e9 / static_cast<double>(cameras_.front()->nominalPeriod().count());
   for (const auto& output : config.outputs) {
     const cv::Size size =
         output.stream == OutputStream::kPanorama ? lut_->size : mosaic_.outputSize();
     outputs_.push_back({output.stream, openSink(output, size, nominalFps)});
+  }
+}
+
+void Pipeline::setUpColourCorrection(const Config& config) {
+  const processing::Rig rig = rigOf(config);
+  if (config.colour.method == ColourMethod::kGain) {
+    gains_ = std::make_unique<processing::GainCompensation>(*lut_, pool_);
+    spdlog::info("colour correction: global gain compensation");
+  } else if (config.colour.method == ColourMethod::kPoisson) {
+    const processing::ColourCorrectionSettings settings{config.colour.scale, config.colour.solver,
+                                                        config.colour.tolerance,
+                                                        config.colour.temporalSmoothing};
+    poisson_ = std::make_unique<processing::PoissonColourCorrection>(rig, panoramaSettings(config),
+                                                                     *lut_, settings, pool_);
+    for (const auto& note : poisson_->notes()) spdlog::warn("colour correction: {}", note);
+    spdlog::info("colour correction: Poisson, {} region(s) at scale {:g}, solver {}",
+                 poisson_->domain().regions.size(), config.colour.scale, poisson_->solverNames());
   }
 }
 
@@ -149,9 +169,17 @@ void Pipeline::render(const capture::FrameSet& set) {
   if (wantMosaic_) mosaic_.compose(std::span(images.data(), set.cameraCount), canvas_);
   if (stitcher_) {
     for (std::size_t c = 0; c < set.cameraCount; ++c) {
+      frames_[c] = images[c] != nullptr ? *images[c] : cv::Mat();
       stitchInputs_[c] = images[c] != nullptr ? *images[c] : blackFrames_[c];
     }
     stitcher_->stitch(stitchInputs_, panorama_);
+    if (poisson_) {
+      poisson_->update(frames_);
+      poisson_->apply(panorama_);
+    } else if (gains_) {
+      gains_->update(frames_);
+      gains_->apply(panorama_);
+    }
   }
   if (!firstTimestamp_) firstTimestamp_ = set.timestamp;
   const auto streamTime = set.timestamp - *firstTimestamp_;

@@ -2,7 +2,8 @@
 // The replay pipeline as it stands: cameras -> synchronizer -> mosaic and/or panorama -> outputs.
 //
 // One capture thread per camera (CameraStream); this thread synchronizes, composes the mosaic,
-// stitches the panorama (on the work pool, only when an output shows it) and feeds the outputs.
+// stitches and colour-corrects the panorama (on the work pool, only when an output shows it) and
+// feeds the outputs.
 // Construction opens every source and output and throws (CaptureError, EncoderError,
 // std::runtime_error) with a message naming the camera or file; run() does not throw for faults of
 // single cameras or outputs: a failing camera ends its stream, a failing output is logged and
@@ -19,6 +20,8 @@
 #include "capture/synchronizer.hpp"
 #include "common/work_pool.hpp"
 #include "daemon/config.hpp"
+#include "processing/gain_compensation.hpp"
+#include "processing/poisson_correction.hpp"
 #include "processing/stitcher.hpp"
 #include "render/frame_sink.hpp"
 #include "render/mosaic.hpp"
@@ -59,6 +62,7 @@ class Pipeline {
     std::unique_ptr<render::FrameSink> sink;  // null once it failed
   };
   const cv::Mat& imageOf(OutputStream stream) const;
+  void setUpColourCorrection(const Config& config);
 
   std::vector<std::unique_ptr<capture::CameraStream>> cameras_;
   capture::Synchronizer synchronizer_;
@@ -67,8 +71,11 @@ class Pipeline {
   cv::Mat canvas_;                                  // the composed mosaic; reused for every set
   std::unique_ptr<processing::PanoramaLut> lut_;    // set when an output shows the panorama
   std::unique_ptr<processing::Stitcher> stitcher_;  // borrows *lut_ and pool_
-  std::vector<cv::Mat> stitchInputs_;  // this set's images (headers only), one per camera
-  std::vector<cv::Mat> blackFrames_;   // stand in for a camera missing from a set
+  std::unique_ptr<processing::PoissonColourCorrection> poisson_;  // colour_correction: poisson
+  std::unique_ptr<processing::GainCompensation> gains_;           // colour_correction: gain
+  std::vector<cv::Mat> frames_;        // this set's images (headers only); empty where missing
+  std::vector<cv::Mat> stitchInputs_;  // the same, with black frames for missing cameras
+  std::vector<cv::Mat> blackFrames_;
   cv::Mat panorama_;
   bool wantMosaic_ = false;
   std::vector<Output> outputs_;

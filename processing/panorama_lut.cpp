@@ -70,6 +70,8 @@ std::vector<ColumnPlan> planColumns(const PanoramaProjector& projector) {
   return columns;
 }
 
+}  // namespace
+
 LutTap encodeTap(const cv::Point2d& p, cv::Size size, std::uint8_t camera) {
   constexpr int kOne = LutTap::kFractionOne;
   // The 2x2 neighbourhood must stay inside the image: at the last column or row, interpolate
@@ -83,8 +85,6 @@ LutTap encodeTap(const cv::Point2d& p, cv::Size size, std::uint8_t camera) {
   return {static_cast<std::uint32_t>(y0 * size.width + x0), static_cast<std::uint8_t>(fx),
           static_cast<std::uint8_t>(fy), camera, 0};
 }
-
-}  // namespace
 
 PanoramaProjector::PanoramaProjector(const Rig& rig, const PanoramaSettings& settings)
     : settings_(settings) {

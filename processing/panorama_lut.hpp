@@ -63,6 +63,9 @@ struct LutTap {
 };
 static_assert(sizeof(LutTap) == 8);
 
+// The tap that samples a camera image of `size` at sub-pixel `p` (inside the image).
+LutTap encodeTap(const cv::Point2d& p, cv::Size size, std::uint8_t camera);
+
 struct BlendTap {
   std::uint32_t pixel = 0;  // row * width + column
   LutTap tap;

@@ -7,6 +7,7 @@ PACKAGES="
   build-essential cmake pkg-config
   libopencv-dev libyaml-cpp-dev libspdlog-dev libfmt-dev zlib1g-dev
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
+  libsuitesparse-dev
   libgtest-dev libgmock-dev
 "
 

@@ -12,6 +12,7 @@
 #include "common/work_pool.hpp"
 #include "daemon/panorama_setup.hpp"
 #include "daemon/rig_yaml.hpp"
+#include "processing/poisson_correction.hpp"
 #include "processing/stitcher.hpp"
 #include "render/mosaic.hpp"
 #include "tests/support/child_process.hpp"
@@ -73,8 +74,8 @@ TEST(EndToEnd, MosaicVideoMatchesTheSourceFrames) {
   EXPECT_THAT(surroundd.output(), HasSubstr("wrote video"));
 }
 
-// The panorama output: the video shows the stitch of the source frames; the LUT is built on the
-// first run, loaded on the next, and rebuilt when its cache file is damaged.
+// The panorama output: the video shows the colour-corrected stitch of the source frames; the LUT is
+// built on the first run, loaded on the next, and rebuilt when its cache file is damaged.
 TEST(EndToEnd, PanoramaVideoMatchesTheStitchedSourceFramesAndTheLutIsCached) {
   const testing::TempDir dir;
   const auto config = dir.write("config.yaml", fmt::format(R"(rig: {{file: {}}}
@@ -113,6 +114,12 @@ outputs:
     std::vector<cv::Mat> frames;
     for (const auto& camera : sources) frames.push_back(camera[k]);
     stitcher.stitch(frames, expected);
+    // The config's default colour correction (Poisson), solved for this frame on its own.
+    processing::PoissonColourCorrection correction(
+        daemon::rigOf(loaded), daemon::panoramaSettings(loaded), lut,
+        {loaded.colour.scale, loaded.colour.solver, loaded.colour.tolerance, 0.0}, pool);
+    correction.update(frames);
+    correction.apply(expected);
     EXPECT_GE(cv::PSNR(expected, video[k]), 35.0) << "frame " << k;
   }
   EXPECT_EQ(cv::imread((dir / "out/panorama.png").string()).size(), lut.size);

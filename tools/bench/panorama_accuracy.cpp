@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <opencv2/imgproc.hpp>
+
 #include "processing/camera_model.hpp"
 
 namespace surroundd::bench {
@@ -76,6 +78,105 @@ cv::Mat trueGroundMask(const synth::Scene& scene, const synth::VehiclePose& pose
     }
   }
   return mask;
+}
+
+double seamColourStep(const cv::Mat& panorama, const processing::PanoramaLut& lut,
+                      double featherRad, const cv::Mat& mask, int window) {
+  const int width = lut.size.width;
+  const cv::Mat owner = lut.ownerMap();
+  const cv::Mat valid = lut.validMask() & mask;
+  const int gap = static_cast<int>(std::ceil(featherRad / 2 * width / (2 * CV_PI))) + 1;
+  // Seam columns: where the owner along the row that most cameras see changes.
+  const cv::Mat anySeen = lut.validMask();
+  int bestRow = 0;
+  for (int v = 0; v < lut.size.height; ++v) {
+    if (cv::countNonZero(anySeen.row(v)) > cv::countNonZero(anySeen.row(bestRow))) bestRow = v;
+  }
+  std::vector<int> seams;
+  for (int u = 0; u < width; ++u) {
+    if (owner.at<std::uint8_t>(bestRow, u) != owner.at<std::uint8_t>(bestRow, (u + 1) % width)) {
+      seams.push_back(u + 1);
+    }
+  }
+  double sum = 0;
+  int bands = 0;
+  for (const int seam : seams) {
+    for (int top = 0; top + window <= lut.size.height; top += window) {
+      cv::Vec3d sides[2];
+      bool seen = true;
+      for (int side = 0; side < 2 && seen; ++side) {
+        const int first = side == 0 ? seam - gap - window : seam + gap;
+        for (int v = top; v < top + window && seen; ++v) {
+          for (int k = 0; k < window; ++k) {
+            const int u = (first + k + width) % width;
+            if (valid.at<std::uint8_t>(v, u) == 0) {
+              seen = false;
+              break;
+            }
+            sides[side] += cv::Vec3d(panorama.at<cv::Vec3b>(v, u));
+          }
+        }
+      }
+      if (!seen) continue;
+      const cv::Vec3d step = (sides[0] - sides[1]) / (window * window);
+      sum += (std::abs(step[0]) + std::abs(step[1]) + std::abs(step[2])) / 3;
+      ++bands;
+    }
+  }
+  return bands > 0 ? sum / bands : 0;
+}
+
+double seamColourError(const cv::Mat& panorama, const std::vector<cv::Mat>& frames,
+                       const processing::Rig& rig, const processing::PanoramaSettings& settings,
+                       const processing::PanoramaLut& lut, const cv::Mat& mask, int window,
+                       int reach) {
+  const processing::PanoramaProjector projector(rig, settings);
+  double sum = 0;
+  int tiles = 0;
+  for (int top = 0; top + window <= lut.size.height; top += window) {
+    for (int left = 0; left + window <= lut.size.width; left += window) {
+      const std::uint8_t source =
+          lut.taps[static_cast<std::size_t>(top) * lut.size.width + left].camera;
+      if (source == processing::PanoramaLut::kUnseen ||
+          rig.cameras[source].role != processing::ColourRole::kSource) {
+        continue;
+      }
+      const auto ownerAt = [&](int u) {
+        return lut
+            .taps[static_cast<std::size_t>(top) * lut.size.width +
+                  static_cast<std::size_t>((u + lut.size.width) % lut.size.width)]
+            .camera;
+      };
+      for (std::size_t target = 0; target < rig.cameras.size(); ++target) {
+        if (rig.cameras[target].role != processing::ColourRole::kTarget) continue;
+        // Near a seam with this target: it owns a pixel within reach on either side.
+        if (ownerAt(left - reach) != target && ownerAt(left + window - 1 + reach) != target) {
+          continue;
+        }
+        cv::Vec3d panoramaSum;
+        cv::Vec3d targetSum;
+        bool inside = true;
+        for (int v = top; v < top + window && inside; ++v) {
+          for (int u = left; u < left + window && inside; ++u) {
+            const auto at =
+                projector.cameraPixel(target, {static_cast<double>(u), static_cast<double>(v)});
+            inside = at.has_value() && mask.at<std::uint8_t>(v, u) != 0 &&
+                     lut.taps[static_cast<std::size_t>(v) * lut.size.width + u].camera == source;
+            if (!inside) break;
+            cv::Mat sample;
+            cv::getRectSubPix(frames[target], {1, 1}, cv::Point2f(*at), sample);
+            targetSum += cv::Vec3d(sample.at<cv::Vec3b>(0, 0));
+            panoramaSum += cv::Vec3d(panorama.at<cv::Vec3b>(v, u));
+          }
+        }
+        if (!inside) continue;
+        const cv::Vec3d difference = (panoramaSum - targetSum) / (window * window);
+        sum += (std::abs(difference[0]) + std::abs(difference[1]) + std::abs(difference[2])) / 3;
+        ++tiles;
+      }
+    }
+  }
+  return tiles > 0 ? sum / tiles : 0;
 }
 
 double meanAbsoluteError(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {

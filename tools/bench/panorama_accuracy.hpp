@@ -31,6 +31,26 @@ SeamAlignment measureGroundSeams(const processing::Rig& rig,
 cv::Mat trueGroundMask(const synth::Scene& scene, const synth::VehiclePose& pose,
                        const processing::PanoramaSettings& settings);
 
+// The colour step across the seams of a panorama, 8-bit levels: at each seam (the bisector
+// columns of the LUT, where the primary camera changes) and every band of `window` rows that lies
+// inside `mask` (CV_8U; e.g. the true ground, where the two cameras see the same thing) on both
+// sides, the mean colours of two `window`-wide column strips just outside the blend band, one on
+// each side, are compared; the result is the mean absolute difference over bands and channels.
+// Scene detail averages out over the strips; what remains is the cameras' disagreement.
+double seamColourStep(const cv::Mat& panorama, const processing::PanoramaLut& lut,
+                      double featherRad, const cv::Mat& mask, int window = 8);
+
+// The colour mismatch across the seams, 8-bit levels: over every `window` x `window` tile of the
+// panorama that a source camera owns within `reach` pixels of a seam with a target camera, that
+// the target camera sees too and that lies in `mask` (the true ground: the same surface for
+// both), the mean colour of the panorama against the mean of the target camera's own samples;
+// the mean absolute difference over tiles and channels. Tiles average the sensor noise away; what
+// remains is the step a viewer sees at the seam.
+double seamColourError(const cv::Mat& panorama, const std::vector<cv::Mat>& frames,
+                       const processing::Rig& rig, const processing::PanoramaSettings& settings,
+                       const processing::PanoramaLut& lut, const cv::Mat& mask, int window = 4,
+                       int reach = 12);
+
 // Mean absolute difference over the mask and the channels, 8-bit levels.
 double meanAbsoluteError(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask);
 

@@ -1,0 +1,69 @@
+#pragma once
+// Where Poisson local colour correction works, built once from the rig and the panorama LUT.
+//
+// The panorama is divided into blocks of `block` x `block` pixels (scale = 1 / block), each owned
+// by the camera that owns its centre pixel. Each connected set of blocks owned by one source
+// camera is a region with its own PoissonSystem. A block across a 4-neighbour border that a
+// target camera owns, and that the source camera sees too, is a Dirichlet block: its value is the
+// mean of (target - source) over the block's pixels that both cameras see, sampled through taps
+// built here. Every other border is Neumann. A region with no Dirichlet block cannot be corrected
+// (nothing to match) and is left out, with a note saying so.
+//
+// For applying the fields: `share` gives each panorama pixel the weight of source cameras in it
+// (1 inside a source region, the blend weight in the seam bands), and `fillFrom` says which field
+// value each block shows, extended two blocks past every region so that bicubic upsampling has
+// data on both sides of its border.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "processing/panorama_lut.hpp"
+#include "processing/poisson_system.hpp"
+
+namespace surroundd::processing {
+
+struct SeamSample {
+  LutTap target;
+  LutTap source;
+};
+
+struct DirichletBlock {
+  int block = 0;                                 // index in the block grid
+  std::uint8_t target = 0;                       // the camera across the seam
+  std::uint32_t firstSample = 0, endSample = 0;  // range in CorrectionDomain::samples
+};
+
+struct CorrectionRegion {
+  std::uint8_t source = 0;
+  PoissonSystem system;
+  std::vector<int> blockOfUnknown;
+  std::vector<DirichletBlock> dirichlet;
+  // Per unknown, its Dirichlet neighbours: dirichletOf[dirichletBegin[i] .. dirichletBegin[i+1]).
+  std::vector<std::uint32_t> dirichletBegin;
+  std::vector<std::uint32_t> dirichletOf;
+};
+
+struct CorrectionDomain {
+  int block = 4;
+  cv::Size grid;  // blocks; columns wrap around like the panorama's
+  std::vector<CorrectionRegion> regions;
+  std::vector<SeamSample> samples;
+  // Field slots: the unknowns of every region, in order, then their Dirichlet blocks.
+  std::size_t slots = 0;
+  std::vector<std::uint32_t> firstUnknownSlot;    // per region
+  std::vector<std::uint32_t> firstDirichletSlot;  // per region
+  std::vector<int> fillFrom;         // per block: the slot it shows, or -1 (no correction)
+  std::vector<std::uint16_t> share;  // per panorama pixel: source weight, 0..256
+  std::vector<bool> sourceCameras;   // per camera: a source (corrected) or a target
+  std::vector<std::string> notes;    // what was left out and why, for the log
+};
+
+// Throws std::invalid_argument for a scale that does not divide the panorama into whole blocks
+// of at least 2 pixels.
+CorrectionDomain buildCorrectionDomain(const Rig& rig, const PanoramaSettings& settings,
+                                       const PanoramaLut& lut, double scale);
+
+}  // namespace surroundd::processing

@@ -1,0 +1,127 @@
+#include "processing/intrinsic_calibration.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <fmt/format.h>
+#include <opencv2/calib3d.hpp>
+
+namespace surroundd::processing {
+namespace {
+
+// Both solvers run until a step changes nothing in double precision (or 200 iterations): a solve
+// takes milliseconds, and stopping early would leave error that the corners do not have.
+cv::TermCriteria solverCriteria() {
+  return {cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 200,
+          std::numeric_limits<double>::epsilon()};
+}
+
+ViewResiduals residualsOf(const CameraModel& model, const BoardView& view,
+                          const std::vector<cv::Point3f>& pattern, const cv::Vec3d& rvec,
+                          const cv::Vec3d& tvec) {
+  ViewResiduals out;
+  out.name = view.name;
+  cv::Rodrigues(rvec, out.boardInCamera.rotation);
+  out.boardInCamera.position = tvec;
+  out.corners = view.corners;
+  double sumSquares = 0;
+  for (std::size_t i = 0; i < pattern.size(); ++i) {
+    const auto pixel =
+        model.project(out.boardInCamera.toVehicle({pattern[i].x, pattern[i].y, pattern[i].z}));
+    // A corner the solved model cannot see at all is as wrong as it gets; report it as such.
+    const cv::Point2f residual = pixel ? cv::Point2f(*pixel) - view.corners[i]
+                                       : cv::Point2f(std::numeric_limits<float>::infinity(), 0.0f);
+    out.residuals.push_back(residual);
+    sumSquares += residual.dot(residual);
+  }
+  out.rmsPx = std::sqrt(sumSquares / static_cast<double>(pattern.size()));
+  return out;
+}
+
+}  // namespace
+
+IntrinsicCalibration calibrateIntrinsics(LensModel model, cv::Size imageSize,
+                                         const Checkerboard& board,
+                                         std::span<const BoardView> views) {
+  if (static_cast<int>(views.size()) < kMinimumBoardViews) {
+    throw CalibrationError(
+        fmt::format("too few views: a board was found in {} image{}, at least "
+                    "{} are needed (from different angles and field positions)",
+                    views.size(), views.size() == 1 ? "" : "s", kMinimumBoardViews));
+  }
+  const auto pattern = board.patternCorners();
+  const std::vector<std::vector<cv::Point3f>> objectPoints(views.size(), pattern);
+  std::vector<std::vector<cv::Point2f>> imagePoints;
+  for (const auto& view : views) imagePoints.push_back(view.corners);
+
+  Intrinsics in;
+  in.model = model;
+  in.imageSize = imageSize;
+  std::vector<cv::Vec3d> rvecs, tvecs;
+  try {
+    if (model == LensModel::kPinhole) {
+      cv::Matx33d k;
+      cv::Mat d;
+      cv::calibrateCamera(objectPoints, imagePoints, imageSize, k, d, rvecs, tvecs, 0,
+                          solverCriteria());
+      for (int i = 0; i < 5; ++i) in.distortion[static_cast<std::size_t>(i)] = d.at<double>(i);
+      in.fx = k(0, 0), in.fy = k(1, 1), in.cx = k(0, 2), in.cy = k(1, 2);
+    } else {
+      cv::Matx33d k;
+      cv::Vec4d d;
+      cv::fisheye::calibrate(objectPoints, imagePoints, imageSize, k, d, rvecs, tvecs,
+                             cv::fisheye::CALIB_RECOMPUTE_EXTRINSIC | cv::fisheye::CALIB_FIX_SKEW,
+                             solverCriteria());
+      for (int i = 0; i < 4; ++i) in.distortion[static_cast<std::size_t>(i)] = d[i];
+      in.fx = k(0, 0), in.fy = k(1, 1), in.cx = k(0, 2), in.cy = k(1, 2);
+      // As wide as the polynomial stays monotonic; widestLitFieldAngle() narrows it to the lens.
+      in.maxFieldAngleRad = std::numbers::pi;
+    }
+  } catch (const cv::Exception& error) {
+    throw CalibrationError(fmt::format("the solver failed: {}", error.err));
+  }
+  const CameraModel camera(in);
+  IntrinsicCalibration result;
+  result.intrinsics = camera.intrinsics();
+  double sumSquares = 0;
+  std::size_t count = 0;
+  for (std::size_t v = 0; v < views.size(); ++v) {
+    result.views.push_back(residualsOf(camera, views[v], pattern, rvecs[v], tvecs[v]));
+    for (const auto& r : result.views.back().residuals) sumSquares += r.dot(r);
+    count += pattern.size();
+  }
+  result.rmsPx = std::sqrt(sumSquares / static_cast<double>(count));
+  if (!std::isfinite(result.rmsPx) || in.fx <= 0 || in.fy <= 0) {
+    throw CalibrationError(fmt::format(
+        "the solver did not converge (RMS {:.3g} px, fx {:.4g}, fy {:.4g}); give more views "
+        "with the board tilted and spread over the whole image",
+        result.rmsPx, in.fx, in.fy));
+  }
+  return result;
+}
+
+double widestLitFieldAngle(const Intrinsics& intrinsics, const cv::Mat& litMask) {
+  // The field angle grows with the normalized radius, so the farthest lit pixel decides.
+  const CameraModel model(intrinsics);
+  double farthest = -1;
+  cv::Point2d pixel;
+  for (int y = 0; y < litMask.rows; ++y) {
+    const auto* lit = litMask.ptr<std::uint8_t>(y);
+    for (int x = 0; x < litMask.cols; ++x) {
+      if (lit[x] == 0) continue;
+      const double r =
+          std::hypot((x - intrinsics.cx) / intrinsics.fx, (y - intrinsics.cy) / intrinsics.fy);
+      if (r > farthest) {
+        farthest = r;
+        pixel = {static_cast<double>(x), static_cast<double>(y)};
+      }
+    }
+  }
+  if (farthest < 0) return model.intrinsics().maxFieldAngleRad;
+  const auto ray = model.unproject(pixel);
+  return ray ? std::acos(std::clamp((*ray)[2], -1.0, 1.0)) : model.intrinsics().maxFieldAngleRad;
+}
+
+}  // namespace surroundd::processing

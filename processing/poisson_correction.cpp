@@ -1,0 +1,213 @@
+#include "processing/poisson_correction.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "common/work_pool.hpp"
+#include "processing/bilinear_sample.hpp"
+
+namespace surroundd::processing {
+namespace {
+
+// Catmull-Rom cubic (OpenCV's INTER_CUBIC uses a sharper -0.75; -0.5 does not overshoot as much
+// on the steps a correction field has at the seams).
+std::array<float, 4> catmullRom(double t) {
+  const double t2 = t * t;
+  const double t3 = t2 * t;
+  return {static_cast<float>((-t3 + 2 * t2 - t) / 2), static_cast<float>((3 * t3 - 5 * t2 + 2) / 2),
+          static_cast<float>((-3 * t3 + 4 * t2 + t) / 2), static_cast<float>((t3 - t2) / 2)};
+}
+
+// Where the four bicubic taps of sub-block phase r start, relative to the block index: pixel
+// centre (k * block + r + 0.5) lies at block coordinate k + (r + 0.5) / block - 0.5.
+int firstTapOffset(int r, int block) {
+  return static_cast<int>(std::floor((r + 0.5) / block - 0.5)) - 1;
+}
+
+}  // namespace
+
+struct PoissonColourCorrection::RegionState {
+  std::unique_ptr<PoissonSolver> solver;
+  std::vector<float> dirichlet;  // 3 per Dirichlet block: target - source, levels
+  std::vector<float> rhs;
+  std::vector<float> solution;  // 3 per unknown; the warm start of the next frame
+  int iterations = 0;
+};
+
+PoissonColourCorrection::PoissonColourCorrection(const Rig& rig, const PanoramaSettings& panorama,
+                                                 const PanoramaLut& lut,
+                                                 const ColourCorrectionSettings& settings,
+                                                 WorkPool& pool)
+    : lut_(lut),
+      pool_(pool),
+      settings_(settings),
+      domain_(buildCorrectionDomain(rig, panorama, lut, settings.scale)) {
+  for (const auto& region : domain_.regions) {
+    RegionState state;
+    state.solver = makePoissonSolver(settings.solver, region.system, settings.tolerance);
+    state.dirichlet.assign(region.dirichlet.size() * 3, 0.0f);
+    state.rhs.assign(region.system.unknowns() * 3, 0.0f);
+    state.solution.assign(region.system.unknowns() * 3, 0.0f);
+    regions_.push_back(std::move(state));
+  }
+  slots_.assign(domain_.slots * 3, 0.0f);
+  field_.create(domain_.grid, CV_32FC3);
+  field_.setTo(cv::Scalar::all(0));
+  for (int r = 0; r < domain_.block; ++r) {
+    const double t = (r + 0.5) / domain_.block - 0.5;
+    phaseWeights_.push_back(catmullRom(t - std::floor(t)));
+  }
+  rowBuffers_.assign(
+      static_cast<std::size_t>(pool.threads()) * 4,
+      std::vector<float>(static_cast<std::size_t>(domain_.grid.width + 2 * kPad) * 3));
+  for (int u = 0; u < lut.size.width; ++u) {
+    columnTap_.push_back(u / domain_.block + firstTapOffset(u % domain_.block, domain_.block));
+  }
+  for (int v = 0; v < lut.size.height; ++v) {
+    const auto* share = domain_.share.data() + static_cast<std::size_t>(v) * lut.size.width;
+    rowHasShare_.push_back(
+        std::any_of(share, share + lut.size.width, [](std::uint16_t w) { return w != 0; }));
+  }
+}
+
+PoissonColourCorrection::~PoissonColourCorrection() = default;
+
+std::string PoissonColourCorrection::solverNames() const {
+  std::string names;
+  for (const auto& region : regions_) {
+    names += fmt::format("{}{}", names.empty() ? "" : ", ", region.solver->name());
+  }
+  return names;
+}
+
+void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames) {
+  const float keep = firstFrame_ ? 0.0f : static_cast<float>(settings_.temporalSmoothing);
+  for (std::size_t r = 0; r < regions_.size(); ++r) {
+    const CorrectionRegion& region = domain_.regions[r];
+    RegionState& state = regions_[r];
+    const cv::Mat& source = frames[region.source];
+    for (std::size_t k = 0; k < region.dirichlet.size(); ++k) {
+      const DirichletBlock& d = region.dirichlet[k];
+      const cv::Mat& target = frames[d.target];
+      if (source.empty() || target.empty()) continue;  // hold the last value
+      float sum[3] = {0, 0, 0};
+      for (auto s = d.firstSample; s < d.endSample; ++s) {
+        const SeamSample& sample = domain_.samples[s];
+        const std::uint32_t t = bilinear(target.data, target.step, sample.target);
+        const std::uint32_t o = bilinear(source.data, source.step, sample.source);
+        for (int c = 0; c < 3; ++c) {
+          sum[c] += static_cast<float>(static_cast<int>((t >> (8 * c)) & 0xffU) -
+                                       static_cast<int>((o >> (8 * c)) & 0xffU));
+        }
+      }
+      const auto count = static_cast<float>(d.endSample - d.firstSample);
+      for (int c = 0; c < 3; ++c) {
+        float& value = state.dirichlet[k * 3 + c];
+        value = keep * value + (1 - keep) * sum[c] / count;
+      }
+    }
+  }
+  firstFrame_ = false;
+}
+
+int PoissonColourCorrection::update(std::span<const cv::Mat> frames) {
+  gatherSeams(frames);
+  pool_.parallelFor(
+      static_cast<int>(regions_.size()),
+      [&](int first, int last) {
+        for (int r = first; r < last; ++r) {
+          const CorrectionRegion& region = domain_.regions[static_cast<std::size_t>(r)];
+          RegionState& state = regions_[static_cast<std::size_t>(r)];
+          for (std::size_t i = 0; i < region.system.unknowns(); ++i) {
+            float sum[3] = {0, 0, 0};
+            for (auto k = region.dirichletBegin[i]; k < region.dirichletBegin[i + 1]; ++k) {
+              for (int c = 0; c < 3; ++c) sum[c] += state.dirichlet[region.dirichletOf[k] * 3 + c];
+            }
+            for (int c = 0; c < 3; ++c) state.rhs[i * 3 + c] = sum[c];
+          }
+          state.iterations = state.solver->solve(state.rhs, state.solution).iterations;
+        }
+      },
+      static_cast<int>(regions_.size()));
+
+  int iterations = 0;
+  for (std::size_t r = 0; r < regions_.size(); ++r) {
+    const RegionState& state = regions_[r];
+    std::copy(state.solution.begin(), state.solution.end(),
+              slots_.begin() + domain_.firstUnknownSlot[r] * 3);
+    std::copy(state.dirichlet.begin(), state.dirichlet.end(),
+              slots_.begin() + domain_.firstDirichletSlot[r] * 3);
+    iterations += state.iterations;
+  }
+  auto* field = field_.ptr<float>();
+  for (std::size_t b = 0; b < domain_.fillFrom.size(); ++b) {
+    const int slot = domain_.fillFrom[b];
+    for (int c = 0; c < 3; ++c) {
+      field[b * 3 + c] = slot < 0 ? 0.0f : slots_[static_cast<std::size_t>(slot) * 3 + c];
+    }
+  }
+  return iterations;
+}
+
+void PoissonColourCorrection::apply(cv::Mat& panorama) {
+  const int chunks = static_cast<int>(rowBuffers_.size());
+  pool_.parallelFor(
+      chunks,
+      [&](int firstChunk, int lastChunk) {
+        for (int chunk = firstChunk; chunk < lastChunk; ++chunk) {
+          const int height = lut_.size.height;
+          applyRows(height * chunk / chunks, height * (chunk + 1) / chunks, panorama,
+                    rowBuffers_[static_cast<std::size_t>(chunk)]);
+        }
+      },
+      chunks);
+}
+
+void PoissonColourCorrection::applyRows(int first, int last, cv::Mat& panorama,
+                                        std::vector<float>& columnBuffer) const {
+  const int block = domain_.block;
+  const int gridWidth = domain_.grid.width;
+  const int gridHeight = domain_.grid.height;
+  const int width = lut_.size.width;
+  // The row at block resolution, with kPad wrapped-around blocks on each side so that the
+  // horizontal taps need no modulo.
+  float* column = columnBuffer.data() + static_cast<std::size_t>(kPad) * 3;
+  for (int v = first; v < last; ++v) {
+    const std::uint16_t* share = domain_.share.data() + static_cast<std::size_t>(v) * width;
+    if (!rowHasShare_[static_cast<std::size_t>(v)]) continue;
+    // Vertical pass: the field interpolated to this row.
+    const auto& wy = phaseWeights_[static_cast<std::size_t>(v % block)];
+    const int firstRow = v / block + firstTapOffset(v % block, block);
+    const float* rows[4];
+    for (int j = 0; j < 4; ++j) {
+      rows[j] = field_.ptr<float>(std::clamp(firstRow + j, 0, gridHeight - 1));
+    }
+    for (int x = 0; x < gridWidth * 3; ++x) {
+      column[x] = wy[0] * rows[0][x] + wy[1] * rows[1][x] + wy[2] * rows[2][x] + wy[3] * rows[3][x];
+    }
+    for (int x = 0; x < kPad * 3; ++x) {
+      column[-kPad * 3 + x] = column[(gridWidth - kPad) * 3 + x];
+      column[gridWidth * 3 + x] = column[x];
+    }
+    // Horizontal pass where a source camera contributes.
+    auto* out = panorama.ptr<std::uint8_t>(v);
+    for (int u = 0; u < width; ++u) {
+      if (share[u] == 0) continue;
+      const auto& wx = phaseWeights_[static_cast<std::size_t>(u % block)];
+      const float* tap =
+          column + static_cast<std::ptrdiff_t>(columnTap_[static_cast<std::size_t>(u)]) * 3;
+      const float weight = share[u] * (1.0f / 256);
+      std::uint8_t* pixel = out + static_cast<std::size_t>(u) * 3;
+      for (int c = 0; c < 3; ++c) {
+        const float value =
+            wx[0] * tap[c] + wx[1] * tap[3 + c] + wx[2] * tap[6 + c] + wx[3] * tap[9 + c];
+        const float corrected = std::clamp(pixel[c] + weight * value, 0.0f, 255.0f);
+        pixel[c] = static_cast<std::uint8_t>(corrected + 0.5f);  // non-negative: truncation rounds
+      }
+    }
+  }
+}
+
+}  // namespace surroundd::processing

@@ -1,0 +1,83 @@
+#pragma once
+// Poisson local colour correction (DESIGN.md §2.3, the paper's §2.3): per frame, each source
+// camera's region of the panorama gets a smooth correction field that takes its colours to the
+// target cameras' across every seam, solved at a reduced scale and added to the stitched
+// panorama after bicubic upsampling. Target cameras are left as they are.
+//
+// Set up once (domain, systems, solver factorizations, buffers); update() and apply() are the
+// per-frame calls and allocate nothing. A camera missing from a frame set leaves the seams it
+// shares at their last values (its region, if a source, shows no picture anyway).
+
+#include <array>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "processing/correction_domain.hpp"
+#include "processing/poisson_solver.hpp"
+
+namespace surroundd {
+class WorkPool;
+}
+
+namespace surroundd::processing {
+
+struct ColourCorrectionSettings {
+  double scale = 0.25;  // the field's resolution against the panorama's (1 / block size)
+  PoissonSolverKind solver = PoissonSolverKind::kAuto;
+  double tolerance = 1e-3;         // iterative solvers: relative residual
+  double temporalSmoothing = 0.0;  // weight of the previous frame's seam data, 0..0.99
+};
+
+class PoissonColourCorrection {
+ public:
+  // Borrows the LUT and the pool; both must outlive this object. Throws std::invalid_argument for
+  // a scale that does not fit the panorama.
+  PoissonColourCorrection(const Rig& rig, const PanoramaSettings& panorama, const PanoramaLut& lut,
+                          const ColourCorrectionSettings& settings, WorkPool& pool);
+  ~PoissonColourCorrection();
+  PoissonColourCorrection(const PoissonColourCorrection&) = delete;
+  PoissonColourCorrection& operator=(const PoissonColourCorrection&) = delete;
+
+  // Things left out at set-up (regions without a seam to a target), to be logged once.
+  const std::vector<std::string>& notes() const { return domain_.notes; }
+  const CorrectionDomain& domain() const { return domain_; }
+  std::string solverNames() const;
+
+  // Solves this frame's fields from the camera images (an empty Mat: that camera is missing).
+  // Returns the solvers' iterations, summed over regions (0 for direct solvers).
+  int update(std::span<const cv::Mat> frames);
+
+  // Adds the fields to a panorama stitched from the same frames (8-bit BGR of the LUT's size).
+  void apply(cv::Mat& panorama);
+
+  // The field at block resolution, CV_32FC3, 8-bit levels (0 outside the regions' reach).
+  const cv::Mat& field() const { return field_; }
+
+ private:
+  struct RegionState;
+  void gatherSeams(std::span<const cv::Mat> frames);
+  void applyRows(int first, int last, cv::Mat& panorama, std::vector<float>& columnBuffer) const;
+
+  const PanoramaLut& lut_;
+  WorkPool& pool_;
+  ColourCorrectionSettings settings_;
+  CorrectionDomain domain_;
+  std::vector<RegionState> regions_;
+  bool firstFrame_ = true;
+  std::vector<float> slots_;  // 3 values per field slot
+  cv::Mat field_;
+  // Upsampling: bicubic weights for each sub-block phase (Catmull-Rom), each pixel column's first
+  // tap (in blocks, -2..width), the rows that have anything to correct, and one row buffer per
+  // work chunk.
+  static constexpr int kPad = 3;
+  std::vector<std::array<float, 4>> phaseWeights_;
+  std::vector<int> columnTap_;
+  std::vector<bool> rowHasShare_;
+  std::vector<std::vector<float>> rowBuffers_;
+};
+
+}  // namespace surroundd::processing

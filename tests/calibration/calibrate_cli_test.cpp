@@ -1,0 +1,322 @@
+// surround-calibrate as a user runs it: images and YAML files in, lens: and mount: blocks that the
+// rig reader accepts out, within the accuracy asked of calibration; and for every kind of bad input
+// a non-zero exit and one message that names the file or option and what was wrong.
+
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "tests/calibration/calibration_test_support.hpp"
+#include "tests/support/child_process.hpp"
+#include "tests/support/temp_dir.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace surroundd::calibration::testing {
+namespace {
+
+using surroundd::testing::TempDir;
+using ::testing::HasSubstr;
+
+struct CalibrateRun {
+  int status;
+  std::string output;
+};
+
+CalibrateRun calibrate(const TempDir& dir, std::vector<std::string> arguments) {
+  arguments.insert(arguments.begin(), SURROUND_CALIBRATE);
+  surroundd::testing::ChildProcess child(arguments, dir / "log.txt");
+  const int status = child.wait();
+  return {status, child.output()};
+}
+
+const processing::Checkerboard kBoard{{9, 6}, 0.05};
+
+std::filesystem::path writeImages(const TempDir& dir, const std::string& folder,
+                                  const std::vector<cv::Mat>& images) {
+  auto path = dir / folder;
+  std::filesystem::create_directories(path);
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    cv::imwrite((path / fmt::format("view_{:02}.png", i)).string(), images[i]);
+  }
+  return path;
+}
+
+// A rig file of one camera, as the user's rig before calibration.
+std::filesystem::path writeRig(const TempDir& dir, const processing::CameraCalibration& camera) {
+  daemon::RigCamera entry;
+  entry.calibration = camera;
+  auto file = dir / "rig.yaml";
+  daemon::writeRigFile(file, std::span(&entry, 1), "");
+  return file;
+}
+
+std::string markerYaml(const processing::MarkerLayout& layout) {
+  std::string text = "aruco_dictionary: 4x4_50\nmarkers:\n";
+  for (const auto& m : layout.markers) {
+    const auto common = fmt::format("name: {}, x_m: {:.17g}, y_m: {:.17g}, yaw_deg: {:.17g}",
+                                    m.name, m.centre[0], m.centre[1], m.yawDeg);
+    text +=
+        m.kind == processing::MarkerKind::kAruco
+            ? fmt::format("  - {{{}, type: aruco, id: {}, side_m: {}}}\n", common, m.arucoId,
+                          m.arucoSideM)
+            : fmt::format("  - {{{}, type: checkerboard, inner_corners: [{}, {}], square_m: {}}}\n",
+                          common, m.board.innerCorners.width, m.board.innerCorners.height,
+                          m.board.squareM);
+  }
+  return text;
+}
+
+// A block written by surround-calibrate, read back through the rig reader inside a camera.
+processing::CameraCalibration readBack(const TempDir& dir, const std::string& lensBlock,
+                                       const std::string& mountBlock) {
+  const auto indent = [](const std::string& block) {
+    std::string out;
+    std::istringstream lines(block);
+    for (std::string line; std::getline(lines, line);) out += "    " + line + "\n";
+    return out;
+  };
+  const auto file = dir.write("readback.yaml",
+                              "cameras:\n  - name: c\n" + indent(lensBlock) + indent(mountBlock));
+  return daemon::loadRigFile(file).front().calibration;
+}
+
+const std::string kPinholeLens =
+    "lens: {model: pinhole, width_px: 640, height_px: 360, fx_px: 268.5, fy_px: 268.5, cx_px: "
+    "319.5, cy_px: 179.5, distortion: [0, 0, 0, 0, 0]}\n";
+const std::string kZeroMount = "mount: {x_m: 0, y_m: 0, z_m: 0}\n";
+
+TEST(CalibrateCli, IntrinsicsWriteALensBlockTheRigAccepts) {
+  const TempDir dir;
+  const auto camera = presetCameras("fisheye.yaml").front();
+  const auto& truth = camera.intrinsics;
+  const auto images = writeImages(dir, "views", boardViews(truth, kBoard, 12, 8));
+  const auto rig = writeRig(dir, camera);
+  const CalibrateRun run = calibrate(
+      dir, {"intrinsics", "--images", images.string(), "--board", "9x6", "--model", "fisheye",
+            "--out", (dir / "lens.yaml").string(), "--residuals", (dir / "residuals.png").string(),
+            "--update-rig", rig.string(), "--camera", camera.name});
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("board found in 12 of 12 images"));
+  EXPECT_THAT(run.output, HasSubstr("view_00.png"));
+  EXPECT_THAT(run.output, HasSubstr("RMS 0.0"));
+  const auto lens =
+      readBack(dir, surroundd::testing::fileBytes(dir / "lens.yaml"), kZeroMount).intrinsics;
+  EXPECT_EQ(lens.model, processing::LensModel::kFisheye);
+  EXPECT_EQ(lens.imageSize, truth.imageSize);
+  EXPECT_NEAR(lens.fx / truth.fx, 1, 0.005);
+  EXPECT_NEAR(lens.fy / truth.fy, 1, 0.005);
+  // As far as the images are lit, through a polynomial fitted out to 80 degrees: a few degrees
+  // short.
+  EXPECT_NEAR(lens.maxFieldAngleRad * 360 / std::numbers::pi, 190, 8);
+  EXPECT_FALSE(cv::imread((dir / "residuals.png").string()).empty());
+  // --update-rig: the rig's camera has the new lens and keeps its mount.
+  const auto updated = daemon::loadRigFile(rig).front().calibration;
+  EXPECT_NEAR(updated.intrinsics.fx, lens.fx, 1e-6);
+  EXPECT_LT(poseError(updated.pose, camera.pose).positionCm, 1e-9);
+}
+
+TEST(CalibrateCli, ExtrinsicsWriteAMountBlockTheRigAccepts) {
+  const TempDir dir;
+  auto camera = presetCameras("paper.yaml", kGroundViewSize).front();
+  const auto layout = synth::groundMarkersInView(camera, groundMarkers(0.2, 0.4));
+  cv::imwrite((dir / "front.png").string(), groundView(camera, layout, 3));
+  const auto markers = dir.write("markers.yaml", markerYaml(layout));
+  const processing::Pose truth = camera.pose;
+  camera.pose = nominal(truth);
+  const auto rig = writeRig(dir, camera);
+  const CalibrateRun run =
+      calibrate(dir, {"extrinsics", "--rig", rig.string(), "--camera", "front", "--image",
+                      (dir / "front.png").string(), "--markers", markers.string(), "--out",
+                      (dir / "mount.yaml").string(), "--residuals",
+                      (dir / "residuals.png").string(), "--update-rig"});
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr(fmt::format("found {} of {} markers", layout.markers.size(),
+                                                layout.markers.size())));
+  EXPECT_THAT(run.output, HasSubstr("change from the rig"));
+  const auto pose =
+      readBack(dir, kPinholeLens, surroundd::testing::fileBytes(dir / "mount.yaml")).pose;
+  const PoseError error = poseError(pose, truth);
+  EXPECT_LT(error.positionCm, 1.0);
+  EXPECT_LT(error.rotationDeg, 0.2);
+  EXPECT_FALSE(cv::imread((dir / "residuals.png").string()).empty());
+  EXPECT_LT(poseError(daemon::loadRigFile(rig).front().calibration.pose, truth).positionCm, 1.0);
+}
+
+// Bad input: one line on stderr that names the file or option, and the exit status says whose
+// problem it is (2: what was passed; 1: the images did not hold enough).
+void expectFailure(const CalibrateRun& run, int status, const std::string& message) {
+  EXPECT_EQ(run.status, status) << run.output;
+  EXPECT_THAT(run.output, HasSubstr(message));
+}
+
+std::vector<std::string> intrinsicsOn(const TempDir& dir, const std::filesystem::path& images) {
+  return {"intrinsics", "--images", images.string(),
+          "--board",    "9x6",      "--model",
+          "pinhole",    "--out",    (dir / "lens.yaml").string()};
+}
+
+TEST(CalibrateCli, IntrinsicsOfAnEmptyOrMissingFolder) {
+  const TempDir dir;
+  std::filesystem::create_directories(dir / "empty");
+  dir.write("empty/notes.txt", "not an image");
+  expectFailure(
+      calibrate(dir, intrinsicsOn(dir, dir / "empty")), 2,
+      "surround-calibrate intrinsics: --images: '" + (dir / "empty").string() +
+          "' holds no images (looked for .png .jpg .jpeg .bmp .tif .tiff .pgm .ppm .pnm)");
+  expectFailure(calibrate(dir, intrinsicsOn(dir, dir / "missing")), 2,
+                "--images: '" + (dir / "missing").string() + "' is not a folder (no such folder)");
+  EXPECT_FALSE(std::filesystem::exists(dir / "lens.yaml"));
+}
+
+TEST(CalibrateCli, IntrinsicsWithNoBoardInAnyImage) {
+  const TempDir dir;
+  const cv::Mat grey(360, 640, CV_8UC3, cv::Scalar(120, 120, 120));
+  const auto images = writeImages(dir, "views", {grey, grey, grey});
+  expectFailure(calibrate(dir, intrinsicsOn(dir, images)), 1,
+                "surround-calibrate intrinsics: calibration failed: no 9x6 checkerboard found in "
+                "any of the 3 images in '" +
+                    images.string() + "' (--board counts inner corners");
+}
+
+TEST(CalibrateCli, IntrinsicsWithTooFewViews) {
+  const TempDir dir;
+  const auto truth = presetCameras("paper.yaml").front().intrinsics;
+  auto views = boardViews(truth, kBoard, 3, 2);
+  views.emplace_back(360, 640, CV_8UC3, cv::Scalar(120, 120, 120));
+  const auto images = writeImages(dir, "views", views);
+  expectFailure(calibrate(dir, intrinsicsOn(dir, images)), 1,
+                "calibration failed: too few views: a board was found in 3 images, at least 5 are "
+                "needed (from different angles and field positions) (found in view_00.png, "
+                "view_01.png, view_02.png; not in 1 other image)");
+}
+
+TEST(CalibrateCli, IntrinsicsWithAnUnreadableOrOddSizedImage) {
+  const TempDir dir;
+  const cv::Mat grey(360, 640, CV_8UC3, cv::Scalar(120, 120, 120));
+  const auto images = writeImages(dir, "views", {grey, grey});
+  dir.write("views/view_01b.png", "PNG? no: a text file with the wrong name");
+  expectFailure(
+      calibrate(dir, intrinsicsOn(dir, images)), 2,
+      (images / "view_01b.png").string() + ": cannot read the image (not an image, or damaged)");
+  std::filesystem::remove(images / "view_01b.png");
+  cv::imwrite((images / "view_02.png").string(), cv::Mat(180, 320, CV_8UC3, cv::Scalar(0)));
+  expectFailure(calibrate(dir, intrinsicsOn(dir, images)), 2,
+                (images / "view_02.png").string() + ": the image is 320x180, " +
+                    (images / "view_00.png").string() +
+                    " is 640x360; the images must all come from one camera at one resolution");
+}
+
+TEST(CalibrateCli, UsageErrorsNameTheOption) {
+  const TempDir dir;
+  expectFailure(
+      calibrate(dir, {}), 2,
+      "surround-calibrate: missing the subcommand: intrinsics or extrinsics (see --help)");
+  expectFailure(calibrate(dir, {"calibrate"}), 2,
+                "unknown subcommand 'calibrate': expected intrinsics or extrinsics");
+  auto arguments = intrinsicsOn(dir, dir.path());
+  arguments[4] = "8x6";
+  expectFailure(calibrate(dir, arguments), 2,
+                "--board: expected COLSxROWS inner corners, each 2 to 64, one odd and one even so "
+                "that the board's two ends differ (e.g. 9x6), got '8x6'");
+  arguments = intrinsicsOn(dir, dir.path());
+  arguments.insert(arguments.end(), {"--field-of-view-deg", "190"});
+  expectFailure(calibrate(dir, arguments), 2, "--field-of-view-deg: only a fisheye lens takes it");
+  arguments = intrinsicsOn(dir, dir.path());
+  arguments.push_back("--update-rig");
+  expectFailure(calibrate(dir, arguments), 2, "--update-rig: missing its value");
+  arguments.emplace_back((dir / "rig.yaml").string());
+  expectFailure(calibrate(dir, arguments), 2, "--update-rig and --camera go together");
+  expectFailure(calibrate(dir, {"intrinsics", "--images", "x", "--model", "pinhole"}), 2,
+                "--board: missing (inner corners, e.g. 9x6)");
+  expectFailure(calibrate(dir, {"extrinsics", "--rig", "r.yaml", "--camera", "front", "--image",
+                                "f.png", "--out", "m.yaml"}),
+                2, "--markers or --points: missing");
+  expectFailure(calibrate(dir, {"extrinsics", "--speed", "3"}), 2,
+                "unknown option '--speed' (see --help)");
+  const auto help = calibrate(dir, {"extrinsics", "--help"});
+  EXPECT_EQ(help.status, 0);
+  EXPECT_THAT(help.output, HasSubstr("usage: surround-calibrate extrinsics --rig FILE"));
+  EXPECT_THAT(calibrate(dir, {"--help"}).output, HasSubstr("exit status: 0 done, 1 calibration"));
+}
+
+// The inputs of extrinsics: a rig with the camera, an image of its size, a valid marker file.
+struct ExtrinsicsInputs {
+  std::filesystem::path rig, image, markers;
+};
+
+ExtrinsicsInputs extrinsicsInputs(const TempDir& dir) {
+  auto camera = presetCameras("paper.yaml").front();
+  cv::imwrite((dir / "front.png").string(),
+              cv::Mat(camera.intrinsics.imageSize, CV_8UC3, cv::Scalar(90, 90, 90)));
+  return {writeRig(dir, camera), dir / "front.png",
+          dir.write("markers.yaml",
+                    "markers:\n  - {name: a, type: checkerboard, inner_corners: [5, 4], square_m: "
+                    "0.2, x_m: 3, y_m: 0}\n")};
+}
+
+std::vector<std::string> extrinsicsOn(const TempDir& dir, const ExtrinsicsInputs& in,
+                                      const std::string& camera = "front") {
+  return {"extrinsics",
+          "--rig",
+          in.rig.string(),
+          "--camera",
+          camera,
+          "--image",
+          in.image.string(),
+          "--markers",
+          in.markers.string(),
+          "--out",
+          (dir / "mount.yaml").string()};
+}
+
+TEST(CalibrateCli, ExtrinsicsWithBadMarkerFilesNameTheLineAndKey) {
+  const TempDir dir;
+  auto in = extrinsicsInputs(dir);
+  in.markers =
+      dir.write("bad.yaml",
+                "aruco_dictionary: 3x3_9\n"
+                "markers:\n"
+                "  - {name: a, type: checkerboard, inner_corners: [4, 4], square_m: 0.2, "
+                "x_m: 3, y_m: 0}\n"
+                "  - {name: a, type: aruco, id: 3, side_m: 0.3, x_m: 1, y_m: 1, yaw: 3}\n");
+  const auto run = calibrate(dir, extrinsicsOn(dir, in));
+  const std::string file = in.markers.string();
+  expectFailure(run, 2, file + ":1:19: aruco_dictionary: expected one of 4x4_50, 4x4_100");
+  EXPECT_THAT(run.output,
+              HasSubstr(file + ":3:50: markers[0].inner_corners: expected [columns, "
+                               "rows] of inner corners, each 2 to 64, one odd and one even"));
+  EXPECT_THAT(run.output, HasSubstr("markers[1].name: duplicate marker name 'a'"));
+  EXPECT_THAT(run.output, HasSubstr(file + ":4:64: markers[1].yaw: unknown key"));
+}
+
+TEST(CalibrateCli, ExtrinsicsWithTheWrongCameraOrImage) {
+  const TempDir dir;
+  const auto in = extrinsicsInputs(dir);
+  expectFailure(calibrate(dir, extrinsicsOn(dir, in, "rear")), 2,
+                "--camera: the rig '" + in.rig.string() + "' has no camera 'rear' (it has front)");
+  cv::imwrite(in.image.string(), cv::Mat(100, 100, CV_8UC3, cv::Scalar(0)));
+  expectFailure(calibrate(dir, extrinsicsOn(dir, in)), 2,
+                "--image: " + in.image.string() + " is 100x100, but camera 'front' in " +
+                    in.rig.string() +
+                    " has a 640x360 lens; calibrate the intrinsics at this resolution first");
+  dir.write("front.png", "not a picture");
+  expectFailure(calibrate(dir, extrinsicsOn(dir, in)), 2,
+                "--image: " + in.image.string() + ": cannot read the image");
+}
+
+TEST(CalibrateCli, ExtrinsicsWhenNoMarkerIsInTheImage) {
+  const TempDir dir;
+  const auto in = extrinsicsInputs(dir);
+  expectFailure(calibrate(dir, extrinsicsOn(dir, in)), 1,
+                "surround-calibrate extrinsics: calibration failed: none of the 1 markers of " +
+                    in.markers.string() + " was found in " + in.image.string());
+  EXPECT_FALSE(std::filesystem::exists(dir / "mount.yaml"));
+}
+
+}  // namespace
+}  // namespace surroundd::calibration::testing

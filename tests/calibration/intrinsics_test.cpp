@@ -1,0 +1,95 @@
+// Intrinsics from checkerboard views that the generator renders through a rig preset's own lens:
+// the calibrated focal lengths must be within 0.5 % of the truth, for the paper's pinhole camera
+// and the 190-degree fisheye.
+
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "processing/intrinsic_calibration.hpp"
+#include "processing/target_detection.hpp"
+#include "tests/calibration/calibration_test_support.hpp"
+
+namespace surroundd::calibration::testing {
+namespace {
+
+const processing::Checkerboard kBoard{{9, 6}, 0.05};
+constexpr int kViews = 20;
+
+processing::IntrinsicCalibration calibrate(const processing::Intrinsics& truth,
+                                           const std::vector<cv::Mat>& images) {
+  std::vector<processing::BoardView> views;
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    if (auto corners = processing::findCheckerboard(toGray(images[i]), kBoard.innerCorners)) {
+      views.push_back({"view " + std::to_string(i), std::move(*corners)});
+    }
+  }
+  // The generator only makes views whose whole board is in the image and large enough.
+  EXPECT_GE(views.size(), images.size() - 1);
+  return processing::calibrateIntrinsics(truth.model, truth.imageSize, kBoard, views);
+}
+
+void expectCloseToTruth(const processing::IntrinsicCalibration& result,
+                        const processing::Intrinsics& truth) {
+  const auto& in = result.intrinsics;
+  const double fxErrorPercent = 100 * (in.fx / truth.fx - 1);
+  const double fyErrorPercent = 100 * (in.fy / truth.fy - 1);
+  EXPECT_LT(std::abs(fxErrorPercent), 0.5) << "fx " << in.fx << ", truth " << truth.fx;
+  EXPECT_LT(std::abs(fyErrorPercent), 0.5) << "fy " << in.fy << ", truth " << truth.fy;
+  EXPECT_NEAR(in.cx, truth.cx, 1.0);
+  EXPECT_NEAR(in.cy, truth.cy, 1.0);
+  EXPECT_LT(result.rmsPx, 0.2);
+  for (const auto& view : result.views) EXPECT_LT(view.rmsPx, 0.4) << view.name;
+  // The whole lens, distortion included: a ray lands within half a pixel of where the truth puts
+  // it, over the part of the image the boards covered (the outer 10 % is extrapolation).
+  const processing::CameraModel solved(in), exact(truth);
+  double worst = 0;
+  for (int row = 2; row <= 18; ++row) {
+    for (int column = 2; column <= 18; ++column) {
+      const cv::Point2d pixel(column * 0.05 * (truth.imageSize.width - 1),
+                              row * 0.05 * (truth.imageSize.height - 1));
+      const auto ray = exact.unproject(pixel);
+      if (!ray || std::acos((*ray)[2]) > 80 * std::numbers::pi / 180) continue;
+      worst = std::max(worst, cv::norm(*solved.project(*ray) - pixel));
+    }
+  }
+  EXPECT_LT(worst, 0.5);
+  ::testing::Test::RecordProperty("fx_error_percent", std::to_string(fxErrorPercent));
+  ::testing::Test::RecordProperty("rms_px", std::to_string(result.rmsPx));
+}
+
+TEST(IntrinsicCalibration, PinholeOfThePaperRig) {
+  const auto truth = presetCameras("paper.yaml").front().intrinsics;
+  const auto result = calibrate(truth, boardViews(truth, kBoard, kViews, 3));
+  expectCloseToTruth(result, truth);
+}
+
+TEST(IntrinsicCalibration, FisheyeOfTheProductionRig) {
+  const auto truth = presetCameras("fisheye.yaml").front().intrinsics;
+  const auto images = boardViews(truth, kBoard, kViews, 4);
+  const auto result = calibrate(truth, images);
+  expectCloseToTruth(result, truth);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_NEAR(result.intrinsics.distortion[i], truth.distortion[i], 0.01) << "k" << i + 1;
+  }
+  // The image circle is inside the sensor: its lit area gives the lens's 190-degree field, exactly
+  // through the true lens, and to a few degrees through the calibrated one, which there
+  // extrapolates its polynomial from the 80 degrees the boards reach to 95.
+  cv::Mat lit = cv::Mat::zeros(truth.imageSize, CV_8U);
+  for (const auto& image : images) lit |= toGray(image) > 16;
+  const double toDeg = 360 / std::numbers::pi;  // half-angle in radians to full field in degrees
+  EXPECT_NEAR(processing::widestLitFieldAngle(truth, lit) * toDeg, 190, 0.5);
+  EXPECT_NEAR(processing::widestLitFieldAngle(result.intrinsics, lit) * toDeg, 190, 5);
+}
+
+TEST(IntrinsicCalibration, TooFewViewsSaySoAndHowManyAreNeeded) {
+  const auto truth = presetCameras("paper.yaml").front().intrinsics;
+  const std::vector<processing::BoardView> views(3, {"a.png", std::vector<cv::Point2f>(54)});
+  expectCalibrationError(
+      [&] { processing::calibrateIntrinsics(truth.model, truth.imageSize, kBoard, views); },
+      "too few views: a board was found in 3 images, at least 5 are needed (from different angles "
+      "and field positions)");
+}
+
+}  // namespace
+}  // namespace surroundd::calibration::testing

@@ -1,0 +1,238 @@
+// Colour correction on the generator's recordings, whose cameras differ in gain (0.7-1.3), white
+// balance, gamma and vignetting: Poisson local correction removes the colour step across the
+// seams, better than global gains; cameras that agree get almost no correction; the solvers give
+// the same fields; a static scene does not flicker; a missing camera is survived.
+
+#include <gtest/gtest.h>
+
+#include "common/work_pool.hpp"
+#include "processing/gain_compensation.hpp"
+#include "processing/poisson_correction.hpp"
+#include "processing/stitcher.hpp"
+#include "tests/processing/panorama_test_support.hpp"
+#include "tests/support/test_support.hpp"
+#include "tools/bench/panorama_accuracy.hpp"
+
+namespace surroundd::processing {
+namespace {
+
+using testing::settingsFor;
+
+const bench::RecordingTruth& recording(const char* name) {
+  static std::map<std::string, bench::RecordingTruth> loaded;
+  auto found = loaded.find(name);
+  if (found == loaded.end()) {
+    found =
+        loaded
+            .emplace(name,
+                     bench::loadRecordingTruth(std::filesystem::path(SURROUNDD_FIXTURE_DIR) / name))
+            .first;
+  }
+  return found->second;
+}
+
+// The first frame of each camera's video, as the daemon decodes it.
+std::vector<cv::Mat> firstFrames(const bench::RecordingTruth& truth) {
+  std::vector<cv::Mat> frames;
+  for (const auto& video : truth.videos) {
+    frames.push_back(surroundd::testing::decodeAll(video, false, 1).images.at(0));
+  }
+  return frames;
+}
+
+class ColourCorrectionTest : public ::testing::Test {
+ protected:
+  explicit ColourCorrectionTest(const char* fixture = "synth_small")
+      : truth_(recording(fixture)),
+        settings_(settingsFor(truth_)),
+        lut_(buildPanoramaLut(truth_.rig, settings_, pool_)),
+        stitcher_(lut_, pool_) {}
+
+  cv::Mat stitch(const std::vector<cv::Mat>& frames) {
+    cv::Mat panorama;
+    stitcher_.stitch(frames, panorama);
+    return panorama;
+  }
+  // Over the true ground, where both cameras of a seam see the same surface: the source
+  // cameras' pixels against the target cameras' view of the same places.
+  double mismatch(const cv::Mat& panorama, const std::vector<cv::Mat>& frames) const {
+    const synth::Scene scene(truth_.seed, truth_.seconds);
+    return bench::seamColourError(
+        panorama, frames, truth_.rig, settings_, lut_,
+        bench::trueGroundMask(scene, truth_.frames.front().pose, settings_));
+  }
+  ColourCorrectionSettings correction(PoissonSolverKind solver, double smoothing = 0) const {
+    ColourCorrectionSettings settings;
+    settings.solver = solver;
+    settings.tolerance = 1e-4;
+    settings.temporalSmoothing = smoothing;
+    return settings;
+  }
+
+  WorkPool pool_{2};
+  const bench::RecordingTruth& truth_;
+  PanoramaSettings settings_;
+  PanoramaLut lut_;
+  Stitcher stitcher_;
+};
+
+TEST_F(ColourCorrectionTest, PoissonRemovesTheStepAcrossSeamsBetterThanGains) {
+  const auto frames = firstFrames(truth_);
+  const cv::Mat raw = stitch(frames);
+
+  PoissonColourCorrection poisson(truth_.rig, settings_, lut_, correction(PoissonSolverKind::kAuto),
+                                  pool_);
+  EXPECT_TRUE(poisson.notes().empty());
+  EXPECT_EQ(poisson.domain().regions.size(), 2u);  // front and back
+  poisson.update(frames);
+  cv::Mat corrected = raw.clone();
+  poisson.apply(corrected);
+
+  GainCompensation gains(lut_, pool_);
+  gains.update(frames);
+  cv::Mat gained = raw.clone();
+  gains.apply(gained);
+
+  const double before = mismatch(raw, frames);
+  const double afterPoisson = mismatch(corrected, frames);
+  const double afterGains = mismatch(gained, frames);
+  RecordProperty("seam_step_before", std::to_string(before));
+  RecordProperty("seam_step_poisson", std::to_string(afterPoisson));
+  RecordProperty("seam_step_gain", std::to_string(afterGains));
+  std::printf(
+      "colour step across the seams: %.2f levels before, %.2f with gain compensation, %.2f with "
+      "Poisson correction\n",
+      before, afterGains, afterPoisson);
+  // Measured on this 320x180 fixture: 14.8 before, 15.2 with gains (they cannot follow the
+  // vignetting at the image edges), 3.4 with Poisson correction. The target (2 levels
+  // after, from 15 before) is not reached yet; this pins what is.
+  EXPECT_GE(before, 10.0);
+  EXPECT_LE(afterPoisson, 0.3 * before);
+  EXPECT_LT(afterPoisson, 0.5 * afterGains);
+  // Targets are untouched: only source-owned and seam-band pixels change.
+  cv::Mat changed;
+  cv::compare(corrected, raw, changed, cv::CMP_NE);
+  cv::Mat changedAny;
+  cv::reduce(changed.reshape(1, static_cast<int>(changed.total())), changedAny, 1, cv::REDUCE_MAX);
+  const auto& share = poisson.domain().share;
+  const auto* flags = changedAny.ptr<std::uint8_t>();
+  for (std::size_t i = 0; i < share.size(); ++i) {
+    if (share[i] == 0) {
+      ASSERT_EQ(flags[i], 0) << "pixel " << i;
+    }
+  }
+}
+
+TEST_F(ColourCorrectionTest, SolversGiveTheSameField) {
+  const auto frames = firstFrames(truth_);
+  std::vector<cv::Mat> fields;
+  for (const auto kind :
+       {PoissonSolverKind::kCholmod, PoissonSolverKind::kIterative, PoissonSolverKind::kAuto}) {
+    PoissonColourCorrection poisson(truth_.rig, settings_, lut_, correction(kind), pool_);
+    poisson.update(frames);
+    fields.push_back(poisson.field().clone());
+  }
+  EXPECT_LE(cv::norm(fields[0], fields[1], cv::NORM_INF), 0.01);
+  EXPECT_LE(cv::norm(fields[0], fields[2], cv::NORM_INF), 0.01);
+  EXPECT_GT(cv::norm(fields[0], cv::NORM_INF), 10.0);  // and there is a field to agree on
+}
+
+// A static scene: the same picture with fresh sensor noise each frame.
+TEST_F(ColourCorrectionTest, AStaticSceneDoesNotFlickerAndWarmStartsAreCheap) {
+  const auto& frame = truth_.frames.front();
+  std::vector<cv::Mat> clean = testing::truthImages(frame);
+  cv::RNG random(5);
+  PoissonColourCorrection poisson(truth_.rig, settings_, lut_,
+                                  correction(PoissonSolverKind::kIterative, 0.8), pool_);
+  cv::Mat previous;
+  std::vector<int> iterations;
+  double worstChange = 0;  // mean over the regions' blocks, the largest of the frames
+  double worstBlock = 0;
+  // The blocks the regions' fields cover (the field beyond them only feeds interpolation).
+  cv::Mat regions(poisson.field().size(), CV_8U, cv::Scalar(0));
+  for (const auto& region : poisson.domain().regions) {
+    for (const int block : region.blockOfUnknown)
+      regions.at<std::uint8_t>(block / regions.cols, block % regions.cols) = 255;
+  }
+  for (int k = 0; k < 6; ++k) {
+    std::vector<cv::Mat> noisy;
+    for (const auto& image : clean) {
+      cv::Mat values;
+      image.convertTo(values, CV_32FC3);
+      cv::Mat noise(image.size(), CV_32FC3);
+      random.fill(noise, cv::RNG::NORMAL, 0, 1.5);  // the generator's sensor noise
+      values += noise;
+      values.convertTo(noisy.emplace_back(), CV_8UC3);
+    }
+    iterations.push_back(poisson.update(noisy));
+    if (!previous.empty()) {
+      cv::Mat change;
+      cv::absdiff(poisson.field(), previous, change);
+      const cv::Scalar mean = cv::mean(change, regions);
+      worstChange = std::max(worstChange, (mean[0] + mean[1] + mean[2]) / 3);
+      worstBlock = std::max(worstBlock, cv::norm(change, cv::NORM_INF, regions));
+    }
+    previous = poisson.field().clone();
+  }
+  std::printf(
+      "static scene: field change between frames %.3f levels mean, %.3f the largest "
+      "block; iterations cold %d, warm %d\n",
+      worstChange, worstBlock, iterations.front(), iterations.back());
+  EXPECT_LE(worstChange, 0.5);
+  EXPECT_LT(iterations.back(), iterations.front());
+}
+
+class IdenticalCamerasTest : public ColourCorrectionTest {
+ protected:
+  IdenticalCamerasTest() : ColourCorrectionTest("synth_small_identity") {}
+};
+
+TEST_F(IdenticalCamerasTest, NeedAlmostNoCorrection) {
+  const auto frames = firstFrames(truth_);
+  PoissonColourCorrection poisson(truth_.rig, settings_, lut_, correction(PoissonSolverKind::kAuto),
+                                  pool_);
+  poisson.update(frames);
+  // Over the regions (where the field is not simply extended): a mean well under a level. The
+  // seams still see parallax where boxes and walls stand off the bowl, so single blocks can
+  // differ by more.
+  double sum = 0;
+  int count = 0;
+  for (const auto& region : poisson.domain().regions) {
+    for (const int block : region.blockOfUnknown) {
+      const auto value =
+          poisson.field().at<cv::Vec3f>(block / poisson.field().cols, block % poisson.field().cols);
+      sum += (std::abs(value[0]) + std::abs(value[1]) + std::abs(value[2])) / 3;
+      ++count;
+    }
+  }
+  ASSERT_GT(count, 100);
+  std::printf("identical cameras: mean |correction| %.3f levels\n", sum / count);
+  EXPECT_LT(sum / count, 1.0);
+}
+
+TEST_F(ColourCorrectionTest, AMissingCameraHoldsItsSeamsAndBreaksNothing) {
+  auto frames = firstFrames(truth_);
+  PoissonColourCorrection poisson(truth_.rig, settings_, lut_, correction(PoissonSolverKind::kAuto),
+                                  pool_);
+  poisson.update(frames);
+  const cv::Mat before = poisson.field().clone();
+  frames[1] = cv::Mat();  // 'right' (a target) lost
+  poisson.update(frames);
+  EXPECT_LE(cv::norm(poisson.field(), before, cv::NORM_INF), 1e-3);
+  frames[0] = cv::Mat();  // and 'front' (a source)
+  poisson.update(frames);
+  cv::Mat panorama = stitch(firstFrames(truth_));
+  poisson.apply(panorama);
+  EXPECT_TRUE(cv::checkRange(poisson.field()));
+}
+
+TEST(ColourCorrectionDomain, AScaleThatDoesNotTileThePanoramaIsRefused) {
+  WorkPool pool(1);
+  const auto& truth = recording("synth_small");
+  const auto settings = settingsFor(truth);
+  const PanoramaLut lut = buildPanoramaLut(truth.rig, settings, pool);
+  EXPECT_THROW(buildCorrectionDomain(truth.rig, settings, lut, 0.3), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace surroundd::processing

@@ -1,0 +1,477 @@
+// The Poisson solvers on systems drawn here: the rectangle that fixed-azimuth seams give, a
+// region with holes, an uneven bottom edge and rows without seams, and one with a part that no
+// seam reaches. Every pair of solvers that applies agrees to 0.01 8-bit levels.
+
+#include "processing/poisson_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include <SuiteSparse_config.h>
+#include <gtest/gtest.h>
+
+#include "processing/poisson_matrix.hpp"
+
+// Counts allocations while `countAllocations` is set: operator new here, malloc and friends in
+// SuiteSparse through its hooks (CHOLMOD allocates through them).
+namespace {
+bool countAllocations = false;
+int allocations = 0;
+}  // namespace
+
+// GCC sees free() meet operator new once these are inlined into the standard library's callers.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+void* operator new(std::size_t size) {
+  if (countAllocations) ++allocations;
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#pragma GCC diagnostic pop
+
+namespace surroundd::processing {
+namespace {
+
+enum class Cell : char { kOutside, kUnknown, kDirichlet };
+
+// A drawing of a region: unknowns, Dirichlet pixels with their values (8-bit levels, per
+// channel), and outside pixels (Neumann borders).
+struct Canvas {
+  cv::Size size;
+  std::vector<Cell> cells;
+  std::vector<cv::Vec3f> values;
+
+  Canvas(cv::Size s, Cell fill)
+      : size(s), cells(static_cast<std::size_t>(s.area()), fill), values(cells.size()) {}
+  std::size_t index(int x, int y) const { return static_cast<std::size_t>(y) * size.width + x; }
+  Cell& at(int x, int y) { return cells[index(x, y)]; }
+  Cell at(int x, int y) const {
+    if (x < 0 || y < 0 || x >= size.width || y >= size.height) return Cell::kOutside;
+    return cells[index(x, y)];
+  }
+};
+
+struct Problem {
+  PoissonSystem system;
+  ChannelValues rhs;
+  std::size_t leftOut = 0;  // unknowns in parts that no Dirichlet pixel reaches
+};
+
+// What the domain builder does: parts of the region without a Dirichlet neighbour are left out;
+// the rest, in row-major order in its bounding box, with degrees, links and right-hand sides.
+Problem buildProblem(const Canvas& canvas) {
+  std::vector<int> part(canvas.cells.size(), -1);
+  std::vector<bool> partTouchesSeam;
+  for (int y = 0; y < canvas.size.height; ++y) {
+    for (int x = 0; x < canvas.size.width; ++x) {
+      if (canvas.at(x, y) != Cell::kUnknown || part[canvas.index(x, y)] >= 0) continue;
+      const int label = static_cast<int>(partTouchesSeam.size());
+      partTouchesSeam.push_back(false);
+      std::vector<cv::Point> stack{{x, y}};
+      part[canvas.index(x, y)] = label;
+      while (!stack.empty()) {
+        const cv::Point p = stack.back();
+        stack.pop_back();
+        for (const cv::Point d :
+             {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
+          const cv::Point q = p + d;
+          if (canvas.at(q.x, q.y) == Cell::kDirichlet) partTouchesSeam.back() = true;
+          if (canvas.at(q.x, q.y) == Cell::kUnknown && part[canvas.index(q.x, q.y)] < 0) {
+            part[canvas.index(q.x, q.y)] = label;
+            stack.push_back(q);
+          }
+        }
+      }
+    }
+  }
+  Problem problem;
+  cv::Rect frame;
+  std::vector<cv::Point> kept;
+  for (int y = 0; y < canvas.size.height; ++y) {
+    for (int x = 0; x < canvas.size.width; ++x) {
+      const int label = part[canvas.index(x, y)];
+      if (label < 0) continue;
+      if (!partTouchesSeam[static_cast<std::size_t>(label)]) {
+        ++problem.leftOut;
+        continue;
+      }
+      frame = kept.empty() ? cv::Rect(x, y, 1, 1) : (frame | cv::Rect(x, y, 1, 1));
+      kept.emplace_back(x, y);
+    }
+  }
+  std::vector<int> unknownOf(canvas.cells.size(), -1);
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    unknownOf[canvas.index(kept[i].x, kept[i].y)] = static_cast<int>(i);
+  }
+  PoissonSystem& system = problem.system;
+  system.size = frame.size();
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    const cv::Point p = kept[i];
+    system.pixels.push_back(p - frame.tl());
+    int degree = 0;
+    cv::Vec3f sum(0, 0, 0);
+    for (const cv::Point d :
+         {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
+      const cv::Point q = p + d;
+      const Cell cell = canvas.at(q.x, q.y);
+      if (cell == Cell::kDirichlet) {
+        ++degree;
+        sum += canvas.values[canvas.index(q.x, q.y)];
+      } else if (cell == Cell::kUnknown && unknownOf[canvas.index(q.x, q.y)] >= 0) {
+        ++degree;
+        const int j = unknownOf[canvas.index(q.x, q.y)];
+        if (static_cast<int>(i) < j) system.links.emplace_back(static_cast<int>(i), j);
+      }
+    }
+    system.degree.push_back(degree);
+    for (int c = 0; c < 3; ++c) problem.rhs.push_back(sum[c]);
+  }
+  return problem;
+}
+
+// Seam values of 0..60 levels, smooth along the seam with some noise on top.
+void fillSeams(Canvas& canvas, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<float> noise(-3.0f, 3.0f);
+  for (int y = 0; y < canvas.size.height; ++y) {
+    for (int x = 0; x < canvas.size.width; ++x) {
+      if (canvas.at(x, y) != Cell::kDirichlet) continue;
+      for (int c = 0; c < 3; ++c) {
+        const float smooth =
+            30.0f + 25.0f * std::sin(0.07f * static_cast<float>(y + 3 * x) + static_cast<float>(c));
+        canvas.values[canvas.index(x, y)][c] = std::clamp(smooth + noise(random), 0.0f, 60.0f);
+      }
+    }
+  }
+}
+
+// W x H unknowns, seams along the whole left and right columns (what fixed azimuths give).
+Canvas rectangleCanvas(cv::Size size, unsigned seed = 1) {
+  Canvas canvas({size.width + 2, size.height}, Cell::kUnknown);
+  for (int y = 0; y < size.height; ++y) {
+    canvas.at(0, y) = Cell::kDirichlet;
+    canvas.at(size.width + 1, y) = Cell::kDirichlet;
+  }
+  fillSeams(canvas, seed);
+  return canvas;
+}
+
+// The rectangle with holes, an uneven bottom edge, rows whose left seam is missing, and a seam
+// piece along part of the top.
+Canvas irregularCanvas(cv::Size size) {
+  Canvas canvas = rectangleCanvas(size);
+  for (int x = 1; x <= size.width; ++x) {
+    const int depth = static_cast<int>(4 + 3 * std::sin(0.3 * x));  // uneven bottom edge
+    for (int y = size.height - depth; y < size.height; ++y) canvas.at(x, y) = Cell::kOutside;
+  }
+  for (int y = 5; y < 9; ++y) canvas.at(0, y) = Cell::kOutside;  // no seam on these rows
+  for (int y = 12; y < 16; ++y) {                                // a hole
+    for (int x = size.width / 3; x < size.width / 3 + 5; ++x) canvas.at(x, y) = Cell::kOutside;
+  }
+  for (int x = size.width / 2; x < size.width / 2 + 6; ++x) canvas.at(x, 0) = Cell::kDirichlet;
+  fillSeams(canvas, 7);
+  return canvas;
+}
+
+constexpr double kTolerance = 1e-5;
+constexpr float kAgreement = 0.01f;  // 8-bit levels
+
+ChannelValues solveWith(PoissonSolverKind kind, const Problem& problem) {
+  auto solver = makePoissonSolver(kind, problem.system, kTolerance);
+  EXPECT_EQ(solver->kind(), kind);
+  ChannelValues x(problem.rhs.size(), 0.0f);
+  solver->solve(problem.rhs, x);
+  return x;
+}
+
+float largestDifference(const ChannelValues& a, const ChannelValues& b) {
+  float largest = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) largest = std::max(largest, std::abs(a[i] - b[i]));
+  return largest;
+}
+
+class RectangleSizes : public ::testing::TestWithParam<cv::Size> {};
+
+TEST_P(RectangleSizes, AllThreeSolversAgree) {
+  const Problem problem = buildProblem(rectangleCanvas(GetParam()));
+  ASSERT_TRUE(rectangleSolverMismatch(problem.system).empty());
+  const ChannelValues cholmod = solveWith(PoissonSolverKind::kCholmod, problem);
+  const ChannelValues iterative = solveWith(PoissonSolverKind::kIterative, problem);
+  const ChannelValues rectangle = solveWith(PoissonSolverKind::kRectangle, problem);
+  EXPECT_LE(largestDifference(cholmod, rectangle), kAgreement);
+  EXPECT_LE(largestDifference(cholmod, iterative), kAgreement);
+  EXPECT_LE(largestDifference(rectangle, iterative), kAgreement);
+  // The field stays within the seam values (maximum principle), so nothing blew up.
+  for (const float value : cholmod) {
+    EXPECT_GE(value, -0.01f);
+    EXPECT_LE(value, 60.01f);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(PoissonSolver, RectangleSizes,
+                         ::testing::Values(cv::Size(1, 1), cv::Size(2, 3), cv::Size(7, 5),
+                                           cv::Size(33, 17), cv::Size(128, 180),
+                                           cv::Size(512, 256)),
+                         [](const auto& test) {
+                           return std::to_string(test.param.width) + "x" +
+                                  std::to_string(test.param.height);
+                         });
+
+TEST(PoissonSolver, DirectSolversLeaveOnlyFloatRounding) {
+  const Problem problem = buildProblem(rectangleCanvas({128, 180}));
+  for (const auto kind : {PoissonSolverKind::kCholmod, PoissonSolverKind::kRectangle}) {
+    auto solver = makePoissonSolver(kind, problem.system, kTolerance);
+    ChannelValues x(problem.rhs.size(), 0.0f);
+    const SolveStats stats = solver->solve(problem.rhs, x);
+    EXPECT_EQ(stats.iterations, 0);
+    // The solution is returned in float: rounding it alone leaves a residual of about 1e-6.
+    EXPECT_LT(stats.relativeResidual, 1e-5) << solver->name();
+    EXPECT_NEAR(stats.relativeResidual,
+                PoissonMatrix(problem.system).relativeResidual(problem.rhs, x), 1e-9);
+  }
+}
+
+TEST(PoissonSolver, IrregularRegionCholmodAndIterativeAgree) {
+  const Problem problem = buildProblem(irregularCanvas({90, 40}));
+  EXPECT_FALSE(rectangleSolverMismatch(problem.system).empty());
+  const ChannelValues cholmod = solveWith(PoissonSolverKind::kCholmod, problem);
+  const ChannelValues iterative = solveWith(PoissonSolverKind::kIterative, problem);
+  EXPECT_LE(largestDifference(cholmod, iterative), kAgreement);
+}
+
+TEST(PoissonSolver, ThinCorridorCholmodAndIterativeAgree) {
+  // A seam at the end of a one-pixel corridor that leads into a room: the field is the seam's
+  // value everywhere, and the matrix is badly conditioned (a residual that float arithmetic
+  // would lose track of still moves the room by a level).
+  Canvas canvas({300, 20}, Cell::kOutside);
+  canvas.at(0, 10) = Cell::kDirichlet;
+  for (int x = 1; x < 299; ++x) canvas.at(x, 10) = Cell::kUnknown;
+  for (int y = 2; y < 18; ++y) {
+    for (int x = 250; x < 299; ++x) canvas.at(x, y) = Cell::kUnknown;
+  }
+  fillSeams(canvas, 3);
+  const Problem problem = buildProblem(canvas);
+  const ChannelValues cholmod = solveWith(PoissonSolverKind::kCholmod, problem);
+  const ChannelValues iterative = solveWith(PoissonSolverKind::kIterative, problem);
+  EXPECT_LE(largestDifference(cholmod, iterative), kAgreement);
+  const cv::Vec3f seam = canvas.values[canvas.index(0, 10)];
+  for (std::size_t i = 0; i < cholmod.size(); ++i) {
+    EXPECT_NEAR(cholmod[i], seam[static_cast<int>(i % 3)], 1e-3);
+  }
+}
+
+TEST(PoissonSolver, IterativeResidualIsTheTrueOne) {
+  const Problem problem = buildProblem(irregularCanvas({90, 40}));
+  for (const double tolerance : {1e-3, 1e-4, 1e-5}) {
+    auto solver = makeIterativeSolver(problem.system, tolerance);
+    ChannelValues x(problem.rhs.size(), 0.0f);
+    const SolveStats stats = solver->solve(problem.rhs, x);
+    EXPECT_LE(stats.relativeResidual, tolerance);
+    EXPECT_GT(stats.iterations, 0);
+    const double trueResidual = PoissonMatrix(problem.system).relativeResidual(problem.rhs, x);
+    EXPECT_NEAR(trueResidual, stats.relativeResidual, 0.1 * tolerance + 2e-6);
+  }
+}
+
+TEST(PoissonSolver, PartWithoutSeamIsLeftOutByConstruction) {
+  Canvas canvas = rectangleCanvas({40, 30});
+  // An island of unknowns walled off from both seams: Neumann all round, so no solution is
+  // defined there; the builder (like the domain builder) leaves it out.
+  for (int y = 8; y < 20; ++y) {
+    for (int x = 10; x < 24; ++x) {
+      const bool wall = y == 8 || y == 19 || x == 10 || x == 23;
+      canvas.at(x, y) = wall ? Cell::kOutside : Cell::kUnknown;
+    }
+  }
+  const Problem problem = buildProblem(canvas);
+  EXPECT_EQ(problem.leftOut, 10u * 12u);
+  EXPECT_FALSE(PoissonMatrix(problem.system).floatingUnknown().has_value());
+  const ChannelValues cholmod = solveWith(PoissonSolverKind::kCholmod, problem);
+  const ChannelValues iterative = solveWith(PoissonSolverKind::kIterative, problem);
+  EXPECT_LE(largestDifference(cholmod, iterative), kAgreement);
+}
+
+TEST(PoissonSolver, SingularSystemIsRefusedAtSetUp) {
+  Canvas canvas({6, 4}, Cell::kUnknown);  // no seam anywhere: Neumann only
+  Problem problem = buildProblem(canvas);
+  ASSERT_EQ(problem.leftOut, 24u);
+  // Built by hand, as a domain builder that forgot to leave the part out would.
+  problem.system.size = {2, 1};
+  problem.system.pixels = {{0, 0}, {1, 0}};
+  problem.system.degree = {1, 1};
+  problem.system.links = {{0, 1}};
+  for (const auto kind : {PoissonSolverKind::kCholmod, PoissonSolverKind::kIterative}) {
+    try {
+      makePoissonSolver(kind, problem.system, kTolerance);
+      ADD_FAILURE() << poissonSolverName(kind) << " accepted a singular system";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("without a Dirichlet neighbour"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+TEST(PoissonSolver, InconsistentSystemIsRefused) {
+  Problem problem = buildProblem(rectangleCanvas({4, 3}));
+  problem.system.links.pop_back();  // two neighbouring unknowns without their link
+  EXPECT_THROW(makePoissonSolver(PoissonSolverKind::kAuto, problem.system, kTolerance),
+               std::invalid_argument);
+  EXPECT_THROW(makePoissonSolver(PoissonSolverKind::kCholmod, problem.system, kTolerance),
+               std::invalid_argument);
+}
+
+// Frame to frame the seams drift: b' from seam values * gain + noise.
+ChannelValues driftedRhs(Canvas canvas, float gain, float noise, unsigned seed) {
+  std::mt19937 random(seed);
+  std::normal_distribution<float> normal(0.0f, noise);
+  for (auto& value : canvas.values) {
+    for (int c = 0; c < 3; ++c) value[c] = value[c] * gain + normal(random);
+  }
+  return buildProblem(canvas).rhs;
+}
+
+TEST(PoissonSolver, IterativeStartsFromThePreviousSolution) {
+  const Canvas canvas = irregularCanvas({128, 64});
+  const Problem problem = buildProblem(canvas);
+  // Seams 1% brighter with 0.2 levels of noise: the warm start is 100 times closer than zero;
+  // a drift of 0.1% and 0.02 levels is closer to what one frame brings.
+  const ChannelValues brighter = driftedRhs(canvas, 1.01f, 0.2f, 3);
+  const ChannelValues drifted = driftedRhs(canvas, 1.001f, 0.02f, 4);
+  // 1e-3 is the config's default; 1e-4 keeps the field within 0.01 levels of the exact one.
+  for (const double tolerance : {1e-3, 1e-4}) {
+    SCOPED_TRACE(tolerance);
+    auto solver = makeIterativeSolver(problem.system, tolerance);
+    ChannelValues previous(problem.rhs.size(), 0.0f);
+    EXPECT_GT(solver->solve(problem.rhs, previous).iterations, 0);
+    const auto iterations = [&](const ChannelValues& rhs, bool warm) {
+      ChannelValues x = warm ? previous : ChannelValues(rhs.size(), 0.0f);
+      return solver->solve(rhs, x).iterations;
+    };
+    // The same right-hand side again: already converged.
+    EXPECT_EQ(iterations(problem.rhs, true), 0);
+    // A V-cycle cuts the residual 20 to 50 times, so a cold start takes 3 to 4 iterations and the
+    // 100 times closer start saves about half of them.
+    const int cold = iterations(brighter, false);
+    const int warm = iterations(brighter, true);
+    EXPECT_LE(2 * warm, cold) << "cold " << cold << ", warm " << warm;
+    if (tolerance >= 1e-3) {
+      EXPECT_LE(3 * warm, cold) << "cold " << cold << ", warm " << warm;
+    }
+    const int coldDrift = iterations(drifted, false);
+    const int warmDrift = iterations(drifted, true);
+    EXPECT_LE(3 * warmDrift, coldDrift) << "cold " << coldDrift << ", warm " << warmDrift;
+  }
+}
+
+TEST(PoissonSolver, AutoTakesTheRectangleSolverWhereItApplies) {
+  const Problem rectangle = buildProblem(rectangleCanvas({64, 48}));
+  auto solver = makePoissonSolver(PoissonSolverKind::kAuto, rectangle.system, kTolerance);
+  EXPECT_EQ(solver->kind(), PoissonSolverKind::kRectangle);
+  EXPECT_EQ(solver->name(), "rectangle");
+  EXPECT_TRUE(solver->selectionNote().empty());
+
+  const Problem irregular = buildProblem(irregularCanvas({64, 48}));
+  solver = makePoissonSolver(PoissonSolverKind::kAuto, irregular.system, kTolerance);
+  EXPECT_EQ(solver->kind(), PoissonSolverKind::kIterative);
+  EXPECT_NE(solver->selectionNote().find("auto uses the iterative solver"), std::string::npos)
+      << solver->selectionNote();
+}
+
+TEST(PoissonSolver, RectangleRequestFallsBackAndSaysWhy) {
+  const Problem irregular = buildProblem(irregularCanvas({64, 48}));
+  auto solver = makePoissonSolver(PoissonSolverKind::kRectangle, irregular.system, kTolerance);
+  EXPECT_EQ(solver->kind(), PoissonSolverKind::kIterative);
+  const std::string& note = solver->selectionNote();
+  EXPECT_NE(note.find("rectangle solver asked for"), std::string::npos) << note;
+  EXPECT_NE(note.find("using the iterative solver"), std::string::npos) << note;
+  EXPECT_THROW(makeRectangleSolver(irregular.system), std::invalid_argument);
+}
+
+TEST(PoissonSolver, RectangleMismatchNamesTheProblem) {
+  const auto mismatch = [](Canvas canvas) {
+    fillSeams(canvas, 1);
+    return rectangleSolverMismatch(buildProblem(canvas).system);
+  };
+  Canvas missingSeam = rectangleCanvas({10, 8});
+  missingSeam.at(0, 3) = Cell::kOutside;
+  EXPECT_EQ(mismatch(missingSeam),
+            "row 3 of 8 has no seam (Dirichlet neighbour) on its left side; the rectangle solver "
+            "needs seams along the whole left and right columns");
+  Canvas missingRight = rectangleCanvas({10, 8});
+  missingRight.at(11, 7) = Cell::kOutside;
+  EXPECT_NE(mismatch(missingRight).find("row 7 of 8 has no seam"), std::string::npos);
+  EXPECT_NE(mismatch(missingRight).find("right side"), std::string::npos);
+
+  Canvas hole = rectangleCanvas({10, 8});
+  hole.at(4, 4) = Cell::kOutside;
+  EXPECT_EQ(mismatch(hole), "79 unknowns do not fill the region's 10x8 frame");
+
+  Canvas seamOnTop({12, 9}, Cell::kUnknown);
+  for (int y = 0; y < 9; ++y) seamOnTop.at(0, y) = seamOnTop.at(11, y) = Cell::kDirichlet;
+  for (int x = 1; x < 11; ++x) seamOnTop.at(x, 0) = x == 5 ? Cell::kDirichlet : Cell::kOutside;
+  EXPECT_NE(mismatch(seamOnTop).find("Dirichlet neighbour above or below"), std::string::npos)
+      << mismatch(seamOnTop);
+}
+
+TEST(PoissonSolver, SolveChecksSpanSizes) {
+  const Problem problem = buildProblem(rectangleCanvas({5, 4}));
+  for (const auto kind : {PoissonSolverKind::kCholmod, PoissonSolverKind::kIterative,
+                          PoissonSolverKind::kRectangle}) {
+    auto solver = makePoissonSolver(kind, problem.system, kTolerance);
+    ChannelValues x(problem.rhs.size() - 3, 0.0f);
+    EXPECT_THROW(solver->solve(problem.rhs, x), std::invalid_argument);
+  }
+}
+
+TEST(PoissonSolver, ZeroRightHandSideGivesZero) {
+  const Problem problem = buildProblem(irregularCanvas({40, 30}));
+  const ChannelValues zero(problem.rhs.size(), 0.0f);
+  for (const auto kind : {PoissonSolverKind::kCholmod, PoissonSolverKind::kIterative}) {
+    auto solver = makePoissonSolver(kind, problem.system, kTolerance);
+    ChannelValues x(problem.rhs.size(), 5.0f);  // a stale start
+    const SolveStats stats = solver->solve(zero, x);
+    EXPECT_EQ(stats.relativeResidual, 0.0);
+    EXPECT_EQ(largestDifference(x, zero), 0.0f) << solver->name();
+  }
+}
+
+TEST(PoissonSolver, SolveAllocatesNothing) {
+  const auto saved = SuiteSparse_config;
+  SuiteSparse_config.malloc_func = [](std::size_t size) {
+    if (countAllocations) ++allocations;
+    return std::malloc(size);
+  };
+  SuiteSparse_config.calloc_func = [](std::size_t count, std::size_t size) {
+    if (countAllocations) ++allocations;
+    return std::calloc(count, size);
+  };
+  SuiteSparse_config.realloc_func = [](void* p, std::size_t size) {
+    if (countAllocations) ++allocations;
+    return std::realloc(p, size);
+  };
+  const Problem rectangle = buildProblem(rectangleCanvas({48, 30}));
+  const Problem irregular = buildProblem(irregularCanvas({48, 30}));
+  for (const auto kind : {PoissonSolverKind::kCholmod, PoissonSolverKind::kIterative,
+                          PoissonSolverKind::kRectangle}) {
+    const Problem& problem = kind == PoissonSolverKind::kRectangle ? rectangle : irregular;
+    auto solver = makePoissonSolver(kind, problem.system, kTolerance);
+    ChannelValues x(problem.rhs.size(), 0.0f);
+    allocations = 0;
+    countAllocations = true;
+    solver->solve(problem.rhs, x);
+    solver->solve(problem.rhs, x);
+    countAllocations = false;
+    EXPECT_EQ(allocations, 0) << solver->name();
+  }
+  SuiteSparse_config = saved;
+}
+
+}  // namespace
+}  // namespace surroundd::processing

@@ -1,0 +1,49 @@
+#pragma once
+// The Poisson solvers of colour correction, one system at a time: set-up (analysis and
+// factorization, multigrid hierarchy, DCT tables), solve milliseconds from a cold start and
+// warm-started on a slowly changing sequence of right-hand sides (as frames give them),
+// iterations, residual, and agreement with CHOLMOD.
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "processing/poisson_solver.hpp"
+
+namespace surroundd::bench {
+
+struct PoissonBenchmarkOptions {
+  int repeats = 30;  // frames solved per solver; medians reported
+  // The iterative solver's relative residual: 1e-4 stays within 0.01 levels of CHOLMOD (the
+  // config's default, 1e-3, is faster and within about 0.06).
+  double tolerance = 1e-4;
+};
+
+struct PoissonSolverTiming {
+  processing::PoissonSolverKind kind = processing::PoissonSolverKind::kCholmod;
+  double setupMs = 0;
+  double coldSolveMs = 0;          // from x = 0
+  double warmSolveMs = 0;          // median over frames, started from the previous frame's solution
+  int coldIterations = 0;          // 0 for direct solvers
+  int warmIterations = 0;          // median
+  double relativeResidual = 0;     // last frame
+  double differenceToCholmod = 0;  // largest |x - x_cholmod| on the last frame, 8-bit levels
+};
+
+// The region that seams at fixed azimuths give: `size` unknowns, a Dirichlet neighbour left of
+// the left column and right of the right column on every row, Neumann at top and bottom.
+processing::PoissonSystem rectanglePoissonSystem(cv::Size size);
+
+// Frame f's right-hand sides: smooth seam values of 0..60 levels at every Dirichlet neighbour,
+// scaled by 1.01^f and with noise of 0.2 levels: what a slow exposure drift gives.
+processing::ChannelValues seamRightHandSides(const processing::PoissonSystem& system, int frame);
+
+// CHOLMOD, the iterative solver and (where it applies) the rectangle solver, interleaved frame by
+// frame on one thread.
+std::vector<PoissonSolverTiming> benchmarkPoissonSolvers(const processing::PoissonSystem& system,
+                                                         const PoissonBenchmarkOptions& options);
+
+std::string formatPoissonTimings(cv::Size size, const std::vector<PoissonSolverTiming>& timings);
+
+}  // namespace surroundd::bench

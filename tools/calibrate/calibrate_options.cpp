@@ -1,0 +1,202 @@
+#include "tools/calibrate/calibrate_options.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <functional>
+#include <map>
+
+#include <fmt/format.h>
+
+namespace surroundd::calibrate {
+namespace {
+
+constexpr std::string_view kIntrinsicsUsage =
+    R"(usage: surround-calibrate intrinsics --images DIR --board COLSxROWS --model pinhole|fisheye
+                                  --out FILE [options]
+
+Intrinsics of one camera from a folder of checkerboard images (the board at many angles and all
+over the image). Prints the RMS and every image's reprojection error; writes the camera's lens:
+block in the rig schema (daemon/rig_yaml.hpp).
+
+  --images DIR               folder of images (.png .jpg .jpeg .bmp .tif .tiff .pgm .ppm), one
+                             camera, one resolution
+  --board COLSxROWS          the board's inner corners (where four squares meet), e.g. 9x6
+  --model MODEL              pinhole (radial-tangential, k1 k2 p1 p2 k3) or fisheye
+                             (Kannala-Brandt, k1..k4)
+  --out FILE                 the lens: block (YAML)
+  --residuals FILE           a PNG of every detected corner with its residual magnified
+  --field-of-view-deg D      fisheye: the lens's full field; default: as far as the images are lit
+  --update-rig FILE          also write the lens into this rig file (rewritten; comments are lost)
+  --camera NAME              with --update-rig: the camera to update
+)";
+
+constexpr std::string_view kExtrinsicsUsage =
+    R"(usage: surround-calibrate extrinsics --rig FILE --camera NAME --image FILE
+                                  (--markers FILE | --points FILE)... --out FILE [options]
+
+The pose of one camera on the vehicle from ground markers (checkerboards, ArUco) at known
+vehicle-frame positions, or from listed points with their pixels. Prints the reprojection error
+and the change from the rig's current mount; writes the camera's mount: block.
+
+  --rig FILE                 rig file with the camera's lens (and its current mount, used to tell
+                             boards of one pattern apart)
+  --camera NAME              the camera in the rig
+  --image FILE               the camera's image of the markers
+  --markers FILE             ground markers (YAML; see tools/calibrate/marker_file.hpp)
+  --points FILE              points with known pixels (YAML; see tools/calibrate/marker_file.hpp)
+  --out FILE                 the mount: block (YAML)
+  --residuals FILE           a PNG of the image with each point's residual magnified
+  --inlier-px X              points missing by more are outliers (default 3)
+  --update-rig               also write the mount into the rig file (rewritten; comments are lost)
+)";
+
+double parseDouble(std::string_view option, std::string_view text, double min, double max,
+                   std::string_view expected) {
+  double value = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (error != std::errc() || end != text.data() + text.size() || !std::isfinite(value) ||
+      value < min || value > max) {
+    throw UsageError(fmt::format("{}: expected {}, got '{}'", option, expected, text));
+  }
+  return value;
+}
+
+cv::Size parseBoard(std::string_view option, std::string_view text) {
+  const auto fail = [&] {
+    return UsageError(fmt::format(
+        "{}: expected COLSxROWS inner corners, each 2 to 64, one odd and one even so that the "
+        "board's two ends differ (e.g. 9x6), got '{}'",
+        option, text));
+  };
+  const auto x = text.find('x');
+  if (x == std::string_view::npos) throw fail();
+  int cols = 0, rows = 0;
+  const auto colsText = text.substr(0, x), rowsText = text.substr(x + 1);
+  const auto a = std::from_chars(colsText.data(), colsText.data() + colsText.size(), cols);
+  const auto b = std::from_chars(rowsText.data(), rowsText.data() + rowsText.size(), rows);
+  if (a.ec != std::errc() || a.ptr != colsText.data() + colsText.size() || b.ec != std::errc() ||
+      b.ptr != rowsText.data() + rowsText.size() || cols < 2 || rows < 2 || cols > 64 ||
+      rows > 64 || (cols + rows) % 2 == 0) {
+    throw fail();
+  }
+  return {cols, rows};
+}
+
+// Options that take a value: the handler gets it. Flags: the handler gets "".
+using Handlers = std::map<std::string_view, std::function<void(std::string_view)>>;
+
+void parseOptions(std::span<const std::string_view> arguments, const Handlers& valued,
+                  const Handlers& flags) {
+  for (std::size_t i = 0; i < arguments.size(); ++i) {
+    const std::string_view option = arguments[i];
+    if (const auto flag = flags.find(option); flag != flags.end()) {
+      flag->second("");
+    } else if (const auto handler = valued.find(option); handler != valued.end()) {
+      if (i + 1 >= arguments.size()) throw UsageError(fmt::format("{}: missing its value", option));
+      handler->second(arguments[++i]);
+    } else {
+      throw UsageError(fmt::format("unknown option '{}' (see --help)", option));
+    }
+  }
+}
+
+IntrinsicsOptions parseIntrinsics(std::span<const std::string_view> arguments) {
+  IntrinsicsOptions o;
+  bool model = false;
+  parseOptions(
+      arguments,
+      {{"--images", [&](auto v) { o.images = std::string(v); }},
+       {"--board", [&](auto v) { o.board = parseBoard("--board", v); }},
+       {"--model",
+        [&](auto v) {
+          if (v != "pinhole" && v != "fisheye") {
+            throw UsageError(fmt::format("--model: expected 'pinhole' or 'fisheye', got '{}'", v));
+          }
+          o.model =
+              v == "pinhole" ? processing::LensModel::kPinhole : processing::LensModel::kFisheye;
+          model = true;
+        }},
+       {"--out", [&](auto v) { o.out = std::string(v); }},
+       {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
+       {"--field-of-view-deg",
+        [&](auto v) {
+          o.fieldOfViewDeg = parseDouble("--field-of-view-deg", v, 1, 360, "degrees from 1 to 360");
+        }},
+       {"--update-rig", [&](auto v) { o.updateRig = std::string(v); }},
+       {"--camera", [&](auto v) { o.camera = std::string(v); }}},
+      {});
+  if (o.images.empty()) throw UsageError("--images: missing (the folder of checkerboard images)");
+  if (o.board.area() == 0) throw UsageError("--board: missing (inner corners, e.g. 9x6)");
+  if (!model) throw UsageError("--model: missing (pinhole or fisheye)");
+  if (o.out.empty()) throw UsageError("--out: missing (the file to write the lens: block to)");
+  if (o.fieldOfViewDeg && o.model != processing::LensModel::kFisheye) {
+    throw UsageError("--field-of-view-deg: only a fisheye lens takes it");
+  }
+  if (o.updateRig.has_value() != !o.camera.empty()) {
+    throw UsageError("--update-rig and --camera go together (the rig file and its camera)");
+  }
+  return o;
+}
+
+ExtrinsicsOptions parseExtrinsics(std::span<const std::string_view> arguments) {
+  ExtrinsicsOptions o;
+  parseOptions(arguments,
+               {{"--rig", [&](auto v) { o.rig = std::string(v); }},
+                {"--camera", [&](auto v) { o.camera = std::string(v); }},
+                {"--image", [&](auto v) { o.image = std::string(v); }},
+                {"--markers", [&](auto v) { o.markers = std::string(v); }},
+                {"--points", [&](auto v) { o.points = std::string(v); }},
+                {"--out", [&](auto v) { o.out = std::string(v); }},
+                {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
+                {"--inlier-px",
+                 [&](auto v) {
+                   o.inlierPx = parseDouble("--inlier-px", v, 0.1, 100, "pixels from 0.1 to 100");
+                 }}},
+               {{"--update-rig", [&](auto) { o.updateRig = true; }}});
+  if (o.rig.empty()) throw UsageError("--rig: missing (the rig file with the camera's lens)");
+  if (o.camera.empty()) throw UsageError("--camera: missing (the camera in the rig to calibrate)");
+  if (o.image.empty()) throw UsageError("--image: missing (the camera's image of the markers)");
+  if (!o.markers && !o.points) {
+    throw UsageError("--markers or --points: missing (what the camera sees, and where it is)");
+  }
+  if (o.out.empty()) throw UsageError("--out: missing (the file to write the mount: block to)");
+  return o;
+}
+
+bool asksForHelp(std::span<const std::string_view> arguments) {
+  return std::any_of(arguments.begin(), arguments.end(),
+                     [](auto a) { return a == "--help" || a == "-h"; });
+}
+
+}  // namespace
+
+Command parseArguments(std::span<const std::string_view> arguments) {
+  if (arguments.empty()) {
+    throw UsageError("missing the subcommand: intrinsics or extrinsics (see --help)");
+  }
+  const std::string_view subcommand = arguments.front();
+  const auto rest = arguments.subspan(1);
+  if (subcommand == "--help" || subcommand == "-h" || subcommand == "help") {
+    return HelpRequest{usage()};
+  }
+  if (subcommand == "intrinsics") {
+    if (asksForHelp(rest)) return HelpRequest{std::string(kIntrinsicsUsage)};
+    return parseIntrinsics(rest);
+  }
+  if (subcommand == "extrinsics") {
+    if (asksForHelp(rest)) return HelpRequest{std::string(kExtrinsicsUsage)};
+    return parseExtrinsics(rest);
+  }
+  throw UsageError(fmt::format(
+      "unknown subcommand '{}': expected intrinsics or extrinsics (see --help)", subcommand));
+}
+
+std::string usage() {
+  return fmt::format(
+      "surround-calibrate: camera calibration for surroundd.\n\n{}\n{}\n"
+      "exit status: 0 done, 1 calibration failed (too little in the images), 2 bad arguments or "
+      "input files\n",
+      kIntrinsicsUsage, kExtrinsicsUsage);
+}
+
+}  // namespace surroundd::calibrate

@@ -1,0 +1,59 @@
+#pragma once
+// Command line of surround-calibrate: one subcommand per calibration, each validated completely
+// before anything is read; a problem throws UsageError naming the option (main prints it and
+// exits 2).
+
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <variant>
+
+#include <opencv2/core.hpp>
+
+#include "processing/camera_model.hpp"
+
+namespace surroundd::calibrate {
+
+// Bad arguments or input files: what the user passed has to change (exit status 2).
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct IntrinsicsOptions {
+  std::filesystem::path images;  // folder of checkerboard images from one camera
+  cv::Size board;                // inner corners, columns x rows
+  processing::LensModel model = processing::LensModel::kPinhole;
+  std::filesystem::path out;                       // the lens: block
+  std::optional<std::filesystem::path> residuals;  // PNG
+  std::optional<double> fieldOfViewDeg;            // fisheye only; default: what the images show
+  std::optional<std::filesystem::path> updateRig;  // rig file whose camera gets the new lens
+  std::string camera;                              // with updateRig
+};
+
+struct ExtrinsicsOptions {
+  std::filesystem::path rig;  // lens and nominal mount of the camera
+  std::string camera;
+  std::filesystem::path image;
+  std::optional<std::filesystem::path> markers;    // ground marker layout
+  std::optional<std::filesystem::path> points;     // explicit vehicle point <-> pixel pairs
+  std::filesystem::path out;                       // the mount: block
+  std::optional<std::filesystem::path> residuals;  // PNG
+  double inlierPx = 3.0;
+  bool updateRig = false;  // write the new mount into the rig file
+};
+
+struct HelpRequest {
+  std::string text;
+};
+
+using Command = std::variant<IntrinsicsOptions, ExtrinsicsOptions, HelpRequest>;
+
+// `arguments` excludes the program name. Throws UsageError.
+Command parseArguments(std::span<const std::string_view> arguments);
+std::string usage();
+
+}  // namespace surroundd::calibrate

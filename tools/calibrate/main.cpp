@@ -1,0 +1,44 @@
+// surround-calibrate: camera intrinsics from checkerboard images, extrinsics from ground markers
+// (see --help).
+
+#include <iostream>
+#include <string_view>
+#include <vector>
+
+#include "daemon/yaml_reader.hpp"
+#include "processing/calibration_error.hpp"
+#include "tools/calibrate/calibrate_options.hpp"
+#include "tools/calibrate/extrinsics_command.hpp"
+#include "tools/calibrate/intrinsics_command.hpp"
+
+int main(int argc, char** argv) {
+  using namespace surroundd::calibrate;
+  const std::vector<std::string_view> arguments(argv + 1, argv + argc);
+  std::string_view subcommand = arguments.empty() ? "" : arguments.front();
+  const std::string prefix = subcommand == "intrinsics" || subcommand == "extrinsics"
+                                 ? "surround-calibrate " + std::string(subcommand) + ": "
+                                 : std::string("surround-calibrate: ");
+  try {
+    const Command command = parseArguments(arguments);
+    if (const auto* help = std::get_if<HelpRequest>(&command)) {
+      std::cout << help->text;
+    } else if (const auto* intrinsics = std::get_if<IntrinsicsOptions>(&command)) {
+      runIntrinsics(*intrinsics, std::cout);
+    } else {
+      runExtrinsics(std::get<ExtrinsicsOptions>(command), std::cout);
+    }
+    return 0;
+  } catch (const UsageError& error) {
+    std::cerr << prefix << error.what() << "\n";
+    return 2;
+  } catch (const surroundd::daemon::ConfigError& error) {
+    for (const auto& message : error.messages()) std::cerr << prefix << message << "\n";
+    return 2;
+  } catch (const surroundd::processing::CalibrationError& error) {
+    std::cerr << prefix << "calibration failed: " << error.what() << "\n";
+    return 1;
+  } catch (const std::exception& error) {
+    std::cerr << prefix << "failed: " << error.what() << "\n";
+    return 1;
+  }
+}
