@@ -136,9 +136,9 @@ int PoissonColourCorrection::update(std::span<const cv::Mat> frames) {
   for (std::size_t r = 0; r < regions_.size(); ++r) {
     const RegionState& state = regions_[r];
     std::copy(state.solution.begin(), state.solution.end(),
-              slots_.begin() + domain_.firstUnknownSlot[r] * 3);
+              slots_.begin() + static_cast<std::ptrdiff_t>(domain_.firstUnknownSlot[r]) * 3);
     std::copy(state.dirichlet.begin(), state.dirichlet.end(),
-              slots_.begin() + domain_.firstDirichletSlot[r] * 3);
+              slots_.begin() + static_cast<std::ptrdiff_t>(domain_.firstDirichletSlot[r]) * 3);
     iterations += state.iterations;
   }
   auto* field = field_.ptr<float>();
@@ -204,7 +204,9 @@ void PoissonColourCorrection::applyRows(int first, int last, cv::Mat& panorama,
         const float value =
             wx[0] * tap[c] + wx[1] * tap[3 + c] + wx[2] * tap[6 + c] + wx[3] * tap[9 + c];
         const float corrected = std::clamp(pixel[c] + weight * value, 0.0f, 255.0f);
-        pixel[c] = static_cast<std::uint8_t>(corrected + 0.5f);  // non-negative: truncation rounds
+        // Non-negative, so adding a half and truncating rounds (lround is a libm call per value).
+        pixel[c] =
+            static_cast<std::uint8_t>(corrected + 0.5f);  // NOLINT(bugprone-incorrect-roundings)
       }
     }
   }

@@ -3,6 +3,14 @@
 #include <fmt/format.h>
 
 namespace surroundd::processing {
+namespace {
+
+// Below this many unknowns CHOLMOD's solve is as fast as two warm V-cycles at tolerance 1e-4
+// (measured on one core: 0.05 against 0.08 ms at 1400 unknowns, even at 6000, 0.5 against
+// 0.4 ms at 8000, 2.6 against 1.4 ms at 23000), and it is exact.
+constexpr std::size_t kDirectBelowUnknowns = 6000;
+
+}  // namespace
 
 std::string_view poissonSolverName(PoissonSolverKind kind) {
   switch (kind) {
@@ -29,14 +37,19 @@ std::unique_ptr<PoissonSolver> makePoissonSolver(PoissonSolverKind kind,
     case PoissonSolverKind::kAuto:
       break;
   }
-  // The rectangle solver where it applies (exact, and the fastest); the iterative one elsewhere.
+  // The rectangle solver where it applies (exact, and the fastest); elsewhere CHOLMOD on small
+  // regions and the iterative solver on large ones.
   const std::string mismatch = rectangleSolverMismatch(system);
   if (mismatch.empty()) return makeRectangleSolver(system);
-  std::unique_ptr<PoissonSolver> solver = makeIterativeSolver(system, tolerance);
+  const bool small = system.unknowns() < kDirectBelowUnknowns;
+  std::unique_ptr<PoissonSolver> solver =
+      small ? makeCholmodSolver(system) : makeIterativeSolver(system, tolerance);
+  const std::string_view choice =
+      small ? "CHOLMOD (exact, and as fast on a region this small)" : "the iterative solver";
   solver->selectionNote_ =
       kind == PoissonSolverKind::kRectangle
-          ? fmt::format("rectangle solver asked for, but {}: using the iterative solver", mismatch)
-          : fmt::format("{}: auto uses the iterative solver", mismatch);
+          ? fmt::format("rectangle solver asked for, but {}: using {}", mismatch, choice)
+          : fmt::format("{}: auto uses {}", mismatch, choice);
   return solver;
 }
 

@@ -10,9 +10,10 @@
 //   rectangle  exact and fastest, for the region that fixed-azimuth seams make: the unknowns fill
 //              a full rectangle, seams (Dirichlet) along its left and right columns, Neumann at
 //              top and bottom. A DCT along y separates it into tridiagonal systems along x.
-// auto takes the rectangle solver where it applies, else the iterative one: measured on one core
-// of the 2-core desk machine (tools/bench/poisson_benchmark), per frame at 128x256 and 512x256,
-// CHOLMOD 2.6 / 19 ms, iterative (1e-4, warm) 1.7 / 6.8 ms, rectangle 0.4 / 2.0 ms.
+// auto takes the rectangle solver where it applies, else CHOLMOD below 6000 unknowns and the
+// iterative solver above: measured on one core of the 2-core desk machine
+// (tools/bench/poisson_benchmark), per frame at 128x256 and 512x256, CHOLMOD 2.6 / 19 ms,
+// iterative (1e-4, warm) 1.6 / 6.7 ms, rectangle 0.4 / 1.9 ms.
 
 #include <memory>
 #include <span>
@@ -38,7 +39,7 @@ class PoissonSolver;
 // Builds the solver of `kind` for `system` (it keeps what it needs: the system may go after this
 // returns). `tolerance` is the relative residual at which the iterative solver stops (1e-4 keeps
 // the field of a compact region within 0.01 levels of the exact one); the direct solvers are exact.
-// kRectangle on a system that is not the rectangle falls back to the iterative solver, and
+// kRectangle on a system that is not the rectangle falls back to what auto takes there, and
 // selectionNote() says why. Throws std::invalid_argument for an inconsistent system and
 // std::runtime_error when the matrix is not positive definite (a part of the region without a
 // Dirichlet neighbour).

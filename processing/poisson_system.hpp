@@ -26,7 +26,7 @@ struct PoissonSystem {
   // +-180 degree column without a break, y from 0 at the region's top row. Row-major order.
   cv::Size size;
   std::vector<cv::Point> pixels;
-  std::vector<int> degree;               // per unknown: neighbours that are unknowns or Dirichlet
+  std::vector<int> degree;                 // per unknown: neighbours that are unknowns or Dirichlet
   std::vector<std::pair<int, int>> links;  // unknown 4-neighbours (i < j), each pair once
 
   std::size_t unknowns() const { return pixels.size(); }

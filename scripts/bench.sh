@@ -1,8 +1,8 @@
 #!/bin/sh
 # The benchmarks: installs what is missing, builds (release), makes the benchmark recordings (the
 # paper rig at 4 x 854x480, 1280x720 and 1920x1080, with ground truth; once, then cached in
-# recordings/bench/), and runs surround-bench on them. Extra arguments go to surround-bench, e.g.
-# --json, --threads 1, --repeats 100.
+# recordings/bench/), and runs surround-bench stitch and colour on them. Extra arguments go to
+# surround-bench, e.g. --threads 1, --repeats 100; --json (first) prints stitch's JSON only.
 set -eu
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -18,5 +18,9 @@ done <<INPUTS
 720p 1280x720 1536x768
 1080p 1920x1080 2048x1024
 INPUTS
-exec build/release/tools/bench/surround-bench stitch "$@" \
-  recordings/bench/480p recordings/bench/720p recordings/bench/1080p
+# surround-bench stitch, then colour; extra arguments go to both (--json to stitch only).
+inputs="recordings/bench/480p recordings/bench/720p recordings/bench/1080p"
+build/release/tools/bench/surround-bench stitch "$@" $inputs
+if [ "${1:-}" != "--json" ]; then
+  build/release/tools/bench/surround-bench colour "$@" $inputs
+fi

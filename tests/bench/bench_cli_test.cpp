@@ -42,7 +42,7 @@ TEST(BenchCli, BadCommandLinesAreUsageErrors) {
   const testing::TempDir dir;
   for (const auto& [arguments, message] :
        {std::pair{std::vector<std::string>{"stitch"}, "no recording given"},
-        std::pair{std::vector<std::string>{"stich", kRecording}, "expected 'stitch'"},
+        std::pair{std::vector<std::string>{"stich", kRecording}, "expected 'stitch' or 'colour'"},
         std::pair{std::vector<std::string>{"stitch", "--threads", "0", kRecording},
                   "--threads needs a number from 1 to 256"},
         std::pair{std::vector<std::string>{"stitch", "--fast", kRecording},

@@ -370,28 +370,42 @@ TEST(PoissonSolver, IterativeStartsFromThePreviousSolution) {
   }
 }
 
-TEST(PoissonSolver, AutoTakesTheRectangleSolverWhereItApplies) {
-  const Problem rectangle = buildProblem(rectangleCanvas({64, 48}));
-  auto solver = makePoissonSolver(PoissonSolverKind::kAuto, rectangle.system, kTolerance);
-  EXPECT_EQ(solver->kind(), PoissonSolverKind::kRectangle);
-  EXPECT_EQ(solver->name(), "rectangle");
-  EXPECT_TRUE(solver->selectionNote().empty());
-
-  const Problem irregular = buildProblem(irregularCanvas({64, 48}));
-  solver = makePoissonSolver(PoissonSolverKind::kAuto, irregular.system, kTolerance);
-  EXPECT_EQ(solver->kind(), PoissonSolverKind::kIterative);
-  EXPECT_NE(solver->selectionNote().find("auto uses the iterative solver"), std::string::npos)
-      << solver->selectionNote();
+TEST(PoissonSolver, AutoTakesTheFastestSolverThatApplies) {
+  // Returns the unknowns, to check which side of the size threshold the region is.
+  const auto expectAuto = [](const Canvas& canvas, PoissonSolverKind kind,
+                             const std::string& note) {
+    const Problem problem = buildProblem(canvas);
+    const auto solver = makePoissonSolver(PoissonSolverKind::kAuto, problem.system, kTolerance);
+    EXPECT_EQ(solver->kind(), kind);
+    if (note.empty()) EXPECT_EQ(solver->selectionNote(), "");
+    if (!note.empty()) EXPECT_NE(solver->selectionNote().find(note), std::string::npos) << note;
+    return problem.system.unknowns();
+  };
+  expectAuto(rectangleCanvas({64, 48}), PoissonSolverKind::kRectangle, "");
+  EXPECT_LT(expectAuto(irregularCanvas({64, 48}), PoissonSolverKind::kCholmod, "auto uses CHOLMOD"),
+            6000u);
+  EXPECT_GE(expectAuto(irregularCanvas({160, 64}), PoissonSolverKind::kIterative,
+                       "auto uses the iterative solver"),
+            6000u);
 }
 
 TEST(PoissonSolver, RectangleRequestFallsBackAndSaysWhy) {
-  const Problem irregular = buildProblem(irregularCanvas({64, 48}));
-  auto solver = makePoissonSolver(PoissonSolverKind::kRectangle, irregular.system, kTolerance);
+  Canvas canvas = rectangleCanvas({100, 80});
+  for (int y = 5; y < 9; ++y) canvas.at(0, y) = Cell::kOutside;  // rows without a left seam
+  const Problem problem = buildProblem(canvas);
+  auto solver = makePoissonSolver(PoissonSolverKind::kRectangle, problem.system, kTolerance);
   EXPECT_EQ(solver->kind(), PoissonSolverKind::kIterative);
-  const std::string& note = solver->selectionNote();
-  EXPECT_NE(note.find("rectangle solver asked for"), std::string::npos) << note;
-  EXPECT_NE(note.find("using the iterative solver"), std::string::npos) << note;
-  EXPECT_THROW(makeRectangleSolver(irregular.system), std::invalid_argument);
+  EXPECT_EQ(solver->selectionNote(),
+            "rectangle solver asked for, but row 5 of 80 has no seam (Dirichlet neighbour) on its "
+            "left side; the rectangle solver needs seams along the whole left and right columns: "
+            "using the iterative solver");
+  EXPECT_THROW(makeRectangleSolver(problem.system), std::invalid_argument);
+
+  const Problem small = buildProblem(irregularCanvas({40, 30}));
+  solver = makePoissonSolver(PoissonSolverKind::kRectangle, small.system, kTolerance);
+  EXPECT_EQ(solver->kind(), PoissonSolverKind::kCholmod);
+  EXPECT_NE(solver->selectionNote().find("do not fill the region's"), std::string::npos)
+      << solver->selectionNote();
 }
 
 TEST(PoissonSolver, RectangleMismatchNamesTheProblem) {

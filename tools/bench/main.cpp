@@ -2,6 +2,7 @@
 // milliseconds, with ratios against a baseline measured in the same run.
 //
 //   surround-bench stitch [--threads N] [--repeats N] [--json] RECORDING...
+//   surround-bench colour [--threads N] [--repeats N] RECORDING...
 //
 // Exit codes: 0 done, 1 failed while measuring, 2 bad command line.
 
@@ -12,17 +13,21 @@
 
 #include <fmt/format.h>
 
+#include "tools/bench/colour_benchmark.hpp"
 #include "tools/bench/stitch_benchmark.hpp"
 
 namespace {
 
 constexpr std::string_view kUsage =
     R"(usage: surround-bench stitch [--threads N] [--repeats N] [--json] RECORDING...
+       surround-bench colour [--threads N] [--repeats N] RECORDING...
+  stitch        LUT build, stitch against cv::remap, accuracy against the ground truth
+  colour        Poisson colour correction: solvers, per-frame cost, seam colour error
   RECORDING     a surround-synth recording folder (with ground truth); scripts/bench.sh makes
                 4x480p, 720p and 1080p ones
   --threads N   threads for the stitcher and cv::remap (default 2); 1 thread is measured too
   --repeats N   timed runs per candidate, median reported (default 30)
-  --json        one JSON object on stdout instead of the text table
+  --json        stitch: one JSON object on stdout instead of the text table
 )";
 
 int usageError(std::string_view message) {
@@ -43,7 +48,10 @@ int main(int argc, char** argv) {
     fmt::print("{}", kUsage);
     return 0;
   }
-  if (argc < 2 || std::string_view(argv[1]) != "stitch") return usageError("expected 'stitch'");
+  const std::string_view command = argc >= 2 ? argv[1] : "";
+  if (command != "stitch" && command != "colour") {
+    return usageError("expected 'stitch' or 'colour'");
+  }
   StitchBenchmarkOptions options;
   for (int i = 2; i < argc; ++i) {
     const std::string_view arg = argv[i];
@@ -62,6 +70,10 @@ int main(int argc, char** argv) {
   }
   if (options.recordings.empty()) return usageError("no recording given");
   try {
+    if (command == "colour") {
+      return surroundd::bench::runColourBenchmark(
+          {options.recordings, options.threads, options.repeats});
+    }
     return surroundd::bench::runStitchBenchmark(options);
   } catch (const std::exception& e) {
     fmt::print(stderr, "surround-bench: {}\n", e.what());

@@ -1,0 +1,108 @@
+#include "tools/bench/colour_benchmark.hpp"
+
+#include <cstdio>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "capture/file_source.hpp"
+#include "common/work_pool.hpp"
+#include "processing/gain_compensation.hpp"
+#include "processing/poisson_correction.hpp"
+#include "processing/stitcher.hpp"
+#include "tools/bench/panorama_accuracy.hpp"
+#include "tools/bench/poisson_benchmark.hpp"
+#include "tools/bench/recording_truth.hpp"
+#include "tools/bench/timing.hpp"
+
+namespace surroundd::bench {
+namespace {
+
+// The first frame of each camera's video: the cameras' real photometrics.
+std::vector<cv::Mat> firstVideoFrames(const RecordingTruth& truth) {
+  std::vector<cv::Mat> frames;
+  for (const auto& video : truth.videos) {
+    capture::FileSource source("bench", {video, 30.0, false, capture::Pacing::kAsFastAsPossible});
+    capture::Frame frame;
+    frame.image.create(source.frameSize(), CV_8UC3);
+    if (source.read(frame) != capture::ReadStatus::kFrame) {
+      throw std::runtime_error(fmt::format("cannot read a frame of {}", video.string()));
+    }
+    frames.push_back(frame.image);
+  }
+  return frames;
+}
+
+void measure(const std::filesystem::path& folder, const ColourBenchmarkOptions& options) {
+  const RecordingTruth truth = loadRecordingTruth(folder);
+  WorkPool pool(options.threads);
+  processing::PanoramaSettings settings;
+  settings.geometry = truth.panorama;
+  const processing::PanoramaLut lut = processing::buildPanoramaLut(truth.rig, settings, pool);
+  processing::Stitcher stitcher(lut, pool);
+  const std::vector<cv::Mat> frames = firstVideoFrames(truth);
+  cv::Mat raw;
+  stitcher.stitch(frames, raw);
+  const synth::Scene scene(truth.seed, truth.seconds);
+  const cv::Mat ground = trueGroundMask(scene, truth.frames.front().pose, settings);
+  const auto seamError = [&](const cv::Mat& panorama) {
+    return seamColourError(panorama, frames, truth.rig, settings, lut, ground);
+  };
+
+  const cv::Size camera = truth.rig.cameras.front().intrinsics.imageSize;
+  fmt::print("{}: 4 x {}x{} -> panorama {}x{}\n", folder.filename().string(), camera.width,
+             camera.height, lut.size.width, lut.size.height);
+  processing::GainCompensation gains(lut, pool);
+  gains.update(frames);
+  cv::Mat gained = raw.clone();
+  gains.apply(gained);
+  fmt::print(
+      "  colour step across the seams (true ground): {:.2f} levels uncorrected, {:.2f} with "
+      "gain compensation\n",
+      seamError(raw), seamError(gained));
+
+  for (const double scale : {0.25, 0.125}) {
+    processing::ColourCorrectionSettings correctionSettings;
+    correctionSettings.scale = scale;
+    std::unique_ptr<processing::PoissonColourCorrection> correction;
+    const double setupMs = millisecondsOf([&] {
+      correction = std::make_unique<processing::PoissonColourCorrection>(truth.rig, settings, lut,
+                                                                         correctionSettings, pool);
+    });
+    const auto& region = correction->domain().regions.front();
+    fmt::print("  scale {:g}: {} regions, set-up {:.1f} ms (domain, solvers); solver '{}'\n", scale,
+               correction->domain().regions.size(), setupMs, correction->solverNames());
+    PoissonBenchmarkOptions solverOptions;
+    solverOptions.repeats = options.repeats;
+    fmt::print("    the front region ({} unknowns in {}x{}):\n{}", region.system.unknowns(),
+               region.system.size.width, region.system.size.height,
+               formatPoissonTimings(region.system.size,
+                                    benchmarkPoissonSolvers(region.system, solverOptions)));
+    const processing::PoissonSystem rectangle = rectanglePoissonSystem(region.system.size);
+    fmt::print(
+        "    the {}x{} rectangle that fixed-azimuth seams give:\n{}", rectangle.size.width,
+        rectangle.size.height,
+        formatPoissonTimings(rectangle.size, benchmarkPoissonSolvers(rectangle, solverOptions)));
+    cv::Mat corrected = raw.clone();
+    const auto medians = interleavedMedians(
+        {[&] { correction->update(frames); }, [&] { correction->apply(corrected); }},
+        options.repeats);
+    raw.copyTo(corrected);
+    correction->apply(corrected);
+    fmt::print(
+        "    per frame, {} threads: seam data + solve {:.2f} ms, upsample and apply {:.2f} ms; "
+        "colour step across the seams {:.2f} levels\n",
+        options.threads, medians[0], medians[1], seamError(corrected));
+  }
+  fmt::print("\n");
+}
+
+}  // namespace
+
+int runColourBenchmark(const ColourBenchmarkOptions& options) {
+  fmt::print("surround-bench colour: Poisson local colour correction (medians, same run)\n\n");
+  for (const auto& folder : options.recordings) measure(folder, options);
+  return 0;
+}
+
+}  // namespace surroundd::bench
