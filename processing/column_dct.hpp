@@ -5,8 +5,12 @@
 // columns: Makhoul's reordering turns a DCT-II into a complex FFT of the same length, two columns
 // packed as the real and imaginary parts of one signal; the FFT is a mixed-radix Stockham FFT
 // (radices 4, 2, and any odd factor). Any length works; lengths with only small factors are
-// fast. Set up once; forward() and inverse() allocate nothing (cv::dct allocates its tables on
-// every call, and does not do odd lengths).
+// fast. Set up once; forward() and inverse() allocate nothing.
+//
+// Why not cv::dct: at 256 rows x 384 columns, one core, this forward transform takes 0.08 ms,
+// cv::dct (DCT_ROWS on the transposed block) 0.27 ms plus two transposes, a product with the
+// precomputed cosine matrix 1.9 ms; and cv::dct allocates its tables on every call and refuses
+// odd lengths.
 
 #include <cstddef>
 #include <vector>

@@ -28,7 +28,7 @@ namespace surroundd::processing {
 struct ColourCorrectionSettings {
   double scale = 0.25;  // the field's resolution against the panorama's (1 / block size)
   PoissonSolverKind solver = PoissonSolverKind::kAuto;
-  double tolerance = 1e-3;         // iterative solvers: relative residual
+  double tolerance = 1e-4;         // iterative solver: relative residual
   double temporalSmoothing = 0.0;  // weight of the previous frame's seam data, 0..0.99
 };
 

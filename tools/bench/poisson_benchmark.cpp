@@ -69,6 +69,7 @@ std::vector<PoissonSolverTiming> benchmarkPoissonSolvers(const PoissonSystem& sy
   std::vector<ChannelValues> solutions(kinds.size(), ChannelValues(3 * system.unknowns(), 0.0f));
   for (std::size_t s = 0; s < kinds.size(); ++s) {
     timings[s].kind = kinds[s];
+    timings[s].unknowns = system.unknowns();
     timings[s].setupMs = millisecondsOf(
         [&] { solvers[s] = processing::makePoissonSolver(kinds[s], system, options.tolerance); });
   }
@@ -109,8 +110,9 @@ std::vector<PoissonSolverTiming> benchmarkPoissonSolvers(const PoissonSystem& sy
 }
 
 std::string formatPoissonTimings(cv::Size size, const std::vector<PoissonSolverTiming>& timings) {
+  const std::size_t unknowns = timings.empty() ? 0 : timings.front().unknowns;
   std::string text = fmt::format("Poisson system {}x{} ({} unknowns, 3 channels), 1 thread\n",
-                                 size.width, size.height, size.area());
+                                 size.width, size.height, unknowns);
   text += fmt::format("  {:<10} {:>10} {:>10} {:>6} {:>10} {:>6} {:>10} {:>10}\n", "solver",
                       "set-up ms", "cold ms", "iter", "warm ms", "iter", "residual", "vs cholmod");
   for (const auto& t : timings) {

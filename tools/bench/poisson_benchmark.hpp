@@ -4,6 +4,7 @@
 // warm-started on a slowly changing sequence of right-hand sides (as frames give them),
 // iterations, residual, and agreement with CHOLMOD.
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,7 @@ struct PoissonBenchmarkOptions {
 
 struct PoissonSolverTiming {
   processing::PoissonSolverKind kind = processing::PoissonSolverKind::kCholmod;
+  std::size_t unknowns = 0;  // of the system measured
   double setupMs = 0;
   double coldSolveMs = 0;          // from x = 0
   double warmSolveMs = 0;          // median over frames, started from the previous frame's solution
@@ -44,6 +46,7 @@ processing::ChannelValues seamRightHandSides(const processing::PoissonSystem& sy
 std::vector<PoissonSolverTiming> benchmarkPoissonSolvers(const processing::PoissonSystem& system,
                                                          const PoissonBenchmarkOptions& options);
 
+// A text table; `size` is the region's frame.
 std::string formatPoissonTimings(cv::Size size, const std::vector<PoissonSolverTiming>& timings);
 
 }  // namespace surroundd::bench
