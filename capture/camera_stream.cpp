@@ -36,11 +36,12 @@ void CameraStream::run() {
   while (!stopping_) {
     FrameRef frame = pool_.acquire(kPoolWait);
     if (!frame) continue;
+    const auto readStart = std::chrono::steady_clock::now();
     const ReadStatus status = source_->read(*frame);
     if (status == ReadStatus::kFrame) {
       consecutiveFaults = 0;
       frame->sequence = sequence++;
-      push(std::move(frame));
+      push(std::move(frame), std::chrono::steady_clock::now() - readStart);
       continue;
     }
     if (status == ReadStatus::kFault) {
@@ -65,13 +66,14 @@ void CameraStream::run() {
   ready_.notify_all();
 }
 
-void CameraStream::push(FrameRef frame) {
+void CameraStream::push(FrameRef frame, std::chrono::nanoseconds readTime) {
   {
     const std::lock_guard lock(mutex_);
     // Never full: the queue has a slot for every buffer of the pool.
     queue_[(head_ + size_) % queue_.size()] = std::move(frame);
     ++size_;
     ++stats_.frames;
+    stats_.readTime += readTime;
   }
   ready_.notify_one();
 }

@@ -11,6 +11,7 @@
 // state it shares with the consumer.
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
@@ -25,6 +26,9 @@ namespace surroundd::capture {
 struct CameraStreamStats {
   std::uint64_t frames = 0;  // delivered to the queue
   std::uint64_t faults = 0;  // reads that failed
+  // Spent in the source's read() for the delivered frames: decoding and conversion, and in a
+  // real-time replay the wait for each frame's time.
+  std::chrono::nanoseconds readTime{0};
 };
 
 class CameraStream {
@@ -51,7 +55,7 @@ class CameraStream {
 
  private:
   void run();
-  void push(FrameRef frame);
+  void push(FrameRef frame, std::chrono::nanoseconds readTime);
 
   std::string name_;
   std::unique_ptr<FrameSource> source_;

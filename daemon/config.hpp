@@ -6,6 +6,7 @@
 // part that consumes them exists (processing/ and render/ never see YAML).
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,10 @@
 #include "daemon/rig_yaml.hpp"
 #include "processing/panorama_lut.hpp"
 #include "processing/poisson_solver.hpp"
+#include "processing/surround_mesh.hpp"
+#include "render/car_model.hpp"
+#include "render/egl_context.hpp"
+#include "render/view_camera.hpp"
 
 namespace surroundd::daemon {
 
@@ -63,7 +68,7 @@ struct ColourCorrectionConfig {
   bool operator==(const ColourCorrectionConfig&) const = default;
 };
 
-enum class MeshModel { kFlat, kSphere360, kBowl };
+using processing::MeshModel;
 
 struct MeshConfig {
   MeshModel model = MeshModel::kBowl;
@@ -78,25 +83,30 @@ struct MeshConfig {
   bool operator==(const MeshConfig&) const = default;
 };
 
-enum class ViewKind { kTop, kPanorama360, kOrbit, kSplit };
+using render::ViewKind;
 
 struct RenderConfig {
-  ViewKind view = ViewKind::kOrbit;
-  int widthPx = 1280;
+  ViewKind view = ViewKind::kOrbit;  // of surround outputs that do not name their own
+  int widthPx = 1280;                // the size of surround and mosaic outputs
   int heightPx = 720;
+  render::EglPlatform platform = render::EglPlatform::kAuto;
+  render::ViewSettings views;
+  std::string splitCamera;  // the camera beside the 3D view in the split view; empty: the first
+  render::CarDimensions car;
 
   bool operator==(const RenderConfig&) const = default;
 };
 
-// What an output shows: the labelled camera grid, or the stitched panorama. The surround views
-// come with render/.
-enum class OutputStream { kMosaic, kPanorama };
+// What an output shows: the labelled camera grid, the stitched panorama, or the rendered
+// surround view.
+enum class OutputStream { kMosaic, kPanorama, kSurround };
 enum class OutputKind { kVideo, kSnapshot };
 
 struct OutputConfig {
   OutputKind kind = OutputKind::kVideo;
   OutputStream stream = OutputStream::kMosaic;
-  std::filesystem::path path;  // parent folders are created at start
+  std::filesystem::path path;    // parent folders are created at start
+  std::optional<ViewKind> view;  // surround: the view it starts with; default render.view
   // video
   int crf = 23;
   std::string preset = "veryfast";

@@ -1,5 +1,8 @@
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <set>
+#include <span>
 
 #include <fmt/format.h>
 
@@ -119,16 +122,40 @@ void readMesh(YamlObject& section, MeshConfig& m) {
   section.finish();
 }
 
+constexpr std::array<std::pair<std::string_view, ViewKind>, 4> kViews{{
+    {"top", ViewKind::kTop},
+    {"360", ViewKind::kPanorama360},
+    {"orbit", ViewKind::kOrbit},
+    {"split", ViewKind::kSplit},
+}};
+
 void readRender(YamlObject& section, RenderConfig& r) {
   r.view = section.choice("view", r.view,
-                          {{"top", ViewKind::kTop},
-                           {"360", ViewKind::kPanorama360},
-                           {"orbit", ViewKind::kOrbit},
-                           {"split", ViewKind::kSplit}});
+                          std::span<const std::pair<std::string_view, ViewKind>>(kViews));
   r.widthPx = section.integer("width_px", r.widthPx, 64, 7680);
   r.heightPx = section.integer("height_px", r.heightPx, 64, 4320);
   requireEven(section, "width_px", r.widthPx);
   requireEven(section, "height_px", r.heightPx);
+  r.platform = section.choice("platform", r.platform,
+                              {{"auto", render::EglPlatform::kAuto},
+                               {"device", render::EglPlatform::kDevice},
+                               {"surfaceless", render::EglPlatform::kSurfaceless},
+                               {"default", render::EglPlatform::kDefault}});
+  const NumberRange distance{0.5, 100.0, false, "metres"};
+  auto& v = r.views;
+  v.topRangeM = section.number("top_range_m", v.topRangeM, distance);
+  v.topHeightM = section.number("top_height_m", v.topHeightM, distance);
+  v.orbitRadiusM = section.number("orbit_radius_m", v.orbitRadiusM, distance);
+  v.orbitHeightM = section.number("orbit_height_m", v.orbitHeightM, distance);
+  v.orbitPeriodS =
+      section.number("orbit_period_s", v.orbitPeriodS, {0.5, 3600.0, false, "seconds"});
+  v.orbitFovDeg = section.number("orbit_fov_deg", v.orbitFovDeg, {10.0, 150.0, false, "degrees"});
+  v.stripTopDeg = section.number("strip_top_deg", v.stripTopDeg, {-60.0, 60.0, false, "degrees"});
+  r.splitCamera = section.string("split_camera", r.splitCamera);
+  const NumberRange size{0.5, 30.0, false, "metres"};
+  r.car.lengthM = section.number("car_length_m", r.car.lengthM, size);
+  r.car.widthM = section.number("car_width_m", r.car.widthM, size);
+  r.car.heightM = section.number("car_height_m", r.car.heightM, {0.3, 10.0, false, "metres"});
   section.finish();
 }
 
@@ -137,9 +164,18 @@ OutputConfig readOutput(YamlObject& item) {
   o.kind = item.choice("type", o.kind,
                        {{"video", OutputKind::kVideo}, {"snapshot", OutputKind::kSnapshot}});
   if (!item.has("type")) item.errorHere("missing key 'type' (one of 'video' 'snapshot')");
-  o.stream =
-      item.choice("stream", o.stream,
-                  {{"mosaic", OutputStream::kMosaic}, {"panorama", OutputStream::kPanorama}});
+  o.stream = item.choice("stream", o.stream,
+                         {{"mosaic", OutputStream::kMosaic},
+                          {"panorama", OutputStream::kPanorama},
+                          {"surround", OutputStream::kSurround}});
+  if (item.has("view")) {
+    if (o.stream == OutputStream::kSurround) {
+      o.view = item.choice("view", ViewKind::kOrbit,
+                           std::span<const std::pair<std::string_view, ViewKind>>(kViews));
+    } else {
+      item.error("view", "only a surround output has a view");
+    }
+  }
   o.path = item.outputPath("path").value_or("");
   const auto extension = o.path.extension().string();
   if (o.kind == OutputKind::kVideo) {
@@ -204,7 +240,15 @@ Config loadConfig(const std::filesystem::path& file) {
     }
   }
   readSection("mesh", [&](YamlObject& s) { readMesh(s, config.mesh); });
-  readSection("render", [&](YamlObject& s) { readRender(s, config.render); });
+  readSection("render", [&](YamlObject& s) {
+    readRender(s, config.render);
+    const auto& split = config.render.splitCamera;
+    if (!split.empty() && std::ranges::none_of(config.cameras, [&](const RigCamera& c) {
+          return c.calibration.name == split;
+        })) {
+      s.error("split_camera", fmt::format("no camera is named '{}'", split));
+    }
+  });
   std::set<std::filesystem::path> paths;
   for (auto& item : root.objectList("outputs", 1, 32)) {
     auto output = readOutput(item);

@@ -43,6 +43,12 @@ processing::PanoramaSettings panoramaSettings(const Config& config) {
   return settings;
 }
 
+processing::MeshSettings meshSettings(const Config& config) {
+  return {config.mesh.model,         config.mesh.flatRadiusM,
+          config.mesh.sphereRadiusM, panoramaSettings(config).bowl,
+          config.mesh.rings,         config.mesh.segments};
+}
+
 std::filesystem::path lutCacheDir(const Config& config) {
   if (!config.panorama.cacheDir.empty()) return config.panorama.cacheDir;
   if (const char* state = environment("STATE_DIRECTORY")) return state;

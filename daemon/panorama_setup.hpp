@@ -6,6 +6,7 @@
 
 #include "daemon/config.hpp"
 #include "processing/panorama_lut.hpp"
+#include "processing/surround_mesh.hpp"
 
 namespace surroundd {
 class WorkPool;
@@ -18,6 +19,9 @@ processing::Rig rigOf(const Config& config);
 // The panorama is seen from (0, 0, mean camera height): the rig's virtual centre, where the
 // generator's ground truth is rendered from too.
 processing::PanoramaSettings panoramaSettings(const Config& config);
+
+// The render mesh: mesh.*, with the bowl of the panorama's projection.
+processing::MeshSettings meshSettings(const Config& config);
 
 // panorama.cache_dir, or the default it documents.
 std::filesystem::path lutCacheDir(const Config& config);

@@ -65,6 +65,12 @@ std::unique_ptr<render::FrameSink> openSink(const OutputConfig& output, cv::Size
 
 }  // namespace
 
+const char* toString(Stage stage) {
+  constexpr std::array<const char*, static_cast<std::size_t>(Stage::kCount)> kNames{
+      "sync", "mosaic", "stitch", "correct", "render", "read-back", "output"};
+  return kNames.at(static_cast<std::size_t>(stage));
+}
+
 Pipeline::Pipeline(const Config& config)
     : cameras_(openCameras(config)),
       synchronizer_(cameras_.size(),
@@ -73,11 +79,10 @@ Pipeline::Pipeline(const Config& config)
       pool_(config.pipeline.threads),
       mosaic_(cv::Size(config.render.widthPx, config.render.heightPx), cameraNames(config)),
       canvas_(mosaic_.outputSize(), CV_8UC3, cv::Scalar::all(0)) {
-  const bool wantPanorama = std::ranges::any_of(
-      config.outputs, [](const auto& o) { return o.stream == OutputStream::kPanorama; });
-  wantMosaic_ = std::ranges::any_of(
-      config.outputs, [](const auto& o) { return o.stream == OutputStream::kMosaic; });
-  if (wantPanorama) {
+  const auto shows = [&](OutputStream stream) {
+    return std::ranges::any_of(config.outputs, [&](const auto& o) { return o.stream == stream; });
+  };
+  if (shows(OutputStream::kPanorama) || shows(OutputStream::kSurround)) {
     lut_ = std::make_unique<processing::PanoramaLut>(obtainPanoramaLut(config, pool_));
     stitcher_ = std::make_unique<processing::Stitcher>(*lut_, pool_);
     panorama_.create(lut_->size, CV_8UC3);
@@ -88,11 +93,19 @@ Pipeline::Pipeline(const Config& config)
     stitchInputs_.resize(cameras_.size());
     setUpColourCorrection(config);
   }
+  if (shows(OutputStream::kSurround)) setUpSurround(config);
   const double nominalFps = 1e9 / static_cast<double>(cameras_.front()->nominalPeriod().count());
   for (const auto& output : config.outputs) {
     const cv::Size size =
         output.stream == OutputStream::kPanorama ? lut_->size : mosaic_.outputSize();
-    outputs_.push_back({output.stream, openSink(output, size, nominalFps)});
+    Output out;
+    out.stream = output.stream;
+    out.sink = openSink(output, size, nominalFps);
+    if (output.stream == OutputStream::kSurround) {
+      out.view = std::make_unique<render::SurroundView>(
+          *scene_, size, output.view.value_or(config.render.view), config.render.views);
+    }
+    outputs_.push_back(std::move(out));
   }
 }
 
@@ -113,11 +126,39 @@ void Pipeline::setUpColourCorrection(const Config& config) {
   }
 }
 
+void Pipeline::setUpSurround(const Config& config) {
+  gl_ = std::make_unique<render::EglContext>(config.render.platform);
+  spdlog::info("render: {}", gl_->description());
+  const processing::PanoramaSettings panorama = panoramaSettings(config);
+  processing::SurroundMesh mesh;
+  try {
+    mesh = processing::buildSurroundMesh(meshSettings(config), panorama.geometry);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(fmt::format("{}: {}", config.file.string(), e.what()));
+  }
+  const auto names = cameraNames(config);
+  const auto split = std::ranges::find(names, config.render.splitCamera);
+  splitCamera_ = split == names.end() ? 0 : static_cast<std::size_t>(split - names.begin());
+  scene_ = std::make_unique<render::SurroundScene>(mesh, panorama.geometry, config.render.car,
+                                                   lut_->cameraSizes.at(splitCamera_));
+  spdlog::info("render: {} mesh of {} triangles, split view shows '{}'",
+               config.mesh.model == MeshModel::kBowl   ? "bowl"
+               : config.mesh.model == MeshModel::kFlat ? "flat"
+                                                       : "sphere360",
+               mesh.indices.size() / 3, names[splitCamera_]);
+}
+
 const cv::Mat& Pipeline::imageOf(OutputStream stream) const {
   return stream == OutputStream::kPanorama ? panorama_ : canvas_;
 }
 
 Pipeline::~Pipeline() = default;
+
+void Pipeline::setView(ViewKind view) {
+  for (auto& output : outputs_) {
+    if (output.view) output.view->setView(view);
+  }
+}
 
 RunSummary Pipeline::run(const std::atomic<bool>& stop) {
   RunSummary summary;
@@ -125,9 +166,11 @@ RunSummary Pipeline::run(const std::atomic<bool>& stop) {
   const auto start = std::chrono::steady_clock::now();
   auto nextProgress = start + kProgressInterval;
   while (!stop && !synchronizer_.finished()) {
+    auto since = std::chrono::steady_clock::now();
     fillNeeds(stop);
+    timed(Stage::kSync, since);
     while (auto set = synchronizer_.pop()) {
-      render(*set);
+      process(*set);
       ++summary.frameSets;
     }
     if (const auto now = std::chrono::steady_clock::now(); now >= nextProgress) {
@@ -139,9 +182,27 @@ RunSummary Pipeline::run(const std::atomic<bool>& stop) {
     }
   }
   if (stop) spdlog::info("stop requested: finalizing outputs");
-  summary.wallTime = std::chrono::steady_clock::now() - start;
   finish(summary);
+  summary.wallTime = std::chrono::steady_clock::now() - start;
   return summary;
+}
+
+void Pipeline::timed(Stage stage, std::chrono::steady_clock::time_point& since) {
+  const auto now = std::chrono::steady_clock::now();
+  stageTime_[static_cast<std::size_t>(stage)] += now - since;
+  since = now;
+}
+
+template <typename Step>
+void Pipeline::guarded(Output& output, Step&& step) {
+  if (!output.sink) return;
+  try {
+    step();
+  } catch (const std::exception& e) {
+    spdlog::error("output failed, dropping it: {}", e.what());
+    ++failedSinks_;
+    output.sink.reset();
+  }
 }
 
 void Pipeline::fillNeeds(const std::atomic<bool>& stop) {
@@ -161,18 +222,32 @@ void Pipeline::fillNeeds(const std::atomic<bool>& stop) {
   }
 }
 
-void Pipeline::render(const capture::FrameSet& set) {
+bool Pipeline::wanted(OutputStream stream, std::chrono::nanoseconds streamTime) const {
+  return std::ranges::any_of(outputs_, [&](const Output& o) {
+    return o.stream == stream && o.sink && o.sink->wantsFrame(streamTime);
+  });
+}
+
+void Pipeline::process(const capture::FrameSet& set) {
+  auto since = std::chrono::steady_clock::now();
+  if (!firstTimestamp_) firstTimestamp_ = set.timestamp;
+  lastStreamTime_ = set.timestamp - *firstTimestamp_;
   std::array<const cv::Mat*, capture::kMaxCameras> images{};
   for (std::size_t c = 0; c < set.cameraCount; ++c) {
     images[c] = set.frame(c) != nullptr ? &set.frame(c)->image : nullptr;
   }
-  if (wantMosaic_) mosaic_.compose(std::span(images.data(), set.cameraCount), canvas_);
+  if (wanted(OutputStream::kMosaic, lastStreamTime_)) {
+    mosaic_.compose(std::span(images.data(), set.cameraCount), canvas_);
+    timed(Stage::kMosaic, since);
+  }
+  // The panorama is made for every set, wanted or not: colour correction follows it over time.
   if (stitcher_) {
     for (std::size_t c = 0; c < set.cameraCount; ++c) {
       frames_[c] = images[c] != nullptr ? *images[c] : cv::Mat();
       stitchInputs_[c] = images[c] != nullptr ? *images[c] : blackFrames_[c];
     }
     stitcher_->stitch(stitchInputs_, panorama_);
+    timed(Stage::kStitch, since);
     if (poisson_) {
       poisson_->update(frames_);
       poisson_->apply(panorama_);
@@ -180,35 +255,78 @@ void Pipeline::render(const capture::FrameSet& set) {
       gains_->update(frames_);
       gains_->apply(panorama_);
     }
+    timed(Stage::kCorrect, since);
   }
-  if (!firstTimestamp_) firstTimestamp_ = set.timestamp;
-  const auto streamTime = set.timestamp - *firstTimestamp_;
+  deliverSurround();
+  renderSurround(set, lastStreamTime_);
+  since = std::chrono::steady_clock::now();
   for (auto& output : outputs_) {
-    if (!output.sink) continue;
-    try {
-      output.sink->consume(imageOf(output.stream), streamTime);
-    } catch (const std::exception& e) {
-      spdlog::error("output failed, dropping it: {}", e.what());
-      ++failedSinks_;
-      output.sink.reset();
-    }
+    if (output.view || !output.sink || !output.sink->wantsFrame(lastStreamTime_)) continue;
+    guarded(output, [&] { output.sink->consume(imageOf(output.stream), lastStreamTime_); });
+  }
+  timed(Stage::kOutput, since);
+}
+
+void Pipeline::renderSurround(const capture::FrameSet& set, std::chrono::nanoseconds streamTime) {
+  if (!scene_) return;
+  auto since = std::chrono::steady_clock::now();
+  bool panoramaUploaded = false;
+  bool cameraUploaded = false;
+  for (auto& output : outputs_) {
+    if (!output.view || !output.sink || !output.sink->wantsFrame(streamTime)) continue;
+    guarded(output, [&] {
+      if (!panoramaUploaded) {
+        scene_->uploadPanorama(panorama_);
+        panoramaUploaded = true;
+      }
+      const capture::Frame* camera = set.frame(splitCamera_);
+      if (output.view->view() == ViewKind::kSplit && !cameraUploaded && camera != nullptr) {
+        scene_->uploadCamera(camera->image);
+        cameraUploaded = true;
+      }
+      output.view->draw(std::chrono::duration<double>(streamTime).count());
+      output.pendingTime = streamTime;
+    });
+  }
+  timed(Stage::kRender, since);
+}
+
+void Pipeline::deliverSurround() {
+  for (auto& output : outputs_) {
+    if (!output.view || !output.view->pending()) continue;
+    guarded(output, [&] {
+      auto since = std::chrono::steady_clock::now();
+      const cv::Mat& picture = output.view->collect();
+      timed(Stage::kReadBack, since);
+      output.sink->consume(picture, output.pendingTime);
+      timed(Stage::kOutput, since);
+    });
   }
 }
 
 void Pipeline::finish(RunSummary& summary) {
   for (auto& camera : cameras_) camera->stop();
+  deliverSurround();
+  bool panoramaUploaded = false;
   for (auto& output : outputs_) {
-    if (!output.sink) continue;
-    try {
-      output.sink->finish(firstTimestamp_ ? imageOf(output.stream) : cv::Mat());
+    guarded(output, [&] {
+      cv::Mat last;  // the picture of the last frame set, for sinks that write it at the end
+      if (firstTimestamp_ && output.view) {
+        if (!panoramaUploaded) scene_->uploadPanorama(panorama_);
+        panoramaUploaded = true;
+        output.view->draw(std::chrono::duration<double>(lastStreamTime_).count());
+        last = output.view->collect();
+      } else if (firstTimestamp_) {
+        last = imageOf(output.stream);
+      }
+      output.sink->finish(last, lastStreamTime_);
       summary.outputs.push_back(output.sink->describe());
-    } catch (const std::exception& e) {
-      spdlog::error("output failed to finish: {}", e.what());
-      ++failedSinks_;
-    }
+    });
   }
   summary.failedOutputs = failedSinks_;
   summary.sync = synchronizer_.stats();
+  summary.stageTime = stageTime_;
+  if (gl_) summary.renderer = gl_->description();
   for (const auto& camera : cameras_) {
     summary.cameraNames.push_back(camera->name());
     summary.cameras.push_back(camera->stats());

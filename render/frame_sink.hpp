@@ -1,6 +1,6 @@
 #pragma once
 // Where rendered frames go. Each output in the config is one FrameSink; the pipeline hands every
-// sink each rendered frame in stream order, then finish() once.
+// sink each frame it wants, in stream order, then finish() once.
 //
 // Error policy: consume() and finish() throw (EncoderError, std::runtime_error) naming the file;
 // the pipeline logs the failure and drops that sink, the others go on.
@@ -25,8 +25,12 @@ class FrameSink {
 
   // `bgr` is 8-bit BGR; `streamTime` counts from the first frame of the run.
   virtual void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) = 0;
-  // The run is over; `lastFrame` is the last frame consumed (empty if there was none).
-  virtual void finish(const cv::Mat& lastFrame) = 0;
+  // Whether the frame at `streamTime` is needed: the pipeline skips making pictures (renders) that
+  // no sink wants.
+  virtual bool wantsFrame(std::chrono::nanoseconds /*streamTime*/) const { return true; }
+  // The run is over; `lastFrame` is the picture of the run's last frame, at `lastTime` (empty if
+  // there was none).
+  virtual void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) = 0;
   // What was written, for the log ("video /out/demo/mosaic.mp4 (300 frames)").
   virtual std::string describe() const = 0;
 };
@@ -36,7 +40,7 @@ class VideoFileSink final : public FrameSink {
  public:
   explicit VideoFileSink(VideoEncoderSettings settings) : encoder_(std::move(settings)) {}
   void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) override;
-  void finish(const cv::Mat& lastFrame) override;
+  void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) override;
   std::string describe() const override;
 
  private:
@@ -48,13 +52,15 @@ class SnapshotSink final : public FrameSink {
  public:
   SnapshotSink(std::filesystem::path path, std::chrono::nanoseconds at);
   void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) override;
-  void finish(const cv::Mat& lastFrame) override;
+  bool wantsFrame(std::chrono::nanoseconds streamTime) const override {
+    return !writtenAt_ && streamTime >= at_;
+  }
+  void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) override;
   std::string describe() const override;
 
  private:
   std::filesystem::path path_;
   std::chrono::nanoseconds at_;
-  std::chrono::nanoseconds lastSeen_{0};
   std::optional<std::chrono::nanoseconds> writtenAt_;
 };
 

@@ -9,16 +9,15 @@ SnapshotSink::SnapshotSink(std::filesystem::path path, std::chrono::nanoseconds 
     : path_(std::move(path)), at_(at) {}
 
 void SnapshotSink::consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) {
-  lastSeen_ = streamTime;
-  if (writtenAt_ || streamTime < at_) return;
+  if (!wantsFrame(streamTime)) return;
   writeImageFile(path_, bgr);
   writtenAt_ = streamTime;
 }
 
-void SnapshotSink::finish(const cv::Mat& lastFrame) {
+void SnapshotSink::finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) {
   if (writtenAt_ || lastFrame.empty()) return;
   writeImageFile(path_, lastFrame);
-  writtenAt_ = lastSeen_;
+  writtenAt_ = lastTime;
 }
 
 std::string SnapshotSink::describe() const {

@@ -8,7 +8,9 @@ void VideoFileSink::consume(const cv::Mat& bgr, std::chrono::nanoseconds streamT
   encoder_.write(bgr, streamTime);
 }
 
-void VideoFileSink::finish(const cv::Mat& /*lastFrame*/) { encoder_.close(); }
+void VideoFileSink::finish(const cv::Mat& /*lastFrame*/, std::chrono::nanoseconds /*lastTime*/) {
+  encoder_.close();
+}
 
 std::string VideoFileSink::describe() const {
   return fmt::format("video {} ({} frames)", encoder_.path().string(), encoder_.framesWritten());

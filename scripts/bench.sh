@@ -1,8 +1,9 @@
 #!/bin/sh
 # The benchmarks: installs what is missing, builds (release), makes the benchmark recordings (the
-# paper rig at 4 x 854x480, 1280x720 and 1920x1080, with ground truth; once, then cached in
-# recordings/bench/), and runs surround-bench stitch and colour on them. Extra arguments go to
-# surround-bench, e.g. --threads 1, --repeats 100; --json (first) prints stitch's JSON only.
+# paper rig at 4 x 854x480, 1280x720 and 1920x1080, 2 s each, with ground truth; once, then cached
+# in recordings/bench/, replaced when they were made with other arguments), and runs
+# surround-bench stitch, colour and pipeline on them. Extra arguments go to each, e.g.
+# --threads 1, --repeats 5; --json (first) prints stitch's and pipeline's JSON only.
 set -eu
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -12,15 +13,16 @@ synth=build/release/tools/synth/surround-synth
 # name, camera size, panorama size (about the cameras' angular resolution, capped at 2048 wide)
 while read -r name size panorama; do
   "$synth" --rig config/rigs/paper.yaml --out "recordings/bench/$name" --size "$size" \
-    --panorama-size "$panorama" --seconds 0.2 --seed 3
+    --panorama-size "$panorama" --seconds 2 --seed 3 --force
 done <<INPUTS
 480p 854x480 1024x512
 720p 1280x720 1536x768
 1080p 1920x1080 2048x1024
 INPUTS
-# surround-bench stitch, then colour; extra arguments go to both (--json to stitch only).
+# surround-bench stitch, colour and pipeline (colour has no JSON and is left out with --json).
 inputs="recordings/bench/480p recordings/bench/720p recordings/bench/1080p"
 build/release/tools/bench/surround-bench stitch "$@" $inputs
 if [ "${1:-}" != "--json" ]; then
   build/release/tools/bench/surround-bench colour "$@" $inputs
 fi
+build/release/tools/bench/surround-bench pipeline "$@" $inputs

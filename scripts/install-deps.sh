@@ -8,6 +8,7 @@ PACKAGES="
   libopencv-dev libyaml-cpp-dev libspdlog-dev libfmt-dev zlib1g-dev
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   libsuitesparse-dev
+  libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
   libgtest-dev libgmock-dev
 "
 

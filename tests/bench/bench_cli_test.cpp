@@ -38,11 +38,45 @@ TEST(BenchCli, StitchReportsTimingsAndAccuracyAsJson) {
             report["sphere"]["ground_mae_levels"].as<double>());
 }
 
+// The pipeline benchmark runs the daemon's pipeline on the recording: every frame set comes out,
+// the stage times add up to no more than the run, and the ratio is the one of the two frame rates.
+TEST(BenchCli, PipelineReportsFrameRatesStagesAndTheBaselineAsJson) {
+  const testing::TempDir dir;
+  testing::ChildProcess bench({SURROUND_BENCH, "pipeline", "--json", "--repeats", "1", "--size",
+                               "320x240", "--view", "top", kRecording},
+                              dir / "out.txt");
+  ASSERT_EQ(bench.wait(), 0) << bench.output();
+  const YAML::Node report = YAML::Load(bench.output())["pipeline"];
+  EXPECT_EQ(report["view"].as<std::string>(), "top");
+  EXPECT_THAT(report["renderer"].as<std::string>(), HasSubstr("OpenGL ES 3"));
+  const YAML::Node input = report["inputs"][0];
+  EXPECT_EQ(input["name"].as<std::string>(), "synth_small");
+  EXPECT_EQ(input["frame_sets"].as<int>(), 30);  // the fixture's 1 s at 30 FPS, none lost
+  const double fps = input["fps"].as<double>();
+  EXPECT_GT(fps, 0);
+  EXPECT_NEAR(input["ratio"].as<double>(), fps / input["baseline_fps"].as<double>(), 1e-3);
+  double stages = 0;
+  for (const char* stage : {"sync", "stitch", "correct", "render", "read-back", "output"}) {
+    EXPECT_GE(input["ms"][stage].as<double>(), 0) << stage;
+    stages += input["ms"][stage].as<double>();
+  }
+  EXPECT_GT(input["ms"]["render"].as<double>(), 0);
+  EXPECT_GT(input["ms"]["decode"].as<double>(), 0);
+  EXPECT_LE(stages, 1000 / fps + 1e-6);
+  EXPECT_GT(input["cpu_percent"].as<double>(), 0);
+  EXPECT_GT(input["peak_mb"].as<double>(), 10);
+}
+
 TEST(BenchCli, BadCommandLinesAreUsageErrors) {
   const testing::TempDir dir;
   for (const auto& [arguments, message] :
        {std::pair{std::vector<std::string>{"stitch"}, "no recording given"},
-        std::pair{std::vector<std::string>{"stich", kRecording}, "expected 'stitch' or 'colour'"},
+        std::pair{std::vector<std::string>{"stich", kRecording},
+                  "expected 'stitch', 'colour' or 'pipeline'"},
+        std::pair{std::vector<std::string>{"pipeline", "--view", "side", kRecording},
+                  "--view needs top, 360, orbit or split"},
+        std::pair{std::vector<std::string>{"pipeline", "--size", "641x480", kRecording},
+                  "--size needs an even WIDTHxHEIGHT"},
         std::pair{std::vector<std::string>{"stitch", "--threads", "0", kRecording},
                   "--threads needs a number from 1 to 256"},
         std::pair{std::vector<std::string>{"stitch", "--fast", kRecording},

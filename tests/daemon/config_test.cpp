@@ -106,6 +106,41 @@ TEST_F(ConfigTest, GoodConfigLoads) {
   EXPECT_EQ(config.panorama.widthPx, PanoramaConfig{}.widthPx);  // absent sections keep defaults
 }
 
+TEST_F(ConfigTest, SurroundOutputsTakeTheirOwnViewOrTheRenderDefault) {
+  const Config config = loadConfig(configWith("  height_px: 360\n", R"(  height_px: 360
+  view: top
+  split_camera: left
+  orbit_period_s: 12
+  car_length_m: 4.2
+  platform: surfaceless
+)"));
+  const auto file = configWith("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                               R"(  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}
+  - {type: video, stream: surround, path: out/orbit.mp4}
+  - {type: snapshot, stream: surround, view: 360, path: out/360.png})");
+  const Config surround = loadConfig(file);
+  ASSERT_EQ(surround.outputs.size(), 4u);
+  EXPECT_EQ(surround.outputs[2].stream, OutputStream::kSurround);
+  EXPECT_EQ(surround.outputs[2].view, std::nullopt);  // render.view
+  EXPECT_EQ(surround.outputs[3].view, ViewKind::kPanorama360);
+  EXPECT_EQ(config.render.view, ViewKind::kTop);
+  EXPECT_EQ(config.render.splitCamera, "left");
+  EXPECT_DOUBLE_EQ(config.render.views.orbitPeriodS, 12.0);
+  EXPECT_DOUBLE_EQ(config.render.car.lengthM, 4.2);
+  EXPECT_EQ(config.render.platform, render::EglPlatform::kSurfaceless);
+}
+
+TEST_F(ConfigTest, AViewOnlyBelongsToASurroundOutput) {
+  expectOneError("{type: snapshot, path: out/mosaic.png,",
+                 "{type: snapshot, view: top, path: out/mosaic.png,",
+                 {"outputs[1].view: only a surround output has a view"});
+}
+
+TEST_F(ConfigTest, SplitCameraMustBeACamera) {
+  expectOneError("  height_px: 360\n", "  height_px: 360\n  split_camera: rear\n",
+                 {"render.split_camera: no camera is named 'rear'"});
+}
+
 TEST_F(ConfigTest, UnknownKey) {
   expectOneError("  sync_tolerance_ms: 5", "  sync_tolerance_ms: 5\n  sync_tolerence_ms: 5",
                  {where(16, 3),

@@ -14,7 +14,9 @@
 #include "daemon/rig_yaml.hpp"
 #include "processing/poisson_correction.hpp"
 #include "processing/stitcher.hpp"
+#include "render/egl_context.hpp"
 #include "render/mosaic.hpp"
+#include "render/surround_view.hpp"
 #include "tests/support/child_process.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/support/test_support.hpp"
@@ -76,6 +78,43 @@ TEST(EndToEnd, MosaicVideoMatchesTheSourceFrames) {
 
 // The panorama output: the video shows the colour-corrected stitch of the source frames; the LUT is
 // built on the first run, loaded on the next, and rebuilt when its cache file is damaged.
+// The recording of a config, and the panorama the daemon makes of each of its frame sets.
+struct Replay {
+  explicit Replay(daemon::Config loaded)
+      : config(std::move(loaded)), lut(daemon::obtainPanoramaLut(config, pool)) {
+    for (const auto& camera : config.cameras) {
+      auto decoded = testing::decodeAll(camera.source->path);
+      sources.push_back(std::move(decoded.images));
+      timestamps.push_back(std::move(decoded.timestamps));
+    }
+  }
+  std::size_t frameSets() const { return sources[0].size(); }  // the recording drops nothing
+  double streamTime(std::size_t k) const {
+    return std::chrono::duration<double>(timestamps[0][k] - timestamps[0][0]).count();
+  }
+  // Stitched and colour-corrected with the config's correction (Poisson by default), solved for
+  // this frame set on its own.
+  cv::Mat panorama(std::size_t k) const {
+    std::vector<cv::Mat> frames;
+    for (const auto& camera : sources) frames.push_back(camera[k]);
+    processing::Stitcher stitcher(lut, pool);
+    cv::Mat stitched;
+    stitcher.stitch(frames, stitched);
+    processing::PoissonColourCorrection correction(
+        daemon::rigOf(config), daemon::panoramaSettings(config), lut,
+        {config.colour.scale, config.colour.solver, config.colour.tolerance, 0.0}, pool);
+    correction.update(frames);
+    correction.apply(stitched);
+    return stitched;
+  }
+
+  daemon::Config config;
+  mutable WorkPool pool{2};
+  processing::PanoramaLut lut;
+  std::vector<std::vector<cv::Mat>> sources;
+  std::vector<std::vector<capture::Timestamp>> timestamps;
+};
+
 TEST(EndToEnd, PanoramaVideoMatchesTheStitchedSourceFramesAndTheLutIsCached) {
   const testing::TempDir dir;
   const auto config = dir.write("config.yaml", fmt::format(R"(rig: {{file: {}}}
@@ -99,30 +138,65 @@ outputs:
   std::filesystem::resize_file(cached.path(), 1000);
   run("is corrupt (checksum mismatch); rebuilding");
 
-  const daemon::Config loaded = daemon::loadConfig(config);
-  WorkPool pool(2);
-  const processing::PanoramaLut lut = daemon::obtainPanoramaLut(loaded, pool);
-  processing::Stitcher stitcher(lut, pool);
-  std::vector<std::vector<cv::Mat>> sources;
-  for (const auto& camera : loaded.cameras) {
-    sources.push_back(testing::decodeAll(camera.source->path).images);
-  }
+  const Replay replay(daemon::loadConfig(config));
   const auto video = testing::decodeAll(dir / "out/panorama.mp4").images;
-  ASSERT_EQ(video.size(), sources[0].size());
-  cv::Mat expected;
+  ASSERT_EQ(video.size(), replay.frameSets());
   for (const std::size_t k : {std::size_t{0}, video.size() - 1}) {
-    std::vector<cv::Mat> frames;
-    for (const auto& camera : sources) frames.push_back(camera[k]);
-    stitcher.stitch(frames, expected);
-    // The config's default colour correction (Poisson), solved for this frame on its own.
-    processing::PoissonColourCorrection correction(
-        daemon::rigOf(loaded), daemon::panoramaSettings(loaded), lut,
-        {loaded.colour.scale, loaded.colour.solver, loaded.colour.tolerance, 0.0}, pool);
-    correction.update(frames);
-    correction.apply(expected);
-    EXPECT_GE(cv::PSNR(expected, video[k]), 35.0) << "frame " << k;
+    EXPECT_GE(cv::PSNR(replay.panorama(k), video[k]), 35.0) << "frame " << k;
   }
-  EXPECT_EQ(cv::imread((dir / "out/panorama.png").string()).size(), lut.size);
+  EXPECT_EQ(cv::imread((dir / "out/panorama.png").string()).size(), replay.lut.size);
+}
+
+// The surround outputs: an orbit video with a picture for every frame set (the read-back of the
+// last one included), and snapshots of other views, each the scene rendered from the panorama of
+// its frame set.
+TEST(EndToEnd, SurroundOutputsShowTheRenderedPanoramaOfEachFrameSet) {
+  const testing::TempDir dir;
+  const auto config = dir.write("config.yaml", fmt::format(R"(rig: {{file: {}}}
+capture: {{pacing: as_fast_as_possible}}
+pipeline: {{threads: 2}}
+panorama: {{width_px: 512, height_px: 256, cache_dir: lut-cache}}
+render: {{width_px: 320, height_px: 240, view: orbit}}
+outputs:
+  - {{type: video, stream: surround, path: out/orbit.mp4, crf: 10, pixel_format: yuv444p}}
+  - {{type: snapshot, stream: surround, view: top, path: out/top.png, at_s: 0.52}}
+  - {{type: snapshot, stream: surround, view: 360, path: out/360.png, at_s: 1000}}
+)",
+                                                           (kRecording / "rig.yaml").string()));
+  testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--config", config.string()},
+                                  dir / "log.txt");
+  ASSERT_EQ(surroundd.wait(), 0) << surroundd.output();
+  EXPECT_THAT(surroundd.output(), HasSubstr("render: "));
+
+  const daemon::Config loaded = daemon::loadConfig(config);
+  const Replay replay(loaded);
+  const render::EglContext context;
+  render::SurroundScene scene(
+      processing::buildSurroundMesh(daemon::meshSettings(loaded),
+                                    daemon::panoramaSettings(loaded).geometry),
+      daemon::panoramaSettings(loaded).geometry, loaded.render.car, replay.lut.cameraSizes[0]);
+  render::SurroundView view(scene, {320, 240}, render::ViewKind::kOrbit, loaded.render.views);
+  const auto rendered = [&](std::size_t k, render::ViewKind kind) {
+    scene.uploadPanorama(replay.panorama(k));
+    view.setView(kind);
+    view.draw(replay.streamTime(k));
+    return view.collect().clone();
+  };
+
+  const auto video = testing::decodeAll(dir / "out/orbit.mp4").images;
+  ASSERT_EQ(video.size(), replay.frameSets());
+  for (const std::size_t k : {std::size_t{0}, video.size() / 2, video.size() - 1}) {
+    EXPECT_GE(cv::PSNR(rendered(k, render::ViewKind::kOrbit), video[k]), 35.0) << "frame " << k;
+  }
+  std::size_t snapshotAt = 0;  // the first frame set at or after 0.52 s (between two frames)
+  while (replay.streamTime(snapshotAt) < 0.52) ++snapshotAt;
+  EXPECT_GE(cv::PSNR(rendered(snapshotAt, render::ViewKind::kTop),
+                     cv::imread((dir / "out/top.png").string())),
+            40.0);
+  // Asked for after the end: the last frame set's picture.
+  EXPECT_GE(cv::PSNR(rendered(replay.frameSets() - 1, render::ViewKind::kPanorama360),
+                     cv::imread((dir / "out/360.png").string())),
+            40.0);
 }
 
 TEST(EndToEnd, SigtermLeavesAPlayableFile) {

@@ -76,7 +76,8 @@ TEST_F(ReplayTest, TimestampsAreTheRecordedOnes) {
 TEST_F(ReplayTest, PipelineLosesOnlyTheSetsOfTheDroppedFrames) {
   const testing::TempDir dir;
   config_.capture.pacing = capture::Pacing::kAsFastAsPossible;
-  config_.render = {ViewKind::kTop, 320, 180};
+  config_.render.widthPx = 320;
+  config_.render.heightPx = 180;
   OutputConfig snapshot;
   snapshot.kind = OutputKind::kSnapshot;
   snapshot.path = dir / "last.png";

@@ -3,17 +3,21 @@
 //
 //   surround-bench stitch [--threads N] [--repeats N] [--json] RECORDING...
 //   surround-bench colour [--threads N] [--repeats N] RECORDING...
+//   surround-bench pipeline [--threads N] [--repeats N] [--json] [--solver S] [--projection P]
+//                           [--view V] [--size WxH] RECORDING...
 //
 // Exit codes: 0 done, 1 failed while measuring, 2 bad command line.
 
 #include <charconv>
 #include <cstdio>
 #include <exception>
+#include <optional>
 #include <string_view>
 
 #include <fmt/format.h>
 
 #include "tools/bench/colour_benchmark.hpp"
+#include "tools/bench/pipeline_benchmark.hpp"
 #include "tools/bench/stitch_benchmark.hpp"
 
 namespace {
@@ -21,13 +25,21 @@ namespace {
 constexpr std::string_view kUsage =
     R"(usage: surround-bench stitch [--threads N] [--repeats N] [--json] RECORDING...
        surround-bench colour [--threads N] [--repeats N] RECORDING...
+       surround-bench pipeline [--threads N] [--repeats N] [--json] [--solver S]
+                               [--projection P] [--view V] [--size WxH] RECORDING...
   stitch        LUT build, stitch against cv::remap, accuracy against the ground truth
   colour        Poisson colour correction: solvers, per-frame cost, seam colour error
+  pipeline      the whole daemon pipeline (the paper's tables 1 and 2): frames per second,
+                milliseconds per stage, CPU and peak memory, against a decode-only replay
   RECORDING     a surround-synth recording folder (with ground truth); scripts/bench.sh makes
                 4x480p, 720p and 1080p ones
-  --threads N   threads for the stitcher and cv::remap (default 2); 1 thread is measured too
-  --repeats N   timed runs per candidate, median reported (default 30)
-  --json        stitch: one JSON object on stdout instead of the text table
+  --threads N   worker threads (default 2); stitch measures 1 thread too
+  --repeats N   timed runs per candidate, median reported (default 30; pipeline 3)
+  --json        stitch, pipeline: one JSON object on stdout instead of the text table
+  --solver S    pipeline: auto | cholmod | iterative | rectangle (default auto)
+  --projection P  pipeline: bowl | sphere (default bowl)
+  --view V      pipeline: top | 360 | orbit | split (default orbit)
+  --size WxH    pipeline: output size (default 1280x720)
 )";
 
 int usageError(std::string_view message) {
@@ -35,33 +47,86 @@ int usageError(std::string_view message) {
   return 2;
 }
 
-bool parseCount(std::string_view text, int& value) {
+bool parseNumber(std::string_view text, int& value, int low, int high) {
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-  return error == std::errc() && end == text.data() + text.size() && value >= 1 && value <= 256;
+  return error == std::errc() && end == text.data() + text.size() && value >= low && value <= high;
+}
+
+bool parseSize(std::string_view text, cv::Size& size) {
+  const auto x = text.find('x');
+  return x != std::string_view::npos && parseNumber(text.substr(0, x), size.width, 64, 7680) &&
+         parseNumber(text.substr(x + 1), size.height, 64, 4320) && size.width % 2 == 0 &&
+         size.height % 2 == 0;
+}
+
+template <typename E>
+std::optional<E> parseWord(std::string_view text,
+                           std::initializer_list<std::pair<std::string_view, E>> words) {
+  for (const auto& [word, value] : words) {
+    if (word == text) return value;
+  }
+  return std::nullopt;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  using surroundd::bench::StitchBenchmarkOptions;
+  namespace bench = surroundd::bench;
+  using surroundd::processing::PanoramaProjection;
+  using surroundd::processing::PoissonSolverKind;
+  using surroundd::render::ViewKind;
   if (argc >= 2 && (std::string_view(argv[1]) == "--help" || std::string_view(argv[1]) == "-h")) {
     fmt::print("{}", kUsage);
     return 0;
   }
   const std::string_view command = argc >= 2 ? argv[1] : "";
-  if (command != "stitch" && command != "colour") {
-    return usageError("expected 'stitch' or 'colour'");
+  if (command != "stitch" && command != "colour" && command != "pipeline") {
+    return usageError("expected 'stitch', 'colour' or 'pipeline'");
   }
-  StitchBenchmarkOptions options;
+  bench::StitchBenchmarkOptions options;
+  bench::PipelineBenchmarkOptions pipeline;
+  std::optional<int> repeats;
   for (int i = 2; i < argc; ++i) {
     const std::string_view arg = argv[i];
+    const bool hasValue = i + 1 < argc;
+    const std::string_view value = hasValue ? argv[i + 1] : "";
     if (arg == "--json") {
       options.json = true;
     } else if (arg == "--threads" || arg == "--repeats") {
-      int& target = arg == "--threads" ? options.threads : options.repeats;
-      if (i + 1 >= argc || !parseCount(argv[++i], target)) {
+      int number = 0;
+      if (!hasValue || !parseNumber(value, number, 1, 256)) {
         return usageError(fmt::format("{} needs a number from 1 to 256", arg));
       }
+      (arg == "--threads" ? options.threads : repeats.emplace()) = number;
+      ++i;
+    } else if (command == "pipeline" && arg == "--solver") {
+      const auto solver =
+          parseWord<PoissonSolverKind>(value, {{"auto", PoissonSolverKind::kAuto},
+                                               {"cholmod", PoissonSolverKind::kCholmod},
+                                               {"iterative", PoissonSolverKind::kIterative},
+                                               {"rectangle", PoissonSolverKind::kRectangle}});
+      if (!solver) return usageError("--solver needs auto, cholmod, iterative or rectangle");
+      pipeline.solver = *solver;
+      ++i;
+    } else if (command == "pipeline" && arg == "--projection") {
+      const auto projection = parseWord<PanoramaProjection>(
+          value, {{"bowl", PanoramaProjection::kBowl}, {"sphere", PanoramaProjection::kSphere}});
+      if (!projection) return usageError("--projection needs bowl or sphere");
+      pipeline.projection = *projection;
+      ++i;
+    } else if (command == "pipeline" && arg == "--view") {
+      const auto view = parseWord<ViewKind>(value, {{"top", ViewKind::kTop},
+                                                    {"360", ViewKind::kPanorama360},
+                                                    {"orbit", ViewKind::kOrbit},
+                                                    {"split", ViewKind::kSplit}});
+      if (!view) return usageError("--view needs top, 360, orbit or split");
+      pipeline.view = *view;
+      ++i;
+    } else if (command == "pipeline" && arg == "--size") {
+      if (!parseSize(value, pipeline.outputSize)) {
+        return usageError("--size needs an even WIDTHxHEIGHT such as 1280x720");
+      }
+      ++i;
     } else if (arg.starts_with("--")) {
       return usageError(fmt::format("unknown option '{}'", arg));
     } else {
@@ -69,12 +134,19 @@ int main(int argc, char** argv) {
     }
   }
   if (options.recordings.empty()) return usageError("no recording given");
+  if (repeats) options.repeats = *repeats;
   try {
     if (command == "colour") {
-      return surroundd::bench::runColourBenchmark(
-          {options.recordings, options.threads, options.repeats});
+      return bench::runColourBenchmark({options.recordings, options.threads, options.repeats});
     }
-    return surroundd::bench::runStitchBenchmark(options);
+    if (command == "pipeline") {
+      pipeline.recordings = options.recordings;
+      pipeline.threads = options.threads;
+      pipeline.repeats = repeats.value_or(pipeline.repeats);
+      pipeline.json = options.json;
+      return bench::runPipelineBenchmark(pipeline);
+    }
+    return bench::runStitchBenchmark(options);
   } catch (const std::exception& e) {
     fmt::print(stderr, "surround-bench: {}\n", e.what());
     return 1;

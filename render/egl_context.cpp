@@ -1,0 +1,195 @@
+#include "render/egl_context.hpp"
+
+#include <array>
+#include <string_view>
+#include <vector>
+
+#include <EGL/eglext.h>
+#include <GLES3/gl3.h>
+#include <fmt/core.h>
+
+#include "render/render_error.hpp"
+
+namespace surroundd::render {
+namespace {
+
+bool hasExtension(const char* list, std::string_view name) {
+  if (list == nullptr) return false;
+  const std::string_view all(list);
+  for (std::size_t at = all.find(name); at != std::string_view::npos; at = all.find(name, at + 1)) {
+    const bool startsWord = at == 0 || all[at - 1] == ' ';
+    const std::size_t end = at + name.size();
+    if (startsWord && (end == all.size() || all[end] == ' ')) return true;
+  }
+  return false;
+}
+
+std::string eglErrorText(std::string_view call) {
+  return fmt::format("{} failed (EGL error 0x{:04x})", call, eglGetError());
+}
+
+template <typename Function>
+Function procedure(const char* name) {
+  return reinterpret_cast<Function>(eglGetProcAddress(name));
+}
+
+// The first hardware EGL device's display; software devices (Mesa's llvmpipe) are left to the
+// surfaceless platform, which is Mesa's own.
+EGLDisplay deviceDisplay(std::string& why) {
+  const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+  if (!hasExtension(client, "EGL_EXT_platform_device") ||
+      !hasExtension(client, "EGL_EXT_device_enumeration")) {
+    why = "the EGL client has no EGL_EXT_platform_device";
+    return EGL_NO_DISPLAY;
+  }
+  const auto queryDevices = procedure<PFNEGLQUERYDEVICESEXTPROC>("eglQueryDevicesEXT");
+  const auto queryDeviceString =
+      procedure<PFNEGLQUERYDEVICESTRINGEXTPROC>("eglQueryDeviceStringEXT");
+  const auto platformDisplay =
+      procedure<PFNEGLGETPLATFORMDISPLAYEXTPROC>("eglGetPlatformDisplayEXT");
+  std::array<EGLDeviceEXT, 16> devices{};
+  EGLint count = 0;
+  if (queryDevices == nullptr || platformDisplay == nullptr || queryDeviceString == nullptr ||
+      queryDevices(static_cast<EGLint>(devices.size()), devices.data(), &count) != EGL_TRUE) {
+    why = eglErrorText("eglQueryDevicesEXT");
+    return EGL_NO_DISPLAY;
+  }
+  for (EGLint i = 0; i < count; ++i) {
+    if (hasExtension(queryDeviceString(devices[i], EGL_EXTENSIONS), "EGL_MESA_device_software")) {
+      continue;
+    }
+    const EGLDisplay display = platformDisplay(EGL_PLATFORM_DEVICE_EXT, devices[i], nullptr);
+    if (display != EGL_NO_DISPLAY) return display;
+  }
+  why = fmt::format("none of {} EGL device(s) is a hardware device", count);
+  return EGL_NO_DISPLAY;
+}
+
+EGLDisplay surfacelessDisplay(std::string& why) {
+  const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+  if (!hasExtension(client, "EGL_MESA_platform_surfaceless")) {
+    why = "the EGL client has no EGL_MESA_platform_surfaceless";
+    return EGL_NO_DISPLAY;
+  }
+  const auto platformDisplay =
+      procedure<PFNEGLGETPLATFORMDISPLAYEXTPROC>("eglGetPlatformDisplayEXT");
+  const EGLDisplay display =
+      platformDisplay != nullptr
+          ? platformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr)
+          : EGL_NO_DISPLAY;
+  if (display == EGL_NO_DISPLAY) why = eglErrorText("eglGetPlatformDisplayEXT(surfaceless)");
+  return display;
+}
+
+}  // namespace
+
+const char* toString(EglPlatform platform) {
+  switch (platform) {
+    case EglPlatform::kAuto:
+      return "auto";
+    case EglPlatform::kDevice:
+      return "device";
+    case EglPlatform::kSurfaceless:
+      return "surfaceless";
+    case EglPlatform::kDefault:
+      return "default";
+  }
+  return "?";
+}
+
+EglContext::EglContext(EglPlatform platform) {
+  const std::vector<EglPlatform> order =
+      platform == EglPlatform::kAuto
+          ? std::vector{EglPlatform::kDevice, EglPlatform::kSurfaceless, EglPlatform::kDefault}
+          : std::vector{platform};
+  std::string failures;
+  for (const EglPlatform candidate : order) {
+    std::string why;
+    if (open(candidate, why)) return;
+    close();
+    failures += fmt::format("; {}: {}", toString(candidate), why);
+  }
+  throw RenderError("no OpenGL ES 3 context through EGL" + failures);
+}
+
+EglContext::~EglContext() { close(); }
+
+bool EglContext::open(EglPlatform platform, std::string& why) {
+  if (platform == EglPlatform::kDevice) display_ = deviceDisplay(why);
+  if (platform == EglPlatform::kSurfaceless) display_ = surfacelessDisplay(why);
+  if (platform == EglPlatform::kDefault) {
+    display_ = eglGetDisplay(EGL_DEFAULT_DISPLAY);
+    if (display_ == EGL_NO_DISPLAY) why = eglErrorText("eglGetDisplay");
+  }
+  if (display_ == EGL_NO_DISPLAY) return false;
+  EGLint major = 0;
+  EGLint minor = 0;
+  if (eglInitialize(display_, &major, &minor) != EGL_TRUE) {
+    why = eglErrorText("eglInitialize");
+    display_ = EGL_NO_DISPLAY;  // nothing to terminate
+    return false;
+  }
+  if (eglBindAPI(EGL_OPENGL_ES_API) != EGL_TRUE) {
+    why = eglErrorText("eglBindAPI(OpenGL ES)");
+    return false;
+  }
+  const std::array<EGLint, 13> configAttributes{EGL_SURFACE_TYPE,
+                                                EGL_PBUFFER_BIT,
+                                                EGL_RENDERABLE_TYPE,
+                                                EGL_OPENGL_ES3_BIT,
+                                                EGL_RED_SIZE,
+                                                8,
+                                                EGL_GREEN_SIZE,
+                                                8,
+                                                EGL_BLUE_SIZE,
+                                                8,
+                                                EGL_ALPHA_SIZE,
+                                                8,
+                                                EGL_NONE};
+  EGLConfig config = nullptr;
+  EGLint configs = 0;
+  if (eglChooseConfig(display_, configAttributes.data(), &config, 1, &configs) != EGL_TRUE ||
+      configs == 0) {
+    why = "no RGBA8 OpenGL ES 3 configuration";
+    return false;
+  }
+  const std::array<EGLint, 5> contextAttributes{EGL_CONTEXT_MAJOR_VERSION, 3,
+                                                EGL_CONTEXT_MINOR_VERSION, 0, EGL_NONE};
+  context_ = eglCreateContext(display_, config, EGL_NO_CONTEXT, contextAttributes.data());
+  if (context_ == EGL_NO_CONTEXT) {
+    why = eglErrorText("eglCreateContext(OpenGL ES 3.0)");
+    return false;
+  }
+  // Rendering goes to framebuffer objects; a surface is only needed where the driver lacks
+  // EGL_KHR_surfaceless_context.
+  if (!hasExtension(eglQueryString(display_, EGL_EXTENSIONS), "EGL_KHR_surfaceless_context")) {
+    const std::array<EGLint, 5> pbuffer{EGL_WIDTH, 1, EGL_HEIGHT, 1, EGL_NONE};
+    surface_ = eglCreatePbufferSurface(display_, config, pbuffer.data());
+    if (surface_ == EGL_NO_SURFACE) {
+      why = eglErrorText("eglCreatePbufferSurface");
+      return false;
+    }
+  }
+  if (eglMakeCurrent(display_, surface_, surface_, context_) != EGL_TRUE) {
+    why = eglErrorText("eglMakeCurrent");
+    return false;
+  }
+  platform_ = platform;
+  description_ = fmt::format("{}: {}, {}", toString(platform),
+                             reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
+                             reinterpret_cast<const char*>(glGetString(GL_VERSION)));
+  return true;
+}
+
+void EglContext::close() {
+  if (display_ == EGL_NO_DISPLAY) return;
+  eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+  if (context_ != EGL_NO_CONTEXT) eglDestroyContext(display_, context_);
+  if (surface_ != EGL_NO_SURFACE) eglDestroySurface(display_, surface_);
+  eglTerminate(display_);
+  display_ = EGL_NO_DISPLAY;
+  context_ = EGL_NO_CONTEXT;
+  surface_ = EGL_NO_SURFACE;
+}
+
+}  // namespace surroundd::render

@@ -1,0 +1,43 @@
+#pragma once
+// A headless OpenGL ES 3 context through EGL, for rendering into framebuffer objects: no window,
+// no display server. Platforms, in the order `kAuto` tries them:
+//   device       EGL_EXT_platform_device on a hardware device (NVIDIA's driver, or a DRM node);
+//   surfaceless  EGL_MESA_platform_surfaceless (Mesa: a GPU, or llvmpipe on the CPU);
+//   default      the default display with a 1x1 pbuffer, for drivers with neither.
+// The context is current on the thread that made it and stays so; GL objects must be made and
+// used on that thread, and destroyed before the context.
+
+#include <string>
+
+#include <EGL/egl.h>
+
+namespace surroundd::render {
+
+enum class EglPlatform { kAuto, kDevice, kSurfaceless, kDefault };
+
+class EglContext {
+ public:
+  // Throws RenderError listing each platform tried and why it failed.
+  explicit EglContext(EglPlatform platform = EglPlatform::kAuto);
+  ~EglContext();
+  EglContext(const EglContext&) = delete;
+  EglContext& operator=(const EglContext&) = delete;
+
+  // "surfaceless: llvmpipe (LLVM 15.0.6, 256 bits), OpenGL ES 3.2 Mesa 22.3.6"
+  const std::string& description() const { return description_; }
+  EglPlatform platform() const { return platform_; }
+
+ private:
+  bool open(EglPlatform platform, std::string& why);
+  void close();
+
+  EGLDisplay display_ = EGL_NO_DISPLAY;
+  EGLContext context_ = EGL_NO_CONTEXT;
+  EGLSurface surface_ = EGL_NO_SURFACE;  // only for the default platform
+  EglPlatform platform_ = EglPlatform::kAuto;
+  std::string description_;
+};
+
+const char* toString(EglPlatform platform);
+
+}  // namespace surroundd::render

@@ -1,0 +1,240 @@
+#include "render/surround_scene.hpp"
+
+#include <cstddef>
+#include <cstring>
+#include <stdexcept>
+
+#include <fmt/core.h>
+
+namespace surroundd::render {
+namespace {
+
+constexpr const char* kMeshVertex = R"(#version 300 es
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec2 a_uv;
+uniform mat4 u_viewProjection;
+out vec2 v_uv;
+void main() {
+  v_uv = a_uv;
+  gl_Position = u_viewProjection * vec4(a_position, 1.0);
+})";
+
+constexpr const char* kMeshFragment = R"(#version 300 es
+precision highp float;
+uniform sampler2D u_panorama;
+in vec2 v_uv;
+out vec4 o_colour;
+void main() { o_colour = vec4(texture(u_panorama, v_uv).rgb, 1.0); })";
+
+constexpr const char* kCarVertex = R"(#version 300 es
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec3 a_colour;
+uniform mat4 u_viewProjection;
+out vec3 v_colour;
+void main() {
+  // One light from above, a little ahead and to the left, and some ambient.
+  float lambert = max(dot(a_normal, normalize(vec3(0.3, 0.4, 1.0))), 0.0);
+  v_colour = a_colour * (0.35 + 0.65 * lambert);
+  gl_Position = u_viewProjection * vec4(a_position, 1.0);
+})";
+
+constexpr const char* kCarFragment = R"(#version 300 es
+precision mediump float;
+in vec3 v_colour;
+out vec4 o_colour;
+void main() { o_colour = vec4(v_colour, 1.0); })";
+
+// One triangle covering the viewport. v_picture: x -1 (left) .. 1 (right), y -1 (bottom) .. 1
+// (top) of the picture; framebuffer row 0 is the top (see view_camera.hpp).
+constexpr const char* kFullViewportVertex = R"(#version 300 es
+out vec2 v_picture;
+void main() {
+  vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
+  v_picture = vec2(p.x, -p.y);
+  gl_Position = vec4(p, 0.0, 1.0);
+})";
+
+constexpr const char* kStripFragment = R"(#version 300 es
+precision highp float;
+uniform sampler2D u_panorama;
+uniform vec2 u_tangents;      // tan(elevation) at the top and bottom of a strip
+uniform float u_panoramaTop;  // the panorama's elevation range, radians
+uniform float u_panoramaSpan;
+in vec2 v_picture;
+out vec4 o_colour;
+const float PI = 3.14159265358979;
+void main() {
+  bool front = v_picture.y >= 0.0;
+  float across = (v_picture.x + 1.0) * 0.5;
+  // Front strip: left (+90 deg) to right (-90); back strip: right (-90) through the back to left.
+  float azimuth = front ? PI * (0.5 - across) : -PI * (0.5 + across);
+  float up = front ? v_picture.y : v_picture.y + 1.0;  // 0 at the bottom of a strip, 1 at its top
+  float elevation = atan(mix(u_tangents.y, u_tangents.x, up));
+  vec2 uv = vec2(fract((azimuth + PI) / (2.0 * PI)), (u_panoramaTop - elevation) / u_panoramaSpan);
+  bool outside = uv.y < 0.0 || uv.y > 1.0;
+  o_colour = outside ? vec4(0.0, 0.0, 0.0, 1.0) : vec4(texture(u_panorama, uv).rgb, 1.0);
+})";
+
+constexpr const char* kPictureFragment = R"(#version 300 es
+precision mediump float;
+uniform sampler2D u_picture;
+in vec2 v_picture;
+out vec4 o_colour;
+void main() {
+  o_colour = vec4(texture(u_picture, vec2(v_picture.x + 1.0, 1.0 - v_picture.y) * 0.5).rgb, 1.0);
+})";
+
+void attribute(GLuint index, GLint components, GLsizei stride, std::size_t offset) {
+  glEnableVertexAttribArray(index);
+  // With a vertex buffer bound, GL takes the offset into it in the pointer argument.
+  glVertexAttribPointer(
+      index, components, GL_FLOAT, GL_FALSE, stride,
+      reinterpret_cast<const void*>(offset));  // NOLINT(performance-no-int-to-ptr)
+}
+
+void requireBgr(const cv::Mat& image, cv::Size size, const char* what) {
+  if (image.type() != CV_8UC3 || image.size() != size) {
+    throw std::invalid_argument(fmt::format("{}: expected 8-bit BGR {}x{}, got {}x{} of type {}",
+                                            what, size.width, size.height, image.cols, image.rows,
+                                            image.type()));
+  }
+}
+
+}  // namespace
+
+SurroundScene::StreamedTexture::StreamedTexture(cv::Size textureSize, GLint horizontalWrap)
+    : size(textureSize) {
+  glBindTexture(GL_TEXTURE_2D, texture.name());
+  glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGB8, size.width, size.height);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, horizontalWrap);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  // Pictures arrive as BGR; the texture unit swaps them back, so no pass over the pixels does.
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_SWIZZLE_R, GL_BLUE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_SWIZZLE_B, GL_RED);
+  const auto bytes = static_cast<GLsizeiptr>(size.area()) * 3;
+  for (const auto& buffer : buffers) {
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, buffer.name());
+    glBufferData(GL_PIXEL_UNPACK_BUFFER, bytes, nullptr, GL_STREAM_DRAW);
+  }
+  glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+  gl::check("creating a streamed texture");
+}
+
+void SurroundScene::StreamedTexture::upload(const cv::Mat& bgr) {
+  glBindBuffer(GL_PIXEL_UNPACK_BUFFER, buffers[next].name());
+  next = (next + 1) % buffers.size();
+  const std::size_t rowBytes = static_cast<std::size_t>(size.width) * 3;
+  auto* mapped = static_cast<unsigned char*>(
+      glMapBufferRange(GL_PIXEL_UNPACK_BUFFER, 0, static_cast<GLsizeiptr>(rowBytes * size.height),
+                       GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT));
+  if (mapped == nullptr) {
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    gl::check("mapping a texture upload buffer");
+    throw std::runtime_error("mapping a texture upload buffer failed");
+  }
+  if (bgr.isContinuous()) {
+    std::memcpy(mapped, bgr.data, rowBytes * size.height);
+  } else {
+    for (int y = 0; y < size.height; ++y) {
+      std::memcpy(mapped + rowBytes * y, bgr.ptr(y), rowBytes);
+    }
+  }
+  glUnmapBuffer(GL_PIXEL_UNPACK_BUFFER);
+  glBindTexture(GL_TEXTURE_2D, texture.name());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, size.width, size.height, GL_RGB, GL_UNSIGNED_BYTE,
+                  nullptr);
+  glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+  gl::check("uploading a texture");
+}
+
+SurroundScene::SurroundScene(const processing::SurroundMesh& mesh,
+                             const processing::PanoramaGeometry& panorama, const CarDimensions& car,
+                             cv::Size cameraSize)
+    : cameraSize_(cameraSize),
+      meshProgram_("surround mesh", kMeshVertex, kMeshFragment),
+      carProgram_("car", kCarVertex, kCarFragment),
+      stripProgram_("360 strips", kFullViewportVertex, kStripFragment),
+      pictureProgram_("camera picture", kFullViewportVertex, kPictureFragment),
+      meshViewProjection_(meshProgram_.uniform("u_viewProjection")),
+      carViewProjection_(carProgram_.uniform("u_viewProjection")),
+      stripTangents_(stripProgram_.uniform("u_tangents")),
+      panoramaTexture_(panorama.size, GL_REPEAT),  // azimuth wraps around
+      cameraTexture_(cameraSize, GL_CLAMP_TO_EDGE),
+      meshIndexCount_(static_cast<GLsizei>(mesh.indices.size())) {
+  glUseProgram(stripProgram_.name());
+  glUniform1f(stripProgram_.uniform("u_panoramaTop"), static_cast<float>(panorama.elevationTopRad));
+  glUniform1f(stripProgram_.uniform("u_panoramaSpan"),
+              static_cast<float>(panorama.elevationTopRad - panorama.elevationBottomRad));
+
+  glBindVertexArray(meshArray_.name());
+  glBindBuffer(GL_ARRAY_BUFFER, meshVertices_.name());
+  glBufferData(GL_ARRAY_BUFFER,
+               static_cast<GLsizeiptr>(mesh.vertices.size() * sizeof(processing::MeshVertex)),
+               mesh.vertices.data(), GL_STATIC_DRAW);
+  constexpr auto kMeshStride = static_cast<GLsizei>(sizeof(processing::MeshVertex));
+  attribute(0, 3, kMeshStride, offsetof(processing::MeshVertex, position));
+  attribute(1, 2, kMeshStride, offsetof(processing::MeshVertex, uv));
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, meshIndices_.name());
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+               static_cast<GLsizeiptr>(mesh.indices.size() * sizeof(std::uint32_t)),
+               mesh.indices.data(), GL_STATIC_DRAW);
+
+  const std::vector<CarVertex> carModel = buildCarModel(car, mesh.innerRadiusM);
+  carVertexCount_ = static_cast<GLsizei>(carModel.size());
+  glBindVertexArray(carArray_.name());
+  glBindBuffer(GL_ARRAY_BUFFER, carVertices_.name());
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(carModel.size() * sizeof(CarVertex)),
+               carModel.data(), GL_STATIC_DRAW);
+  constexpr auto kCarStride = static_cast<GLsizei>(sizeof(CarVertex));
+  attribute(0, 3, kCarStride, offsetof(CarVertex, position));
+  attribute(1, 3, kCarStride, offsetof(CarVertex, normal));
+  attribute(2, 3, kCarStride, offsetof(CarVertex, colour));
+  glBindVertexArray(0);
+  gl::check("setting up the surround scene");
+}
+
+void SurroundScene::uploadPanorama(const cv::Mat& bgr) {
+  requireBgr(bgr, panoramaTexture_.size, "panorama");
+  panoramaTexture_.upload(bgr);
+}
+
+void SurroundScene::uploadCamera(const cv::Mat& bgr) {
+  requireBgr(bgr, cameraTexture_.size, "camera picture");
+  cameraTexture_.upload(bgr);
+}
+
+void SurroundScene::drawSurround(const cv::Matx44f& viewProjection) const {
+  glEnable(GL_DEPTH_TEST);
+  glUseProgram(meshProgram_.name());
+  glUniformMatrix4fv(meshViewProjection_, 1, GL_TRUE, viewProjection.val);
+  glBindTexture(GL_TEXTURE_2D, panoramaTexture_.texture.name());
+  glBindVertexArray(meshArray_.name());
+  glDrawElements(GL_TRIANGLES, meshIndexCount_, GL_UNSIGNED_INT, nullptr);
+  glUseProgram(carProgram_.name());
+  glUniformMatrix4fv(carViewProjection_, 1, GL_TRUE, viewProjection.val);
+  glBindVertexArray(carArray_.name());
+  glDrawArrays(GL_TRIANGLES, 0, carVertexCount_);
+  glBindVertexArray(0);
+  glDisable(GL_DEPTH_TEST);
+}
+
+void SurroundScene::drawStrips(const cv::Vec2f& stripTangents) const {
+  glUseProgram(stripProgram_.name());
+  glUniform2f(stripTangents_, stripTangents[0], stripTangents[1]);
+  glBindTexture(GL_TEXTURE_2D, panoramaTexture_.texture.name());
+  glBindVertexArray(emptyArray_.name());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+void SurroundScene::drawCamera() const {
+  glUseProgram(pictureProgram_.name());
+  glBindTexture(GL_TEXTURE_2D, cameraTexture_.texture.name());
+  glBindVertexArray(emptyArray_.name());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+}  // namespace surroundd::render

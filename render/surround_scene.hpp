@@ -1,0 +1,71 @@
+#pragma once
+// What every surround view draws from, on the GPU: the panorama texture (streamed each frame
+// through pixel buffer objects), the surround mesh and the car (uploaded once), the split view's
+// camera picture, and the shader programs. Built at start-up on the thread of the current
+// EglContext; SurroundView draws it.
+
+#include <array>
+#include <optional>
+
+#include <opencv2/core.hpp>
+
+#include "processing/panorama_geometry.hpp"
+#include "processing/surround_mesh.hpp"
+#include "render/car_model.hpp"
+#include "render/gl_objects.hpp"
+#include "render/shader_program.hpp"
+#include "render/view_camera.hpp"
+
+namespace surroundd::render {
+
+class SurroundScene {
+ public:
+  // `cameraSize` is the size of the pictures the split view shows beside the 3D view.
+  SurroundScene(const processing::SurroundMesh& mesh, const processing::PanoramaGeometry& panorama,
+                const CarDimensions& car, cv::Size cameraSize);
+
+  // 8-bit BGR, of the panorama's size (resp. cameraSize); throws std::invalid_argument otherwise.
+  void uploadPanorama(const cv::Mat& bgr);
+  void uploadCamera(const cv::Mat& bgr);
+
+  // Into the current framebuffer and viewport:
+  void drawSurround(const cv::Matx44f& viewProjection) const;  // mesh and car, depth-tested
+  void drawStrips(const cv::Vec2f& stripTangents) const;       // the 360 view
+  void drawCamera() const;                                     // the camera picture, filling it
+
+  cv::Size cameraSize() const { return cameraSize_; }
+
+ private:
+  // A texture fed through two pixel buffers in turn, so that filling one does not wait for the
+  // transfer of the other.
+  struct StreamedTexture {
+    StreamedTexture(cv::Size size, GLint horizontalWrap);
+    void upload(const cv::Mat& bgr);
+
+    cv::Size size;
+    gl::Texture texture;
+    std::array<gl::Buffer, 2> buffers;
+    std::size_t next = 0;
+  };
+
+  cv::Size cameraSize_;
+  ShaderProgram meshProgram_;
+  ShaderProgram carProgram_;
+  ShaderProgram stripProgram_;
+  ShaderProgram pictureProgram_;
+  GLint meshViewProjection_;
+  GLint carViewProjection_;
+  GLint stripTangents_;
+  StreamedTexture panoramaTexture_;
+  StreamedTexture cameraTexture_;
+  gl::VertexArray meshArray_;
+  gl::Buffer meshVertices_;
+  gl::Buffer meshIndices_;
+  GLsizei meshIndexCount_;
+  gl::VertexArray carArray_;
+  gl::Buffer carVertices_;
+  GLsizei carVertexCount_;
+  gl::VertexArray emptyArray_;  // full-screen passes make their vertices from gl_VertexID
+};
+
+}  // namespace surroundd::render

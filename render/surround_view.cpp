@@ -1,0 +1,106 @@
+#include "render/surround_view.hpp"
+
+#include <stdexcept>
+
+#include <fmt/core.h>
+#include <opencv2/imgproc.hpp>
+
+#include "render/render_error.hpp"
+
+namespace surroundd::render {
+namespace {
+
+// The largest rectangle of `picture`'s aspect that fits `area`, centred in it.
+cv::Rect letterbox(cv::Size picture, const cv::Rect& area) {
+  const double scale = std::min(static_cast<double>(area.width) / picture.width,
+                                static_cast<double>(area.height) / picture.height);
+  const int w = static_cast<int>(picture.width * scale);
+  const int h = static_cast<int>(picture.height * scale);
+  return {area.x + (area.width - w) / 2, area.y + (area.height - h) / 2, w, h};
+}
+
+}  // namespace
+
+SurroundView::SurroundView(const SurroundScene& scene, cv::Size size, ViewKind view,
+                           ViewSettings settings)
+    : scene_(scene), size_(size), view_(view), settings_(settings), picture_(size, CV_8UC3) {
+  if (size.width <= 0 || size.height <= 0 || size.width % 2 != 0 || size.height % 2 != 0) {
+    throw std::invalid_argument(fmt::format(
+        "surround view: size must be even and positive, got {}x{}", size.width, size.height));
+  }
+  glBindRenderbuffer(GL_RENDERBUFFER, colour_.name());
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, size.width, size.height);
+  glBindRenderbuffer(GL_RENDERBUFFER, depth_.name());
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, size.width, size.height);
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.name());
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour_.name());
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_.name());
+  const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    throw RenderError(fmt::format("surround view {}x{}: framebuffer incomplete (0x{:04x})",
+                                  size.width, size.height, status));
+  }
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, readBuffer_.name());
+  glBufferData(GL_PIXEL_PACK_BUFFER, static_cast<GLsizeiptr>(size.area()) * 4, nullptr,
+               GL_STREAM_READ);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  gl::check("creating a surround view");
+}
+
+void SurroundView::draw(double timeS) {
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.name());
+  glViewport(0, 0, size_.width, size_.height);
+  glClearColor(0.08F, 0.08F, 0.08F, 1.0F);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  switch (view_) {
+    case ViewKind::kTop:
+      scene_.drawSurround(topViewProjection(settings_, size_));
+      break;
+    case ViewKind::kPanorama360:
+      scene_.drawStrips(stripTangents(settings_, size_));
+      break;
+    case ViewKind::kOrbit:
+      scene_.drawSurround(orbitViewProjection(settings_, size_, timeS));
+      break;
+    case ViewKind::kSplit: {
+      // Framebuffer row 0 is the picture's top, so viewport rectangles read top-down too.
+      const cv::Size half(size_.width / 2, size_.height);
+      glViewport(0, 0, half.width, half.height);
+      scene_.drawSurround(orbitViewProjection(settings_, half, timeS));
+      const cv::Rect camera =
+          letterbox(scene_.cameraSize(), {half.width, 0, half.width, half.height});
+      glViewport(camera.x, camera.y, camera.width, camera.height);
+      scene_.drawCamera();
+      break;
+    }
+  }
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, readBuffer_.name());
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(0, 0, size_.width, size_.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  gl::check("drawing a surround view");
+  pending_ = true;
+}
+
+const cv::Mat& SurroundView::collect() {
+  if (!pending_) return picture_;
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, readBuffer_.name());
+  const void* mapped = glMapBufferRange(GL_PIXEL_PACK_BUFFER, 0,
+                                        static_cast<GLsizeiptr>(size_.area()) * 4, GL_MAP_READ_BIT);
+  if (mapped == nullptr) {
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    gl::check("mapping the read-back buffer");
+    throw RenderError("mapping the read-back buffer failed");
+  }
+  // The mapped pixels are read once, straight into the output's BGR picture.
+  const cv::Mat rgba(size_, CV_8UC4, const_cast<void*>(mapped));
+  cv::cvtColor(rgba, picture_, cv::COLOR_RGBA2BGR);
+  glUnmapBuffer(GL_PIXEL_PACK_BUFFER);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  pending_ = false;
+  return picture_;
+}
+
+}  // namespace surroundd::render

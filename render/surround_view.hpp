@@ -1,0 +1,45 @@
+#pragma once
+// One rendered output of the surround scene: a framebuffer of the output's size, the view shown
+// in it (switchable at any time), and an asynchronous read-back through a pixel buffer object.
+//
+// Per frame: draw() renders and starts the read-back; the caller does other work (the next
+// frame's stitch) while the GPU finishes; collect() then waits for the pixels. Nothing is
+// allocated per frame.
+
+#include <opencv2/core.hpp>
+
+#include "render/gl_objects.hpp"
+#include "render/surround_scene.hpp"
+#include "render/view_camera.hpp"
+
+namespace surroundd::render {
+
+class SurroundView {
+ public:
+  // `size`: even width and height. The scene must outlive the view.
+  SurroundView(const SurroundScene& scene, cv::Size size, ViewKind view, ViewSettings settings);
+
+  void setView(ViewKind view) { view_ = view; }
+  ViewKind view() const { return view_; }
+  cv::Size size() const { return size_; }
+
+  // Renders the scene as it was last uploaded; `timeS` moves the orbiting eye.
+  void draw(double timeS);
+  bool pending() const { return pending_; }
+  // The picture of the last draw(), 8-bit BGR; valid until the next collect().
+  const cv::Mat& collect();
+
+ private:
+  const SurroundScene& scene_;
+  cv::Size size_;
+  ViewKind view_;
+  ViewSettings settings_;
+  gl::Framebuffer framebuffer_;
+  gl::Renderbuffer colour_;
+  gl::Renderbuffer depth_;
+  gl::Buffer readBuffer_;
+  bool pending_ = false;
+  cv::Mat picture_;
+};
+
+}  // namespace surroundd::render

@@ -1,0 +1,90 @@
+#include "render/view_camera.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace surroundd::render {
+namespace {
+
+constexpr double kDegToRad = std::numbers::pi / 180;
+constexpr float kNearM = 0.1F;
+constexpr float kFarM = 200.0F;
+
+cv::Matx44f perspective(double fovyRad, double aspect) {
+  const auto f = static_cast<float>(1 / std::tan(fovyRad / 2));
+  const auto a = static_cast<float>(aspect);
+  // The y row is negated so that row 0 of the framebuffer is the top of the picture.
+  return {f / a,
+          0,
+          0,
+          0,  //
+          0,
+          -f,
+          0,
+          0,  //
+          0,
+          0,
+          (kFarM + kNearM) / (kNearM - kFarM),
+          2 * kFarM * kNearM / (kNearM - kFarM),  //
+          0,
+          0,
+          -1,
+          0};
+}
+
+cv::Matx44f lookAt(const cv::Vec3f& eye, const cv::Vec3f& target, const cv::Vec3f& up) {
+  const cv::Vec3f f = cv::normalize(target - eye);
+  const cv::Vec3f s = cv::normalize(f.cross(up));
+  const cv::Vec3f u = s.cross(f);
+  return {s[0],  s[1],  s[2],  -s.dot(eye),  //
+          u[0],  u[1],  u[2],  -u.dot(eye),  //
+          -f[0], -f[1], -f[2], f.dot(eye),   //
+          0,     0,     0,     1};
+}
+
+double aspectOf(cv::Size viewport) { return static_cast<double>(viewport.width) / viewport.height; }
+
+}  // namespace
+
+const char* toString(ViewKind view) {
+  switch (view) {
+    case ViewKind::kTop:
+      return "top";
+    case ViewKind::kPanorama360:
+      return "360";
+    case ViewKind::kOrbit:
+      return "orbit";
+    case ViewKind::kSplit:
+      return "split";
+  }
+  return "?";
+}
+
+cv::Matx44f topViewProjection(const ViewSettings& settings, cv::Size viewport) {
+  const double aspect = aspectOf(viewport);
+  // Half the picture's height on the ground: the range itself, or more where the picture is
+  // taller than wide and its width is the shorter side.
+  const double halfHeightM = aspect >= 1 ? settings.topRangeM : settings.topRangeM / aspect;
+  const double fovy = 2 * std::atan(halfHeightM / settings.topHeightM);
+  const cv::Vec3f eye(0, 0, static_cast<float>(settings.topHeightM));
+  return perspective(fovy, aspect) * lookAt(eye, {0, 0, 0}, {1, 0, 0});
+}
+
+cv::Matx44f orbitViewProjection(const ViewSettings& settings, cv::Size viewport, double timeS) {
+  const double angle = std::numbers::pi + 2 * std::numbers::pi * timeS / settings.orbitPeriodS;
+  const cv::Vec3f eye(static_cast<float>(settings.orbitRadiusM * std::cos(angle)),
+                      static_cast<float>(settings.orbitRadiusM * std::sin(angle)),
+                      static_cast<float>(settings.orbitHeightM));
+  return perspective(settings.orbitFovDeg * kDegToRad, aspectOf(viewport)) *
+         lookAt(eye, {0, 0, 0.5F}, {0, 0, 1});
+}
+
+cv::Vec2f stripTangents(const ViewSettings& settings, cv::Size viewport) {
+  // A strip is half a turn wide; at the horizon a radian takes as many rows as columns.
+  const double pixelsPerRadian = viewport.width / std::numbers::pi;
+  const double top = std::tan(settings.stripTopDeg * kDegToRad);
+  const double bottom = top - (viewport.height / 2.0) / pixelsPerRadian;
+  return {static_cast<float>(top), static_cast<float>(bottom)};
+}
+
+}  // namespace surroundd::render

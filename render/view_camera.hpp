@@ -1,0 +1,39 @@
+#pragma once
+// The views of the surround scene and where their eyes are (DESIGN.md §2.5):
+//   top     bird's eye: straight down from above the vehicle, its front up in the picture; the
+//           shorter side of the picture spans 2 x topRangeM on the ground.
+//   360     the horizontal panorama from the vehicle's centre as two strips, front half above
+//           (left side ... front ... right side) and back half below (right ... back ... left),
+//           vertical lines straight (a cylinder seen from its axis).
+//   orbit   a camera circling the vehicle, looking at it.
+//   split   the orbit view on the left half, one camera's own picture on the right.
+// Matrices take vehicle-frame points to OpenGL clip space, with rows of the picture top first.
+
+#include <opencv2/core.hpp>
+
+namespace surroundd::render {
+
+enum class ViewKind { kTop, kPanorama360, kOrbit, kSplit };
+
+const char* toString(ViewKind view);
+
+struct ViewSettings {
+  double topRangeM = 8.0;
+  double topHeightM = 14.0;    // eye height of the top view
+  double orbitRadiusM = 8.0;   // horizontal distance of the orbiting eye from the vehicle
+  double orbitHeightM = 4.5;   // its height
+  double orbitPeriodS = 20.0;  // one turn, in stream time; the eye starts behind the vehicle
+  double orbitFovDeg = 60.0;   // vertical field of view
+  double stripTopDeg = 15.0;   // 360 view: elevation at the top of each strip
+
+  bool operator==(const ViewSettings&) const = default;
+};
+
+cv::Matx44f topViewProjection(const ViewSettings& settings, cv::Size viewport);
+cv::Matx44f orbitViewProjection(const ViewSettings& settings, cv::Size viewport, double timeS);
+
+// The 360 view's strips: elevations (tan) at the top and bottom of a strip of `viewport` / 2
+// rows that keeps angles at the horizon undistorted.
+cv::Vec2f stripTangents(const ViewSettings& settings, cv::Size viewport);
+
+}  // namespace surroundd::render

@@ -1,0 +1,229 @@
+// The surround view on whatever EGL offers (Mesa's llvmpipe here): ground points land where the
+// top view's geometry puts them, each view matches its golden picture, views switch at run time,
+// and set-up errors say what failed.
+
+#include "render/surround_view.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <numbers>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "render/egl_context.hpp"
+#include "render/render_error.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace surroundd::render {
+namespace {
+
+// A panorama whose every pixel says where it is: red and green run up and down (a triangle
+// wave) along columns and rows, blue counts the 256-pixel blocks. Linear filtering between
+// neighbours stays decodable because the waves never jump.
+cv::Mat codedPanorama(cv::Size size) {
+  cv::Mat image(size, CV_8UC3);
+  const auto wave = [](int i) { return (i >> 8) % 2 == 0 ? (i & 255) : 255 - (i & 255); };
+  for (int r = 0; r < size.height; ++r) {
+    for (int c = 0; c < size.width; ++c) {
+      image.at<cv::Vec3b>(r, c) =
+          cv::Vec3b(static_cast<std::uint8_t>(30 * (c >> 8) + 128 * (r >> 8)),
+                    static_cast<std::uint8_t>(wave(r)), static_cast<std::uint8_t>(wave(c)));
+    }
+  }
+  return image;
+}
+
+cv::Point2d decode(const cv::Vec3b& bgr) {
+  const int rowBlock = bgr[0] >= 110 ? 1 : 0;
+  const int columnBlock = static_cast<int>(std::lround((bgr[0] - 128 * rowBlock) / 30.0));
+  const auto unwave = [](int block, int value) {
+    return block * 256 + (block % 2 == 0 ? value : 255 - value);
+  };
+  return {static_cast<double>(unwave(columnBlock, bgr[2])),
+          static_cast<double>(unwave(rowBlock, bgr[1]))};
+}
+
+processing::PanoramaGeometry testPanorama() {
+  processing::PanoramaGeometry p;
+  p.size = {1024, 512};
+  p.centre = {0, 0, 1.9};
+  return p;
+}
+
+struct Rendering {
+  Rendering(processing::MeshModel model, cv::Size size, ViewKind view)
+      : scene(mesh(model), testPanorama(), CarDimensions{}, {320, 180}),
+        surround(scene, size, view, ViewSettings{}) {
+    scene.uploadPanorama(codedPanorama(testPanorama().size));
+    scene.uploadCamera(surroundd::testing::syntheticPicture({320, 180}, 3));
+  }
+  static processing::SurroundMesh mesh(processing::MeshModel model) {
+    processing::MeshSettings settings;
+    settings.model = model;
+    return processing::buildSurroundMesh(settings, testPanorama());
+  }
+  cv::Mat draw(double timeS = 0) {
+    surround.draw(timeS);
+    return surround.collect().clone();
+  }
+
+  SurroundScene scene;
+  SurroundView surround;
+};
+
+class SurroundViewTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { context_ = new EglContext(); }
+  static void TearDownTestSuite() {
+    delete context_;
+    context_ = nullptr;
+  }
+  static EglContext* context_;
+};
+EglContext* SurroundViewTest::context_ = nullptr;
+
+TEST_F(SurroundViewTest, MakesAHeadlessContext) {
+  RecordProperty("egl", context_->description());
+  EXPECT_NE(context_->description().find("OpenGL ES 3"), std::string::npos)
+      << context_->description();
+}
+
+// Ground points at known vehicle-frame positions: in the top view they must land where its
+// geometry says (front up, left on the left, the shorter side spanning 2 x range), and the
+// panorama pixel seen there must be the one that looks at that ground point.
+void expectGroundPointsLandOnTheirPixels(processing::MeshModel model,
+                                         std::initializer_list<cv::Point2d> groundPoints) {
+  const cv::Size size(640, 480);
+  Rendering rendering(model, size, ViewKind::kTop);
+  const cv::Mat picture = rendering.draw();
+  const processing::PanoramaGeometry panorama = testPanorama();
+  const double pixelsPerMetre = std::min(size.width, size.height) / (2 * ViewSettings{}.topRangeM);
+  for (const cv::Point2d& ground : groundPoints) {
+    const cv::Point2d expected(size.width / 2.0 - ground.y * pixelsPerMetre - 0.5,
+                               size.height / 2.0 - ground.x * pixelsPerMetre - 0.5);
+    const cv::Point2d wanted = panorama.pixel(cv::Vec3d(ground.x, ground.y, 0) - panorama.centre);
+    double bestError = 1e9;
+    cv::Point best;
+    for (int y = static_cast<int>(expected.y) - 6; y <= static_cast<int>(expected.y) + 6; ++y) {
+      for (int x = static_cast<int>(expected.x) - 6; x <= static_cast<int>(expected.x) + 6; ++x) {
+        const cv::Point2d seen = decode(picture.at<cv::Vec3b>(y, x));
+        double dc = std::abs(seen.x - wanted.x);
+        dc = std::min(dc, panorama.size.width - dc);
+        const double error = std::hypot(dc, seen.y - wanted.y);
+        if (error < bestError) {
+          bestError = error;
+          best = {x, y};
+        }
+      }
+    }
+    EXPECT_LT(bestError, 2.0) << "ground point " << ground << ": panorama pixel " << wanted
+                              << " not seen near " << expected;
+    EXPECT_LE(cv::norm(cv::Point2d(best) - expected), 2.0)
+        << "ground point " << ground << " drawn at " << best << ", expected " << expected;
+  }
+}
+
+TEST_F(SurroundViewTest, TopViewPutsGroundPointsOnTheirPixelsOnTheBowlFloor) {
+  expectGroundPointsLandOnTheirPixels(processing::MeshModel::kBowl, {{3.5, 0},
+                                                                     {-3.5, 0},
+                                                                     {0, 2.5},
+                                                                     {0, -2.5},
+                                                                     {3, 2.5},
+                                                                     {-3, 2.5},
+                                                                     {3, -2.5},
+                                                                     {4.5, 1.5},
+                                                                     {-1, 4.5}});
+}
+
+TEST_F(SurroundViewTest, TopViewPutsGroundPointsOnTheirPixelsOnTheFlatDisk) {
+  expectGroundPointsLandOnTheirPixels(processing::MeshModel::kFlat,
+                                      {{7, 0}, {0, 6.5}, {-5, -5}, {-7.5, 1}, {2, -8}});
+}
+
+// Each view against its golden picture (rendered once on llvmpipe and reviewed). Set
+// SURROUNDD_UPDATE_GOLDEN=1 to write new ones after an intended change.
+void expectMatchesGolden(const cv::Mat& picture, const std::string& name) {
+  const std::filesystem::path golden =
+      std::filesystem::path(SURROUNDD_SOURCE_DIR) / "tests/render/golden" / (name + ".png");
+  if (std::getenv("SURROUNDD_UPDATE_GOLDEN") != nullptr) {
+    cv::imwrite(golden.string(), picture);
+    GTEST_SKIP() << "wrote " << golden;
+  }
+  const cv::Mat expected = cv::imread(golden.string(), cv::IMREAD_COLOR);
+  ASSERT_FALSE(expected.empty()) << "no golden picture " << golden;
+  ASSERT_EQ(expected.size(), picture.size());
+  cv::Mat difference;
+  cv::absdiff(picture, expected, difference);
+  difference = difference.reshape(1);
+  const double mean = cv::mean(difference)[0];
+  const double farOff = static_cast<double>(cv::countNonZero(difference > 24)) /
+                        static_cast<double>(difference.total());
+  const std::filesystem::path actual =
+      std::filesystem::temp_directory_path() / ("surroundd-" + name + "-actual.png");
+  if (mean > 0.5 || farOff > 0.002) cv::imwrite(actual.string(), picture);
+  EXPECT_LE(mean, 0.5) << name << ": mean difference to the golden picture; this run's is "
+                       << actual;
+  EXPECT_LE(farOff, 0.002) << name << ": share of values more than 24 levels off; see " << actual;
+}
+
+TEST_F(SurroundViewTest, EveryViewMatchesItsGoldenPicture) {
+  Rendering rendering(processing::MeshModel::kBowl, {320, 240}, ViewKind::kTop);
+  for (const ViewKind view :
+       {ViewKind::kTop, ViewKind::kPanorama360, ViewKind::kOrbit, ViewKind::kSplit}) {
+    SCOPED_TRACE(toString(view));
+    rendering.surround.setView(view);
+    expectMatchesGolden(rendering.draw(3.0), std::string("view_") + toString(view));
+  }
+}
+
+TEST_F(SurroundViewTest, SwitchingTheViewChangesThePictureAndBack) {
+  Rendering rendering(processing::MeshModel::kBowl, {320, 240}, ViewKind::kTop);
+  const cv::Mat top = rendering.draw();
+  const uchar* buffer = rendering.surround.collect().data;
+  rendering.surround.setView(ViewKind::kOrbit);
+  EXPECT_EQ(rendering.surround.view(), ViewKind::kOrbit);
+  const cv::Mat orbit = rendering.draw();
+  rendering.surround.setView(ViewKind::kTop);
+  const cv::Mat topAgain = rendering.draw();
+  EXPECT_GT(cv::norm(top, orbit, cv::NORM_L1) / static_cast<double>(top.total()), 10.0);
+  EXPECT_EQ(cv::norm(top, topAgain, cv::NORM_INF), 0.0);
+  EXPECT_EQ(rendering.surround.collect().data, buffer) << "the picture was reallocated";
+}
+
+TEST_F(SurroundViewTest, OrbitMovesWithTimeAndReadBackIsCollectedOnce) {
+  Rendering rendering(processing::MeshModel::kBowl, {320, 240}, ViewKind::kOrbit);
+  EXPECT_FALSE(rendering.surround.pending());
+  rendering.surround.draw(0.0);
+  EXPECT_TRUE(rendering.surround.pending());
+  const cv::Mat first = rendering.surround.collect().clone();
+  EXPECT_FALSE(rendering.surround.pending());
+  EXPECT_EQ(cv::norm(first, rendering.surround.collect(), cv::NORM_INF), 0.0);
+  const cv::Mat later = rendering.draw(5.0);  // a quarter turn on
+  EXPECT_GT(cv::norm(first, later, cv::NORM_L1) / static_cast<double>(first.total()), 10.0);
+}
+
+TEST_F(SurroundViewTest, RefusesPicturesOfTheWrongSize) {
+  Rendering rendering(processing::MeshModel::kBowl, {320, 240}, ViewKind::kTop);
+  EXPECT_THROW(rendering.scene.uploadPanorama(cv::Mat(100, 200, CV_8UC3)), std::invalid_argument);
+  EXPECT_THROW(rendering.scene.uploadCamera(cv::Mat(180, 320, CV_8UC1)), std::invalid_argument);
+  EXPECT_THROW(SurroundView(rendering.scene, {321, 240}, ViewKind::kTop, ViewSettings{}),
+               std::invalid_argument);
+}
+
+TEST_F(SurroundViewTest, ShaderErrorsCarryTheDriversLog) {
+  try {
+    ShaderProgram broken("broken", "#version 300 es\nvoid main() { gl_Position = vec4(x); }",
+                         "#version 300 es\nvoid main() {}");
+    FAIL() << "a shader with an undeclared name compiled";
+  } catch (const RenderError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("'broken'"), std::string::npos) << message;
+    EXPECT_NE(message.find("vertex shader does not compile"), std::string::npos) << message;
+    EXPECT_NE(message.find('x'), std::string::npos) << message;
+  }
+}
+
+}  // namespace
+}  // namespace surroundd::render

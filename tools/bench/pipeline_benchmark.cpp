@@ -1,0 +1,241 @@
+#include "tools/bench/pipeline_benchmark.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include "daemon/logging.hpp"
+#include "daemon/pipeline.hpp"
+#include "daemon/rig_yaml.hpp"
+#include "tools/bench/recording_truth.hpp"
+
+namespace surroundd::bench {
+namespace {
+
+// The paper's table 1 (frames per second for 4 x 1080p, 720p, 480p), for orientation only: other
+// hardware, not measured here.
+constexpr const char* kPaperFigures =
+    "paper, table 1: desktop (Xeon E3-1230 + GTX 1070) 50 / 55 / 62 FPS, Jetson AGX Xavier "
+    "15 / 18 / 20 FPS for 4 x 1080p / 720p / 480p";
+
+struct RunFigures {
+  daemon::RunSummary summary;
+  double cpuSeconds = 0;
+  double peakMegabytes = 0;
+  double fps() const { return summary.framesPerSecond(); }
+};
+
+struct RecordingFigures {
+  std::string name;
+  cv::Size camera;
+  cv::Size panorama;
+  RunFigures full;         // the run of median frame rate
+  double baselineFps = 0;  // median
+  double decodeMs = 0;     // per camera frame, in the capture threads
+};
+
+double cpuSecondsSoFar() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const auto seconds = [](const timeval& t) {
+    return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_usec) * 1e-6;
+  };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
+// Linux keeps the peak resident size (VmHWM); writing 5 to clear_refs starts it afresh.
+void resetPeakMemory() { std::ofstream("/proc/self/clear_refs") << "5"; }
+
+double peakMegabytes() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.starts_with("VmHWM:")) return std::stod(line.substr(6)) / 1024;
+  }
+  return 0;
+}
+
+RunFigures runOnce(const daemon::Config& config) {
+  daemon::Pipeline pipeline(config);  // LUT (cached), factorizations, GL: start-up, not timed
+  resetPeakMemory();
+  const double cpuBefore = cpuSecondsSoFar();
+  const std::atomic<bool> stop{false};
+  RunFigures figures;
+  figures.summary = pipeline.run(stop);
+  figures.cpuSeconds = cpuSecondsSoFar() - cpuBefore;
+  figures.peakMegabytes = peakMegabytes();
+  return figures;
+}
+
+daemon::Config configFor(const std::filesystem::path& folder, const RecordingTruth& truth,
+                         const PipelineBenchmarkOptions& options,
+                         const std::filesystem::path& scratch) {
+  daemon::Config config;
+  config.file = folder / "rig.yaml";
+  config.cameras = daemon::loadRigFile(folder / "rig.yaml");
+  config.capture.pacing = capture::Pacing::kAsFastAsPossible;
+  config.pipeline.threads = options.threads;
+  config.panorama.widthPx = truth.panorama.size.width;
+  config.panorama.heightPx = truth.panorama.size.height;
+  config.panorama.projection = options.projection;
+  config.panorama.cacheDir = scratch / "lut-cache";
+  config.colour.solver = options.solver;
+  config.render.view = options.view;
+  config.render.widthPx = options.outputSize.width;
+  config.render.heightPx = options.outputSize.height;
+  daemon::OutputConfig video;
+  video.stream = daemon::OutputStream::kSurround;
+  video.path = scratch / "surround.mp4";
+  video.preset = "ultrafast";
+  config.outputs = {video};
+  return config;
+}
+
+RecordingFigures measure(const std::filesystem::path& folder,
+                         const PipelineBenchmarkOptions& options,
+                         const std::filesystem::path& scratch) {
+  const RecordingTruth truth = loadRecordingTruth(folder);
+  const daemon::Config full = configFor(folder, truth, options, scratch);
+  daemon::Config baseline = full;
+  baseline.outputs.clear();  // decode and sync only
+
+  std::vector<RunFigures> fullRuns;
+  std::vector<double> baselineFps;
+  for (int r = 0; r < options.repeats; ++r) {
+    baselineFps.push_back(runOnce(baseline).fps());
+    fullRuns.push_back(runOnce(full));
+  }
+  std::ranges::sort(fullRuns, {}, &RunFigures::fps);
+  std::ranges::sort(baselineFps);
+
+  RecordingFigures figures;
+  figures.name = folder.filename().string();
+  figures.camera = truth.rig.cameras.front().intrinsics.imageSize;
+  figures.panorama = truth.panorama.size;
+  figures.full = fullRuns[fullRuns.size() / 2];
+  figures.baselineFps = baselineFps[baselineFps.size() / 2];
+  std::chrono::nanoseconds read{0};
+  std::uint64_t frames = 0;
+  for (const auto& camera : figures.full.summary.cameras) {
+    read += camera.readTime;
+    frames += camera.frames;
+  }
+  figures.decodeMs = frames > 0 ? std::chrono::duration<double, std::milli>(read).count() /
+                                      static_cast<double>(frames)
+                                : 0;
+  return figures;
+}
+
+double stageMs(const RunFigures& run, daemon::Stage stage) {
+  const auto sets = static_cast<double>(std::max<std::uint64_t>(run.summary.frameSets, 1));
+  return std::chrono::duration<double, std::milli>(
+             run.summary.stageTime[static_cast<std::size_t>(stage)])
+             .count() /
+         sets;
+}
+
+double cpuPercent(const RunFigures& run, int cores) {
+  return 100 * run.cpuSeconds / run.summary.wallTime.count() / cores;
+}
+
+constexpr std::array kStages{daemon::Stage::kSync,     daemon::Stage::kStitch,
+                             daemon::Stage::kCorrect,  daemon::Stage::kRender,
+                             daemon::Stage::kReadBack, daemon::Stage::kOutput};
+
+void printText(const std::vector<RecordingFigures>& all, const PipelineBenchmarkOptions& options,
+               int cores) {
+  const auto& first = all.front().full.summary;
+  fmt::print(
+      "surround-bench pipeline: replay as fast as possible; {} projection, colour solver {}, {} "
+      "view {}x{}, H.264 ultrafast; {} worker threads on {} cores; renderer {}; medians of {} "
+      "runs\n",
+      options.projection == processing::PanoramaProjection::kBowl ? "bowl" : "sphere",
+      processing::poissonSolverName(options.solver), render::toString(options.view),
+      options.outputSize.width, options.outputSize.height, options.threads, cores, first.renderer,
+      options.repeats);
+  fmt::print("{:<26} {:>7} {:>13} {:>7} {:>6} {:>8}\n", "input -> panorama", "FPS", "decode+sync",
+             "ratio", "CPU %", "peak MB");
+  for (const auto& r : all) {
+    fmt::print("{:<26} {:>7.1f} {:>9.1f} FPS {:>6.2f}x {:>6.0f} {:>8.0f}\n",
+               fmt::format("4x{}x{} -> {}x{}", r.camera.width, r.camera.height, r.panorama.width,
+                           r.panorama.height),
+               r.full.fps(), r.baselineFps, r.full.fps() / r.baselineFps, cpuPercent(r.full, cores),
+               r.full.peakMegabytes);
+  }
+  fmt::print(
+      "\nmilliseconds per frame set (pipeline thread; decode runs in parallel, one thread "
+      "per camera, and is per camera frame)\n{:<8} {:>7}",
+      "input", "decode");
+  for (const auto stage : kStages) fmt::print(" {:>9}", daemon::toString(stage));
+  fmt::print("\n");
+  for (const auto& r : all) {
+    fmt::print("{:<8} {:>7.2f}", r.name, r.decodeMs);
+    for (const auto stage : kStages) fmt::print(" {:>9.2f}", stageMs(r.full, stage));
+    fmt::print("\n");
+  }
+  fmt::print(
+      "\n'ratio' is the full pipeline's frame rate over the decode+sync-only replay of the "
+      "same recording, run in turns with it.\n{}\n",
+      kPaperFigures);
+}
+
+void printJson(const std::vector<RecordingFigures>& all, const PipelineBenchmarkOptions& options,
+               int cores) {
+  fmt::print(
+      "{{\"pipeline\": {{\"threads\": {}, \"cores\": {}, \"repeats\": {}, \"view\": \"{}\", "
+      "\"renderer\": \"{}\", \"inputs\": [",
+      options.threads, cores, options.repeats, render::toString(options.view),
+      all.front().full.summary.renderer);
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const auto& r = all[i];
+    fmt::print(
+        "{}\n  {{\"name\": \"{}\", \"camera\": [{}, {}], \"panorama\": [{}, {}], "
+        "\"fps\": {:.3f}, \"baseline_fps\": {:.3f}, \"ratio\": {:.4f}, \"cpu_percent\": "
+        "{:.1f}, \"peak_mb\": {:.1f}, \"frame_sets\": {}, \"ms\": {{\"decode\": {:.3f}",
+        i == 0 ? "" : ",", r.name, r.camera.width, r.camera.height, r.panorama.width,
+        r.panorama.height, r.full.fps(), r.baselineFps, r.full.fps() / r.baselineFps,
+        cpuPercent(r.full, cores), r.full.peakMegabytes, r.full.summary.frameSets, r.decodeMs);
+    for (const auto stage : kStages) {
+      fmt::print(", \"{}\": {:.3f}", daemon::toString(stage), stageMs(r.full, stage));
+    }
+    fmt::print("}}}}");
+  }
+  fmt::print("\n]}}}}\n");
+}
+
+}  // namespace
+
+int runPipelineBenchmark(const PipelineBenchmarkOptions& options) {
+  const auto scratch = std::filesystem::temp_directory_path() /
+                       fmt::format("surround-bench-pipeline-{}", ::getpid());
+  std::filesystem::create_directories(scratch);
+  daemon::setUpLogging(spdlog::level::warn);  // the daemon's warnings and errors, no progress
+  std::vector<RecordingFigures> all;
+  try {
+    for (const auto& folder : options.recordings) {
+      if (!options.json) std::fprintf(stderr, "measuring %s ...\n", folder.string().c_str());
+      all.push_back(measure(folder, options, scratch));
+    }
+  } catch (...) {
+    std::filesystem::remove_all(scratch);
+    throw;
+  }
+  std::filesystem::remove_all(scratch);
+  const int cores = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+  if (options.json) {
+    printJson(all, options, cores);
+  } else {
+    printText(all, options, cores);
+  }
+  return 0;
+}
+
+}  // namespace surroundd::bench
