@@ -250,6 +250,9 @@ void Pipeline::process(const capture::FrameSet& set) {
     timed(Stage::kStitch, since);
     if (poisson_) {
       poisson_->update(frames_);
+      for (const auto& note : poisson_->notesOfLastUpdate()) {
+        spdlog::warn("colour correction: {}", note);
+      }
       poisson_->apply(panorama_);
     } else if (gains_) {
       gains_->update(frames_);

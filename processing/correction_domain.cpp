@@ -71,7 +71,8 @@ int firstColumn(const BlockGrid& grid, const std::vector<int>& blocks) {
 }  // namespace
 
 CorrectionDomain buildCorrectionDomain(const Rig& rig, const PanoramaSettings& settings,
-                                       const PanoramaLut& lut, double scale) {
+                                       const PanoramaLut& lut, double scale,
+                                       std::span<const bool> present) {
   const int block = static_cast<int>(std::lround(1 / scale));
   if (block < 1 || lut.size.width % block != 0 || lut.size.height % block != 0) {
     throw std::invalid_argument(fmt::format(
@@ -89,6 +90,14 @@ CorrectionDomain buildCorrectionDomain(const Rig& rig, const PanoramaSettings& s
   const auto isSource = [&](std::uint8_t camera) {
     return camera != PanoramaLut::kUnseen && domain.sourceCameras[camera];
   };
+  const auto isPresent = [&](std::uint8_t camera) { return present.empty() || present[camera]; };
+  for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+    if (isPresent(static_cast<std::uint8_t>(c))) continue;
+    domain.notes.push_back(fmt::format("camera '{}' is missing: {}", rig.cameras[c].name,
+                                       domain.sourceCameras[c]
+                                           ? "its region is left uncorrected"
+                                           : "its seams are free (Neumann) borders"));
+  }
 
   std::vector<std::uint8_t> owner(static_cast<std::size_t>(blocks));
   for (int b = 0; b < blocks; ++b) {
@@ -130,6 +139,7 @@ CorrectionDomain buildCorrectionDomain(const Rig& rig, const PanoramaSettings& s
     std::vector<int> members = componentOf(grid, owner, seed, visited);
     CorrectionRegion region;
     region.source = owner[static_cast<std::size_t>(seed)];
+    if (!isPresent(region.source)) continue;
     // Row-major order in the region's own frame, columns unwrapped across +-180 degrees.
     const int x0 = firstColumn(grid, members);
     const auto localX = [&](int b) {
@@ -162,7 +172,9 @@ CorrectionDomain buildCorrectionDomain(const Rig& rig, const PanoramaSettings& s
           continue;
         }
         const std::uint8_t across = owner[static_cast<std::size_t>(q)];
-        if (across == PanoramaLut::kUnseen || isSource(across)) continue;  // Neumann
+        if (across == PanoramaLut::kUnseen || isSource(across) || !isPresent(across)) {
+          continue;  // Neumann
+        }
         auto found = dirichletOfBlock.find(q);
         if (found == dirichletOfBlock.end()) {
           const auto first = static_cast<std::uint32_t>(domain.samples.size());

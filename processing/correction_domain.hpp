@@ -15,6 +15,7 @@
 // data on both sides of its border.
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -61,9 +62,11 @@ struct CorrectionDomain {
   std::vector<std::string> notes;    // what was left out and why, for the log
 };
 
-// Throws std::invalid_argument for a scale that does not divide the panorama into whole blocks
-// of at least 2 pixels.
+// `present` (per camera; empty: all) leaves out missing cameras: a missing source's regions, and
+// the seams with a missing target, which become Neumann borders. Throws std::invalid_argument for
+// a scale that does not divide the panorama into whole blocks of at least 2 pixels.
 CorrectionDomain buildCorrectionDomain(const Rig& rig, const PanoramaSettings& settings,
-                                       const PanoramaLut& lut, double scale);
+                                       const PanoramaLut& lut, double scale,
+                                       std::span<const bool> present = {});
 
 }  // namespace surroundd::processing

@@ -1,6 +1,7 @@
 #include "processing/poisson_correction.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -36,6 +37,13 @@ struct PoissonColourCorrection::RegionState {
   int iterations = 0;
 };
 
+struct PoissonColourCorrection::Configuration {
+  CorrectionDomain domain;
+  std::vector<RegionState> regions;
+  std::vector<float> slots;  // 3 values per field slot
+  bool firstFrame = true;
+};
+
 PoissonColourCorrection::PoissonColourCorrection(const Rig& rig, const PanoramaSettings& panorama,
                                                  const PanoramaLut& lut,
                                                  const ColourCorrectionSettings& settings,
@@ -43,30 +51,27 @@ PoissonColourCorrection::PoissonColourCorrection(const Rig& rig, const PanoramaS
     : lut_(lut),
       pool_(pool),
       settings_(settings),
-      domain_(buildCorrectionDomain(rig, panorama, lut, settings.scale)) {
-  for (const auto& region : domain_.regions) {
-    RegionState state;
-    state.solver = makePoissonSolver(settings.solver, region.system, settings.tolerance);
-    state.dirichlet.assign(region.dirichlet.size() * 3, 0.0f);
-    state.rhs.assign(region.system.unknowns() * 3, 0.0f);
-    state.solution.assign(region.system.unknowns() * 3, 0.0f);
-    regions_.push_back(std::move(state));
-  }
-  slots_.assign(domain_.slots * 3, 0.0f);
-  field_.create(domain_.grid, CV_32FC3);
+      rig_(rig),
+      panorama_(panorama),
+      missingSets_(rig.cameras.size(), 0) {
+  activeCameras_ = (1U << rig.cameras.size()) - 1;
+  full_ = &configurationFor(activeCameras_);
+  active_ = full_;
+  const CorrectionDomain& domain = full_->domain;
+  field_.create(domain.grid, CV_32FC3);
   field_.setTo(cv::Scalar::all(0));
-  for (int r = 0; r < domain_.block; ++r) {
-    const double t = (r + 0.5) / domain_.block - 0.5;
+  for (int r = 0; r < domain.block; ++r) {
+    const double t = (r + 0.5) / domain.block - 0.5;
     phaseWeights_.push_back(catmullRom(t - std::floor(t)));
   }
   rowBuffers_.assign(
       static_cast<std::size_t>(pool.threads()) * 4,
-      std::vector<float>(static_cast<std::size_t>(domain_.grid.width + 2 * kPad) * 3));
+      std::vector<float>(static_cast<std::size_t>(domain.grid.width + 2 * kPad) * 3));
   for (int u = 0; u < lut.size.width; ++u) {
-    columnTap_.push_back(u / domain_.block + firstTapOffset(u % domain_.block, domain_.block));
+    columnTap_.push_back(u / domain.block + firstTapOffset(u % domain.block, domain.block));
   }
   for (int v = 0; v < lut.size.height; ++v) {
-    const auto* share = domain_.share.data() + static_cast<std::size_t>(v) * lut.size.width;
+    const auto* share = domain.share.data() + static_cast<std::size_t>(v) * lut.size.width;
     rowHasShare_.push_back(
         std::any_of(share, share + lut.size.width, [](std::uint16_t w) { return w != 0; }));
   }
@@ -74,19 +79,68 @@ PoissonColourCorrection::PoissonColourCorrection(const Rig& rig, const PanoramaS
 
 PoissonColourCorrection::~PoissonColourCorrection() = default;
 
+const std::vector<std::string>& PoissonColourCorrection::notes() const {
+  return full_->domain.notes;
+}
+
+const CorrectionDomain& PoissonColourCorrection::domain() const { return active_->domain; }
+
+PoissonColourCorrection::Configuration& PoissonColourCorrection::configurationFor(
+    std::uint32_t presentCameras) {
+  auto& configuration = configurations_[presentCameras];
+  if (configuration) return *configuration;
+  std::array<bool, 32> present{};
+  for (std::size_t c = 0; c < rig_.cameras.size(); ++c) present[c] = (presentCameras >> c) & 1U;
+  configuration = std::make_unique<Configuration>();
+  configuration->domain = buildCorrectionDomain(rig_, panorama_, lut_, settings_.scale,
+                                                std::span(present.data(), rig_.cameras.size()));
+  for (const auto& region : configuration->domain.regions) {
+    RegionState state;
+    state.solver = makePoissonSolver(settings_.solver, region.system, settings_.tolerance);
+    state.dirichlet.assign(region.dirichlet.size() * 3, 0.0f);
+    state.rhs.assign(region.system.unknowns() * 3, 0.0f);
+    state.solution.assign(region.system.unknowns() * 3, 0.0f);
+    configuration->regions.push_back(std::move(state));
+  }
+  configuration->slots.assign(configuration->domain.slots * 3, 0.0f);
+  return *configuration;
+}
+
 std::string PoissonColourCorrection::solverNames() const {
   std::string names;
-  for (const auto& region : regions_) {
+  for (const auto& region : active_->regions) {
     names += fmt::format("{}{}", names.empty() ? "" : ", ", region.solver->name());
   }
   return names;
 }
 
+void PoissonColourCorrection::followLostCameras(std::span<const cv::Mat> frames) {
+  changes_.clear();
+  std::uint32_t present = 0;
+  for (std::size_t c = 0; c < missingSets_.size(); ++c) {
+    missingSets_[c] = frames[c].empty() ? missingSets_[c] + 1 : 0;
+    if (missingSets_[c] < kLostAfterSets) present |= 1U << c;
+  }
+  if (present == activeCameras_) return;
+  const bool firstTime = !configurations_.contains(present);
+  const auto start = std::chrono::steady_clock::now();
+  active_ = &configurationFor(present);
+  activeCameras_ = present;
+  if (!firstTime) return;
+  changes_ = active_->domain.notes;
+  changes_.push_back(fmt::format(
+      "colour correction domain rebuilt for the cameras present in {:.0f} ms: {} region(s), "
+      "solver {}",
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count(),
+      active_->domain.regions.size(), solverNames()));
+}
+
 void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames) {
-  const float keep = firstFrame_ ? 0.0f : static_cast<float>(settings_.temporalSmoothing);
-  for (std::size_t r = 0; r < regions_.size(); ++r) {
-    const CorrectionRegion& region = domain_.regions[r];
-    RegionState& state = regions_[r];
+  Configuration& active = *active_;
+  const float keep = active.firstFrame ? 0.0f : static_cast<float>(settings_.temporalSmoothing);
+  for (std::size_t r = 0; r < active.regions.size(); ++r) {
+    const CorrectionRegion& region = active.domain.regions[r];
+    RegionState& state = active.regions[r];
     const cv::Mat& source = frames[region.source];
     for (std::size_t k = 0; k < region.dirichlet.size(); ++k) {
       const DirichletBlock& d = region.dirichlet[k];
@@ -94,7 +148,7 @@ void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames) {
       if (source.empty() || target.empty()) continue;  // hold the last value
       float sum[3] = {0, 0, 0};
       for (auto s = d.firstSample; s < d.endSample; ++s) {
-        const SeamSample& sample = domain_.samples[s];
+        const SeamSample& sample = active.domain.samples[s];
         const std::uint32_t t = bilinear(target.data, target.step, sample.target);
         const std::uint32_t o = bilinear(source.data, source.step, sample.source);
         for (int c = 0; c < 3; ++c) {
@@ -109,17 +163,19 @@ void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames) {
       }
     }
   }
-  firstFrame_ = false;
+  active.firstFrame = false;
 }
 
 int PoissonColourCorrection::update(std::span<const cv::Mat> frames) {
+  followLostCameras(frames);
   gatherSeams(frames);
+  Configuration& active = *active_;
   pool_.parallelFor(
-      static_cast<int>(regions_.size()),
+      static_cast<int>(active.regions.size()),
       [&](int first, int last) {
         for (int r = first; r < last; ++r) {
-          const CorrectionRegion& region = domain_.regions[static_cast<std::size_t>(r)];
-          RegionState& state = regions_[static_cast<std::size_t>(r)];
+          const CorrectionRegion& region = active.domain.regions[static_cast<std::size_t>(r)];
+          RegionState& state = active.regions[static_cast<std::size_t>(r)];
           for (std::size_t i = 0; i < region.system.unknowns(); ++i) {
             float sum[3] = {0, 0, 0};
             for (auto k = region.dirichletBegin[i]; k < region.dirichletBegin[i + 1]; ++k) {
@@ -130,22 +186,24 @@ int PoissonColourCorrection::update(std::span<const cv::Mat> frames) {
           state.iterations = state.solver->solve(state.rhs, state.solution).iterations;
         }
       },
-      static_cast<int>(regions_.size()));
+      static_cast<int>(active.regions.size()));
 
   int iterations = 0;
-  for (std::size_t r = 0; r < regions_.size(); ++r) {
-    const RegionState& state = regions_[r];
-    std::copy(state.solution.begin(), state.solution.end(),
-              slots_.begin() + static_cast<std::ptrdiff_t>(domain_.firstUnknownSlot[r]) * 3);
+  for (std::size_t r = 0; r < active.regions.size(); ++r) {
+    const RegionState& state = active.regions[r];
+    std::copy(
+        state.solution.begin(), state.solution.end(),
+        active.slots.begin() + static_cast<std::ptrdiff_t>(active.domain.firstUnknownSlot[r]) * 3);
     std::copy(state.dirichlet.begin(), state.dirichlet.end(),
-              slots_.begin() + static_cast<std::ptrdiff_t>(domain_.firstDirichletSlot[r]) * 3);
+              active.slots.begin() +
+                  static_cast<std::ptrdiff_t>(active.domain.firstDirichletSlot[r]) * 3);
     iterations += state.iterations;
   }
   auto* field = field_.ptr<float>();
-  for (std::size_t b = 0; b < domain_.fillFrom.size(); ++b) {
-    const int slot = domain_.fillFrom[b];
+  for (std::size_t b = 0; b < active.domain.fillFrom.size(); ++b) {
+    const int slot = active.domain.fillFrom[b];
     for (int c = 0; c < 3; ++c) {
-      field[b * 3 + c] = slot < 0 ? 0.0f : slots_[static_cast<std::size_t>(slot) * 3 + c];
+      field[b * 3 + c] = slot < 0 ? 0.0f : active.slots[static_cast<std::size_t>(slot) * 3 + c];
     }
   }
   return iterations;
@@ -167,15 +225,16 @@ void PoissonColourCorrection::apply(cv::Mat& panorama) {
 
 void PoissonColourCorrection::applyRows(int first, int last, cv::Mat& panorama,
                                         std::vector<float>& columnBuffer) const {
-  const int block = domain_.block;
-  const int gridWidth = domain_.grid.width;
-  const int gridHeight = domain_.grid.height;
+  const CorrectionDomain& domain = full_->domain;  // its grid and shares are every domain's
+  const int block = domain.block;
+  const int gridWidth = domain.grid.width;
+  const int gridHeight = domain.grid.height;
   const int width = lut_.size.width;
   // The row at block resolution, with kPad wrapped-around blocks on each side so that the
   // horizontal taps need no modulo.
   float* column = columnBuffer.data() + static_cast<std::size_t>(kPad) * 3;
   for (int v = first; v < last; ++v) {
-    const std::uint16_t* share = domain_.share.data() + static_cast<std::size_t>(v) * width;
+    const std::uint16_t* share = domain.share.data() + static_cast<std::size_t>(v) * width;
     if (!rowHasShare_[static_cast<std::size_t>(v)]) continue;
     // Vertical pass: the field interpolated to this row.
     const auto& wy = phaseWeights_[static_cast<std::size_t>(v % block)];

@@ -6,9 +6,14 @@
 //
 // Set up once (domain, systems, solver factorizations, buffers); update() and apply() are the
 // per-frame calls and allocate nothing. A camera missing from a frame set leaves the seams it
-// shares at their last values (its region, if a source, shows no picture anyway).
+// shares at their last values; missing for kLostAfterSets sets in a row it counts as lost and the
+// domain changes: a lost source's region is left uncorrected, a lost target's seams become free
+// (Neumann) borders. The domain and solvers for each set of cameras are built the first time it
+// occurs (a one-off cost, said in notesOfLastUpdate()) and kept for when it occurs again.
 
 #include <array>
+#include <cstdint>
+#include <map>
 #include <memory>
 #include <span>
 #include <string>
@@ -42,9 +47,15 @@ class PoissonColourCorrection {
   PoissonColourCorrection(const PoissonColourCorrection&) = delete;
   PoissonColourCorrection& operator=(const PoissonColourCorrection&) = delete;
 
+  static constexpr int kLostAfterSets = 5;
+
   // Things left out at set-up (regions without a seam to a target), to be logged once.
-  const std::vector<std::string>& notes() const { return domain_.notes; }
-  const CorrectionDomain& domain() const { return domain_; }
+  const std::vector<std::string>& notes() const;
+  // What the last update() changed in the domain, the first time cameras were lost or came back
+  // in this combination (empty otherwise), to be logged.
+  const std::vector<std::string>& notesOfLastUpdate() const { return changes_; }
+  // The domain in use: the full rig's, or the one without the cameras lost now.
+  const CorrectionDomain& domain() const;
   std::string solverNames() const;
 
   // Solves this frame's fields from the camera images (an empty Mat: that camera is missing).
@@ -59,16 +70,24 @@ class PoissonColourCorrection {
 
  private:
   struct RegionState;
+  struct Configuration;
+  Configuration& configurationFor(std::uint32_t presentCameras);
+  void followLostCameras(std::span<const cv::Mat> frames);
   void gatherSeams(std::span<const cv::Mat> frames);
   void applyRows(int first, int last, cv::Mat& panorama, std::vector<float>& columnBuffer) const;
 
   const PanoramaLut& lut_;
   WorkPool& pool_;
   ColourCorrectionSettings settings_;
-  CorrectionDomain domain_;
-  std::vector<RegionState> regions_;
-  bool firstFrame_ = true;
-  std::vector<float> slots_;  // 3 values per field slot
+  Rig rig_;
+  PanoramaSettings panorama_;
+  // Per set of cameras not lost (bit c: camera c), its domain and solvers' state.
+  std::map<std::uint32_t, std::unique_ptr<Configuration>> configurations_;
+  Configuration* full_ = nullptr;    // every camera
+  Configuration* active_ = nullptr;  // the cameras not lost now
+  std::uint32_t activeCameras_ = 0;
+  std::vector<int> missingSets_;  // per camera: frame sets in a row without it
+  std::vector<std::string> changes_;
   cv::Mat field_;
   // Upsampling: bicubic weights for each sub-block phase (Catmull-Rom), each pixel column's first
   // tap (in blocks, -2..width), the rows that have anything to correct, and one row buffer per

@@ -1,7 +1,7 @@
 // Colour correction on the generator's recordings, whose cameras differ in gain (0.7-1.3), white
 // balance, gamma and vignetting: Poisson local correction removes the colour step across the
 // seams, better than global gains; cameras that agree get almost no correction; the solvers give
-// the same fields; a static scene does not flicker; a missing camera is survived.
+// the same fields; a static scene does not flicker; a lost camera changes the domain.
 
 #include <gtest/gtest.h>
 
@@ -210,20 +210,68 @@ TEST_F(IdenticalCamerasTest, NeedAlmostNoCorrection) {
   EXPECT_LT(sum / count, 1.0);
 }
 
-TEST_F(ColourCorrectionTest, AMissingCameraHoldsItsSeamsAndBreaksNothing) {
-  auto frames = firstFrames(truth_);
+bool anySeamWith(const CorrectionDomain& domain, std::uint8_t camera) {
+  for (const auto& region : domain.regions) {
+    for (const auto& d : region.dirichlet) {
+      if (d.target == camera) return true;
+    }
+  }
+  return false;
+}
+
+// A camera missing from a few sets holds its seams; missing for longer it is lost and the domain
+// changes (once logged); when it is back the full domain returns, warm.
+TEST_F(ColourCorrectionTest, ALostCameraChangesTheDomainAndItsReturnRestoresIt) {
+  const auto frames = firstFrames(truth_);
   PoissonColourCorrection poisson(truth_.rig, settings_, lut_, correction(PoissonSolverKind::kAuto),
                                   pool_);
   poisson.update(frames);
-  const cv::Mat before = poisson.field().clone();
-  frames[1] = cv::Mat();  // 'right' (a target) lost
-  poisson.update(frames);
-  EXPECT_LE(cv::norm(poisson.field(), before, cv::NORM_INF), 1e-3);
-  frames[0] = cv::Mat();  // and 'front' (a source)
-  poisson.update(frames);
-  cv::Mat panorama = stitch(firstFrames(truth_));
-  poisson.apply(panorama);
+  const cv::Mat full = poisson.field().clone();
+  ASSERT_TRUE(anySeamWith(poisson.domain(), 1));
+  std::vector<int> frontBlocks;
+  for (const auto& region : poisson.domain().regions) {
+    if (region.source == 0) frontBlocks = region.blockOfUnknown;
+  }
+  ASSERT_FALSE(frontBlocks.empty());
+
+  auto withoutRight = frames;
+  withoutRight[1] = cv::Mat();  // 'right', a target
+  for (int k = 1; k < PoissonColourCorrection::kLostAfterSets; ++k) {
+    poisson.update(withoutRight);
+    EXPECT_TRUE(poisson.notesOfLastUpdate().empty());
+    EXPECT_LE(cv::norm(poisson.field(), full, cv::NORM_INF), 1e-3) << "set " << k;
+  }
+  poisson.update(withoutRight);  // now lost
+  ASSERT_EQ(poisson.notesOfLastUpdate().size(), 2u);
+  EXPECT_EQ(poisson.notesOfLastUpdate()[0],
+            "camera 'right' is missing: its seams are free (Neumann) borders");
+  EXPECT_NE(poisson.notesOfLastUpdate()[1].find("domain rebuilt"), std::string::npos);
+  EXPECT_FALSE(anySeamWith(poisson.domain(), 1));
+  EXPECT_EQ(poisson.domain().regions.size(), 2u);  // front and back still meet 'left'
   EXPECT_TRUE(cv::checkRange(poisson.field()));
+  EXPECT_GT(cv::norm(poisson.field(), full, cv::NORM_INF), 0.5);  // no longer pinned to 'right'
+  poisson.update(withoutRight);
+  EXPECT_TRUE(poisson.notesOfLastUpdate().empty());  // said once
+
+  poisson.update(frames);  // back
+  EXPECT_TRUE(anySeamWith(poisson.domain(), 1));
+  EXPECT_LE(cv::norm(poisson.field(), full, cv::NORM_INF), 0.01);
+
+  auto withoutFront = frames;
+  withoutFront[0] = cv::Mat();  // 'front', a source
+  for (int k = 0; k < PoissonColourCorrection::kLostAfterSets; ++k) poisson.update(withoutFront);
+  ASSERT_FALSE(poisson.notesOfLastUpdate().empty());
+  EXPECT_EQ(poisson.notesOfLastUpdate()[0],
+            "camera 'front' is missing: its region is left uncorrected");
+  ASSERT_EQ(poisson.domain().regions.size(), 1u);
+  EXPECT_EQ(poisson.domain().regions.front().source, 2);  // 'back'
+  for (const int block : frontBlocks) {
+    ASSERT_EQ(
+        poisson.field().at<cv::Vec3f>(block / poisson.field().cols, block % poisson.field().cols),
+        cv::Vec3f(0, 0, 0));
+  }
+  cv::Mat panorama = stitch(frames);
+  poisson.apply(panorama);  // nothing to break
 }
 
 TEST(ColourCorrectionDomain, AScaleThatDoesNotTileThePanoramaIsRefused) {

@@ -96,7 +96,8 @@ TEST(SynthCli, BadInputExitsWithAMessage) {
       {{"--rig", kPaper, "--out", out, "--size", "321x180"}, "--size"},
       {{"--rig", kPaper, "--out", out, "--seconds", "-1"}, "--seconds"},
       {{"--rig", kPaper, "--out", out, "--drop-every", "middle:3"}, "no camera named 'middle'"},
-      {{"--rig", kPaper, "--out", out, "--photometrics", "fancy"}, "'random' or 'identity'"},
+      {{"--rig", kPaper, "--out", out, "--photometrics", "fancy"},
+       "'random', 'identity' or 'extreme'"},
       {{"--rig", kPaper}, "--out: missing"},
       {{"--rig", kPaper, "--out", out, "--frobnicate"}, "unknown option"},
   };

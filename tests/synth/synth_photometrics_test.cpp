@@ -49,6 +49,22 @@ double meanAbs(const cv::Mat& a, const cv::Mat& b) {
   return (m[0] + m[1] + m[2]) / 3;
 }
 
+// --photometrics extreme: the random cameras, with gain and white balance pushed to opposite
+// ends of their ranges for colour sources and targets.
+TEST(SynthPhotometrics, ExtremeSetsSourcesAndTargetsAtOppositeEnds) {
+  for (const bool source : {true, false}) {
+    const CameraPhotometrics random = randomPhotometrics(7, 2, 1.5, true);
+    const CameraPhotometrics extreme = extremePhotometrics(7, 2, 1.5, true, source);
+    EXPECT_DOUBLE_EQ(extreme.gain, source ? 0.7 : 1.3);
+    EXPECT_EQ(extreme.whiteBalance,
+              source ? cv::Vec3d(0.85, 1.0, 1.15) : cv::Vec3d(1.15, 1.0, 0.85));
+    CameraPhotometrics rest = extreme;
+    rest.gain = random.gain;
+    rest.whiteBalance = random.whiteBalance;
+    EXPECT_EQ(rest, random);  // gamma, vignetting, noise and drift as drawn
+  }
+}
+
 TEST(SynthPhotometrics, ParametersAreInRangeAndDescribeTheVideos) {
   const auto folder = testing::fixture("synth_small");
   const YAML::Node truth = YAML::LoadFile((folder / "ground_truth.yaml").string());

@@ -18,7 +18,7 @@ constexpr std::uint64_t kNoiseStream = 22;
 // transcendental per channel. Tails reach 3.7 sigma, plenty for sensor noise.
 constexpr int kGaussianBits = 12;
 const std::array<float, 1 << kGaussianBits>& gaussianTable() {
-  static const auto table = [] {
+  static const auto kTable = [] {
     std::array<float, 1 << kGaussianBits> t{};
     for (std::size_t i = 0; i < t.size(); ++i) {
       const double p = (static_cast<double>(i) + 0.5) / static_cast<double>(t.size());
@@ -32,7 +32,7 @@ const std::array<float, 1 << kGaussianBits>& gaussianTable() {
     }
     return t;
   }();
-  return table;
+  return kTable;
 }
 
 }  // namespace
@@ -70,6 +70,14 @@ CameraPhotometrics randomPhotometrics(std::uint64_t seed, int index, double nois
     p.driftPeriodS = period;
     p.driftPhaseRad = phase;
   }
+  return p;
+}
+
+CameraPhotometrics extremePhotometrics(std::uint64_t seed, int index, double noiseSigma, bool drift,
+                                       bool source) {
+  CameraPhotometrics p = randomPhotometrics(seed, index, noiseSigma, drift);
+  p.gain = source ? 0.7 : 1.3;
+  p.whiteBalance = source ? cv::Vec3d(0.85, 1.0, 1.15) : cv::Vec3d(1.15, 1.0, 0.85);  // B, G, R
   return p;
 }
 
@@ -131,7 +139,9 @@ void PhotometricCamera::convertRow(const Frame& frame, const cv::Vec3f* radiance
                         : 0;
     for (int c = 0; c < 3; ++c) {
       float x = std::min(radiance[i][c] * frame.channelGain[c] * v, kMaxX);
-      if (lut != nullptr) x = lut[static_cast<int>(x * kLutSteps + 0.5f)];
+      // x >= 0, so adding a half and truncating rounds.
+      if (lut != nullptr)
+        x = lut[static_cast<int>(x * kLutSteps + 0.5f)];  // NOLINT(bugprone-incorrect-roundings)
       if (noiseSigma_ > 0) x += noiseSigma_ * gaussian[(bits >> (kGaussianBits * c)) & kMask];
       out[i][c] = cv::saturate_cast<uchar>(x);  // rounds to nearest and clamps
     }

@@ -36,6 +36,10 @@ struct CameraPhotometrics {
 CameraPhotometrics identityPhotometrics();
 // Random parameters for camera `index`, deterministic from the seed.
 CameraPhotometrics randomPhotometrics(std::uint64_t seed, int index, double noiseSigma, bool drift);
+// The random parameters with gain and white balance at the ends of their ranges: dark and warm for
+// a colour-correction source, bright and cool for a target.
+CameraPhotometrics extremePhotometrics(std::uint64_t seed, int index, double noiseSigma, bool drift,
+                                       bool source);
 
 // The per-camera part that does not change from frame to frame (gamma table, vignette image), and
 // the per-pixel conversion. One per camera, built before the first frame.

@@ -93,18 +93,30 @@ RecordingPlan planRecording(const SynthOptions& options) {
                                    intrinsics.imageSize.height));
     }
     const int index = static_cast<int>(i);
-    camera.photometrics =
-        options.randomPhotometrics
-            ? randomPhotometrics(options.seed, index, options.noiseSigma, options.drift)
-            : identityPhotometrics();
+    switch (options.photometrics) {
+      case SynthOptions::Photometrics::kRandom:
+        camera.photometrics =
+            randomPhotometrics(options.seed, index, options.noiseSigma, options.drift);
+        break;
+      case SynthOptions::Photometrics::kIdentity:
+        camera.photometrics = identityPhotometrics();
+        break;
+      case SynthOptions::Photometrics::kExtreme:
+        camera.photometrics =
+            extremePhotometrics(options.seed, index, options.noiseSigma, options.drift,
+                                camera.camera.calibration.role == processing::ColourRole::kSource);
+        break;
+    }
     HashRng timing(options.seed, kTimingStream * 1000 + i);
     camera.startOffsetS = timing.uniform(0, 0.004);
     heightSum += camera.camera.calibration.pose.position[2];
     plan.cameras.push_back(std::move(camera));
   }
   for (const auto& [name, n] : options.dropEvery) {
-    const auto it = std::find_if(plan.cameras.begin(), plan.cameras.end(),
-                                 [&](const auto& c) { return c.camera.calibration.name == name; });
+    const std::string& wanted = name;  // clang-tidy (clang 14) cannot capture the binding
+    const auto it = std::find_if(plan.cameras.begin(), plan.cameras.end(), [&](const auto& c) {
+      return c.camera.calibration.name == wanted;
+    });
     if (it == plan.cameras.end()) {
       throw UsageError(fmt::format("--drop-every: the rig has no camera named '{}'", name));
     }

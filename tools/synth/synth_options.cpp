@@ -62,7 +62,10 @@ std::string SynthOptions::canonical() const {
   std::ostringstream s;
   s << "size=" << (size ? fmt::format("{}x{}", size->width, size->height) : "preset")
     << " seconds=" << fmt::format("{}", seconds) << " fps=" << fmt::format("{}", fps)
-    << " seed=" << seed << " photometrics=" << (randomPhotometrics ? "random" : "identity")
+    << " seed=" << seed << " photometrics="
+    << (photometrics == Photometrics::kRandom     ? "random"
+        : photometrics == Photometrics::kIdentity ? "identity"
+                                                  : "extreme")
     << " drift=" << drift << " noise_sigma=" << fmt::format("{}", noiseSigma) << " drop_every=";
   for (const auto& [name, n] : dropEvery) s << name << ":" << n << ";";
   s << " ground_truth_frames=";
@@ -107,10 +110,13 @@ SynthOptions parseSynthArguments(std::span<const std::string_view> arguments) {
       o.seed = parseNumber<std::uint64_t>(option, value(), 0, UINT64_MAX, "a non-negative integer");
     } else if (option == "--photometrics") {
       const auto v = value();
-      if (v != "random" && v != "identity") {
-        throw UsageError(fmt::format("{}: expected 'random' or 'identity', got '{}'", option, v));
+      if (v != "random" && v != "identity" && v != "extreme") {
+        throw UsageError(
+            fmt::format("{}: expected 'random', 'identity' or 'extreme', got '{}'", option, v));
       }
-      o.randomPhotometrics = v == "random";
+      o.photometrics = v == "random"     ? SynthOptions::Photometrics::kRandom
+                       : v == "identity" ? SynthOptions::Photometrics::kIdentity
+                                         : SynthOptions::Photometrics::kExtreme;
     } else if (option == "--no-drift") {
       o.drift = false;
     } else if (option == "--noise-sigma") {
@@ -138,7 +144,7 @@ SynthOptions parseSynthArguments(std::span<const std::string_view> arguments) {
   }
   if (!haveRig) throw UsageError("--rig: missing (the rig preset YAML to render)");
   if (!haveOut) throw UsageError("--out: missing (the folder to write the recording to)");
-  if (!o.randomPhotometrics) {
+  if (o.photometrics == SynthOptions::Photometrics::kIdentity) {
     // Identity means neutral sensors: no noise, no drift, whatever else was asked.
     o.noiseSigma = 0;
     o.drift = false;
@@ -167,7 +173,9 @@ usage: surround-synth --rig FILE --out DIR [options]
   --seconds S                length (default 10)
   --fps F                    frame rate (default 30)
   --seed N                   scene, photometrics, noise and timing (default 1)
-  --photometrics MODE        random (default) or identity (neutral, no noise, no drift)
+  --photometrics MODE        random (default), identity (neutral, no noise, no drift) or
+                             extreme (random, with gains 0.7 / 1.3 and white balance at the
+                             ends of its range for colour sources / targets)
   --no-drift                 no slow exposure drift
   --noise-sigma X            sensor noise in 8-bit levels (default 1.5)
   --drop-every NAME:N        omit every Nth frame of camera NAME (repeatable)

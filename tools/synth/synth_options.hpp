@@ -28,9 +28,13 @@ struct SynthOptions {
   double seconds = 10;           // recording length
   double fps = 30;               // nominal frame rate
   std::uint64_t seed = 1;
-  bool randomPhotometrics = true;  // false: identity (neutral, noise 0, no drift)
-  bool drift = true;               // slow exposure drift
-  double noiseSigma = 1.5;         // sensor noise, 8-bit levels
+  // random: per camera within the ranges of photometrics.hpp; identity: neutral, noise 0, no
+  // drift; extreme: random, but gains and white balance at opposite ends of their ranges for
+  // colour-correction sources and targets (the largest colour steps across seams).
+  enum class Photometrics { kRandom, kIdentity, kExtreme };
+  Photometrics photometrics = Photometrics::kRandom;
+  bool drift = true;                                   // slow exposure drift
+  double noiseSigma = 1.5;                             // sensor noise, 8-bit levels
   std::vector<std::pair<std::string, int>> dropEvery;  // camera name, N: omit every Nth frame
   std::optional<std::vector<int>> groundTruthFrames;   // default: first, middle, last
   cv::Size panoramaSize{2048, 1024};
