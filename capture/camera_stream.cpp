@@ -49,9 +49,11 @@ void CameraStream::run() {
         const std::lock_guard lock(mutex_);
         ++stats_.faults;
       }
-      // One line per fault is bounded by maxConsecutiveFaults_ before the stream gives up.
+      // One line per fault: a replay gives up after maxConsecutiveFaults_ of them; a live source
+      // paces its own retries (a timeout or a reopening backoff per fault).
       spdlog::warn("camera '{}': {}", name_, source_->lastError());
-      if (++consecutiveFaults < maxConsecutiveFaults_) continue;
+      ++consecutiveFaults;
+      if (maxConsecutiveFaults_ == 0 || consecutiveFaults < maxConsecutiveFaults_) continue;
       spdlog::error("camera '{}': {} faults in a row, giving up on this camera", name_,
                     consecutiveFaults);
     } else {

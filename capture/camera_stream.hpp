@@ -5,7 +5,8 @@
 // Back-pressure: the pool holds `poolFrames` buffers; when the consumer keeps all of them (queued
 // or in flight down the pipeline), the thread waits for one to come back instead of dropping —
 // replay stays lossless. A fault is logged and read again (sources may recover);
-// `maxConsecutiveFaults` in a row, or the end of the stream, ends the stream.
+// `maxConsecutiveFaults` in a row (0: never, for live cameras that reconnect), or the end of the
+// stream, ends the stream.
 //
 // Threads: the capture thread owns the source; the queue (mutex + condition variable) is the only
 // state it shares with the consumer.

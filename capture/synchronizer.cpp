@@ -11,6 +11,10 @@ std::uint64_t SyncStats::totalDropped() const {
          std::accumulate(outOfOrderDropped.begin(), outOfOrderDropped.end(), std::uint64_t{0});
 }
 
+Timestamp SyncStats::meanSpread() const {
+  return setsEmitted > 0 ? spreadTotal / static_cast<std::int64_t>(setsEmitted) : Timestamp(0);
+}
+
 Synchronizer::Synchronizer(std::size_t cameraCount, Timestamp tolerance)
     : cameraCount_(cameraCount), tolerance_(tolerance) {
   if (cameraCount == 0 || cameraCount > kMaxCameras) {
@@ -57,6 +61,27 @@ std::optional<FrameSet> Synchronizer::pop() {
   for (std::size_t c = 0; c < cameraCount_; ++c) {
     if (heads_[c]) newest = std::max(newest, heads_[c]->timestamp);
   }
+  if (dropUnmatched(newest)) return std::nullopt;
+  return emit(newest);
+}
+
+std::optional<FrameSet> Synchronizer::popLate(Timestamp now, Timestamp deadline) {
+  Timestamp newest = Timestamp::min();
+  Timestamp oldest = Timestamp::max();
+  for (std::size_t c = 0; c < cameraCount_; ++c) {
+    if (!heads_[c]) continue;
+    newest = std::max(newest, heads_[c]->timestamp);
+    oldest = std::min(oldest, heads_[c]->timestamp);
+  }
+  if (newest == Timestamp::min() || now - oldest <= deadline) return std::nullopt;
+  dropUnmatched(newest);
+  for (std::size_t c = 0; c < cameraCount_; ++c) {
+    if (!ended_[c] && !heads_[c]) ++stats_.lateMissing[c];
+  }
+  return emit(newest);
+}
+
+bool Synchronizer::dropUnmatched(Timestamp newest) {
   bool dropped = false;
   for (std::size_t c = 0; c < cameraCount_; ++c) {
     if (heads_[c] && newest - heads_[c]->timestamp > tolerance_) {
@@ -65,8 +90,10 @@ std::optional<FrameSet> Synchronizer::pop() {
       dropped = true;
     }
   }
-  if (dropped) return std::nullopt;
+  return dropped;
+}
 
+FrameSet Synchronizer::emit(Timestamp newest) {
   FrameSet set;
   set.cameraCount = cameraCount_;
   set.timestamp = newest;
@@ -77,6 +104,7 @@ std::optional<FrameSet> Synchronizer::pop() {
     set.frames[c] = std::move(heads_[c]);
   }
   stats_.maxSpread = std::max(stats_.maxSpread, newest - oldest);
+  stats_.spreadTotal += newest - oldest;
   return set;
 }
 

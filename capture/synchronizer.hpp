@@ -7,8 +7,11 @@
 // heads lie within the tolerance they leave together as one set. A camera that has ended leaves an
 // empty slot in every later set; the others go on.
 //
+// Live cameras do not wait for each other forever: popLate() lets a set go without the cameras
+// that have not delivered by a deadline (their slots empty, counted as late).
+//
 // Pure logic, no threads or clocks: the caller feeds frames (needs() says which camera to read
-// next), which makes every case testable with timestamps alone.
+// next) and, live, the time, which makes every case testable with timestamps alone.
 
 #include <array>
 #include <cstdint>
@@ -22,9 +25,12 @@ struct SyncStats {
   std::uint64_t setsEmitted = 0;
   std::array<std::uint64_t, kMaxCameras> unmatchedDropped{};   // frames with no partner in time
   std::array<std::uint64_t, kMaxCameras> outOfOrderDropped{};  // timestamps that went backwards
-  Timestamp maxSpread{0};  // largest newest-minus-oldest timestamp within an emitted set
+  std::array<std::uint64_t, kMaxCameras> lateMissing{};        // sets sent without this camera
+  Timestamp maxSpread{0};    // largest newest-minus-oldest timestamp within an emitted set
+  Timestamp spreadTotal{0};  // summed over emitted sets, for the mean skew
 
   std::uint64_t totalDropped() const;
+  Timestamp meanSpread() const;
 };
 
 class Synchronizer {
@@ -40,6 +46,9 @@ class Synchronizer {
 
   // A complete set once every running camera has offered a frame and the heads line up.
   std::optional<FrameSet> pop();
+  // Live: when the oldest head waited longer than `deadline` at time `now` (the cameras' clock)
+  // for cameras that have not delivered, the heads that line up leave as a set without them.
+  std::optional<FrameSet> popLate(Timestamp now, Timestamp deadline);
   // Every camera has ended.
   bool finished() const;
 
@@ -48,6 +57,9 @@ class Synchronizer {
 
  private:
   bool allHeadsPresent() const;
+  // Drops heads further than the tolerance before the newest; true if it dropped any.
+  bool dropUnmatched(Timestamp newest);
+  FrameSet emit(Timestamp newest);
 
   std::size_t cameraCount_;
   Timestamp tolerance_;

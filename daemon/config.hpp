@@ -26,7 +26,8 @@ namespace surroundd::daemon {
 struct CaptureConfig {
   capture::Pacing pacing = capture::Pacing::kRealtime;
   double syncToleranceMs = 10.0;  // frames further apart than this are not one set
-  int queueFrames = 4;  // frames buffered per camera between its thread and the synchronizer
+  int queueFrames = 4;        // frames buffered per camera between its thread and the synchronizer
+  double lateAfterMs = 50.0;  // live: a set waits this long for a late camera, then goes without
 
   bool operator==(const CaptureConfig&) const = default;
 };

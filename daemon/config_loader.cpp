@@ -35,10 +35,17 @@ void readRig(YamlObject& root, Config& config) {
   }
   rig->finish();
   for (const auto& camera : config.cameras) {
-    if (!camera.source) {
+    if (!camera.source && !camera.device) {
       rig->errorHere(fmt::format("camera '{}' has no 'source' (surroundd needs one per camera)",
                                  camera.calibration.name));
     }
+  }
+  // Live devices and files run on different clocks; their frames could never be matched.
+  const auto live = std::ranges::count_if(config.cameras,
+                                          [](const RigCamera& c) { return c.device.has_value(); });
+  if (live > 0 && live < static_cast<std::ptrdiff_t>(config.cameras.size())) {
+    rig->errorHere(
+        "mixes live devices and files: the cameras of a rig are either all live or all replayed");
   }
 }
 
@@ -59,6 +66,8 @@ void readCapture(YamlObject& section, CaptureConfig& c) {
   c.syncToleranceMs =
       section.number("sync_tolerance_ms", c.syncToleranceMs, {0.0, 1000.0, false, "milliseconds"});
   c.queueFrames = section.integer("queue_frames", c.queueFrames, 1, 64);
+  c.lateAfterMs =
+      section.number("late_after_ms", c.lateAfterMs, {1.0, 10000.0, false, "milliseconds"});
   section.finish();
 }
 

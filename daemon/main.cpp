@@ -94,9 +94,12 @@ void logSummary(const daemon::RunSummary& summary) {
       summary.sync.totalDropped(),
       std::chrono::duration<double, std::milli>(summary.sync.maxSpread).count());
   for (std::size_t c = 0; c < summary.cameras.size(); ++c) {
-    spdlog::info("camera '{}': {} frames, {} faults, {} dropped unmatched, {} out of order",
-                 summary.cameraNames[c], summary.cameras[c].frames, summary.cameras[c].faults,
-                 summary.sync.unmatchedDropped[c], summary.sync.outOfOrderDropped[c]);
+    spdlog::info(
+        "camera '{}': {} frames, {} faults, {} dropped unmatched, {} out of order, {} sets sent "
+        "without it",
+        summary.cameraNames[c], summary.cameras[c].frames, summary.cameras[c].faults,
+        summary.sync.unmatchedDropped[c], summary.sync.outOfOrderDropped[c],
+        summary.sync.lateMissing[c]);
   }
   for (const auto& output : summary.outputs) spdlog::info("wrote {}", output);
 }

@@ -6,13 +6,16 @@
 #include <spdlog/spdlog.h>
 
 #include "capture/file_source.hpp"
+#include "capture/v4l2_source.hpp"
 #include "daemon/panorama_setup.hpp"
 
 namespace surroundd::daemon {
 namespace {
 
-// Between checks of the stop flag while a camera has nothing to deliver.
+// Between checks of the stop flag while a camera has nothing to deliver. Live, the wait is short:
+// the other cameras' frames must not wait behind a late one past the set's deadline.
 constexpr std::chrono::milliseconds kCameraWait{200};
+constexpr std::chrono::milliseconds kLiveCameraWait{2};
 constexpr std::chrono::seconds kProgressInterval{10};
 
 std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& config) {
@@ -20,21 +23,34 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
   const auto poolFrames = static_cast<std::size_t>(config.capture.queueFrames) + 2;
   std::vector<std::unique_ptr<capture::CameraStream>> cameras;
   for (const auto& camera : config.cameras) {
-    auto settings = *camera.source;
-    settings.pacing = config.capture.pacing;
     const auto& name = camera.calibration.name;
-    auto source = std::make_unique<capture::FileSource>(name, settings);
+    std::unique_ptr<capture::FrameSource> source;
+    std::string origin;
+    int maxConsecutiveFaults = 30;  // a replay that keeps failing ends
+    if (camera.device) {
+      auto device = std::make_unique<capture::V4l2Source>(name, *camera.device);
+      origin = fmt::format("{} ({})", camera.device->device.string(),
+                           capture::toString(device->format()));
+      source = std::move(device);
+      maxConsecutiveFaults = 0;  // a live camera is reopened until it is back
+    } else {
+      auto settings = *camera.source;
+      settings.pacing = config.capture.pacing;
+      origin = settings.path.string();
+      source = std::make_unique<capture::FileSource>(name, settings);
+    }
     const cv::Size calibrated = camera.calibration.intrinsics.imageSize;
     if (source->frameSize() != calibrated) {
       throw std::runtime_error(
           fmt::format("camera '{}': {} has {}x{} frames but the lens is calibrated for {}x{}", name,
-                      settings.path.string(), source->frameSize().width, source->frameSize().height,
+                      origin, source->frameSize().width, source->frameSize().height,
                       calibrated.width, calibrated.height));
     }
-    spdlog::info("camera '{}': {} ({}x{}, {:.2f} fps)", name, settings.path.string(),
-                 source->frameSize().width, source->frameSize().height,
+    spdlog::info("camera '{}': {} ({}x{}, {:.2f} fps)", name, origin, source->frameSize().width,
+                 source->frameSize().height,
                  1e9 / static_cast<double>(source->nominalPeriod().count()));
-    cameras.push_back(std::make_unique<capture::CameraStream>(name, std::move(source), poolFrames));
+    cameras.push_back(std::make_unique<capture::CameraStream>(name, std::move(source), poolFrames,
+                                                              maxConsecutiveFaults));
   }
   return cameras;
 }
@@ -76,6 +92,10 @@ Pipeline::Pipeline(const Config& config)
       synchronizer_(cameras_.size(),
                     std::chrono::duration_cast<capture::Timestamp>(
                         std::chrono::duration<double, std::milli>(config.capture.syncToleranceMs))),
+      live_(std::ranges::any_of(config.cameras,
+                                [](const RigCamera& c) { return c.device.has_value(); })),
+      lateAfter_(std::chrono::duration_cast<capture::Timestamp>(
+          std::chrono::duration<double, std::milli>(config.capture.lateAfterMs))),
       pool_(config.pipeline.threads),
       mosaic_(cv::Size(config.render.widthPx, config.render.heightPx), cameraNames(config)),
       canvas_(mosaic_.outputSize(), CV_8UC3, cv::Scalar::all(0)) {
@@ -173,6 +193,14 @@ RunSummary Pipeline::run(const std::atomic<bool>& stop) {
       process(*set);
       ++summary.frameSets;
     }
+    // Live timestamps are CLOCK_MONOTONIC, which is steady_clock here.
+    if (live_) {
+      if (auto set = synchronizer_.popLate(std::chrono::steady_clock::now().time_since_epoch(),
+                                           lateAfter_)) {
+        process(*set);
+        ++summary.frameSets;
+      }
+    }
     if (const auto now = std::chrono::steady_clock::now(); now >= nextProgress) {
       nextProgress += kProgressInterval;
       spdlog::info("{} frame sets, {:.1f} fps, {} frames dropped by sync", summary.frameSets,
@@ -209,7 +237,7 @@ void Pipeline::fillNeeds(const std::atomic<bool>& stop) {
   for (std::size_t c = 0; c < cameras_.size() && !stop; ++c) {
     if (!synchronizer_.needs(c)) continue;
     capture::FrameRef frame;
-    switch (cameras_[c]->next(frame, kCameraWait)) {
+    switch (cameras_[c]->next(frame, live_ ? kLiveCameraWait : kCameraWait)) {
       case capture::CameraStream::Next::kFrame:
         synchronizer_.offer(c, std::move(frame));
         break;

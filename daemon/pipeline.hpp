@@ -93,6 +93,8 @@ class Pipeline {
 
   std::vector<std::unique_ptr<capture::CameraStream>> cameras_;
   capture::Synchronizer synchronizer_;
+  bool live_;  // V4L2 cameras: sets go without a late camera
+  capture::Timestamp lateAfter_;
   WorkPool pool_;
   render::Mosaic mosaic_;
   cv::Mat canvas_;                                  // the composed mosaic; reused for every set

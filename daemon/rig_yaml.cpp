@@ -1,10 +1,12 @@
 #include "daemon/rig_yaml.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <numbers>
 #include <set>
+#include <span>
 
 #include <fmt/format.h>
 
@@ -53,6 +55,46 @@ capture::FileSourceSettings readSource(YamlObject& source) {
         fmt::format("expected an existing video file, got '{}' ({})", path->string(),
                     std::filesystem::exists(*path, ec) ? "not a regular file" : "no such file"));
   }
+  return settings;
+}
+
+constexpr std::array<std::pair<std::string_view, capture::V4l2Format>, 5> kV4l2Formats{{
+    {"auto", capture::V4l2Format::kAuto},
+    {"yuyv", capture::V4l2Format::kYuyv},
+    {"uyvy", capture::V4l2Format::kUyvy},
+    {"nv12", capture::V4l2Format::kNv12},
+    {"mjpeg", capture::V4l2Format::kMjpeg},
+}};
+constexpr std::array<std::string_view, 8> kV4l2Controls{"exposure_auto",
+                                                        "exposure_absolute",
+                                                        "gain",
+                                                        "white_balance_auto",
+                                                        "white_balance_temperature",
+                                                        "brightness",
+                                                        "contrast",
+                                                        "saturation"};
+
+// A live camera; its size is the lens's (set by the caller), its device path is taken as written
+// (a /dev path, not relative to the file).
+capture::V4l2Settings readDevice(YamlObject& source) {
+  capture::V4l2Settings settings;
+  settings.device = source.string("device", "");
+  settings.format = source.choice(
+      "format", settings.format,
+      std::span<const std::pair<std::string_view, capture::V4l2Format>>(kV4l2Formats));
+  settings.fps = source.number("fps", settings.fps, {1.0, 1000.0, false, "frames per second"});
+  settings.buffers = source.integer("buffers", settings.buffers, 2, 32);
+  settings.timeout = std::chrono::milliseconds(source.integer("timeout_ms", 500, 20, 60'000));
+  if (auto controls = source.object("controls")) {
+    for (const auto name : kV4l2Controls) {
+      if (controls->has(name)) {
+        settings.controls.push_back(
+            {std::string(name), controls->integer(name, 0, -1'000'000, 1'000'000)});
+      }
+    }
+    controls->finish();
+  }
+  source.finish();
   return settings;
 }
 
@@ -155,7 +197,14 @@ std::vector<RigCamera> readRigCameras(YamlObject& rig) {
     calibration.role = entry.choice(
         "role", defaultRole(calibration.pose),
         {{"source", processing::ColourRole::kSource}, {"target", processing::ColourRole::kTarget}});
-    if (auto source = entry.object("source")) camera.source = readSource(*source);
+    if (auto source = entry.object("source")) {
+      if (source->has("device")) {
+        camera.device = readDevice(*source);
+        camera.device->size = calibration.intrinsics.imageSize;
+      } else {
+        camera.source = readSource(*source);
+      }
+    }
     entry.finish();
     cameras.push_back(std::move(camera));
   }
@@ -187,6 +236,25 @@ void emitCamera(YAML::Emitter& out, const RigCamera& camera, const std::filesyst
     out << YAML::Key << "source" << YAML::Value << YAML::Flow << YAML::BeginMap;
     out << YAML::Key << "file" << YAML::Value << (inside ? path.filename() : path).string();
     if (camera.source->loop) out << YAML::Key << "loop" << YAML::Value << true;
+    out << YAML::EndMap;
+  }
+  if (camera.device) {
+    const auto& d = *camera.device;
+    out << YAML::Key << "source" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "device" << YAML::Value << d.device.string();
+    for (const auto& [word, format] : kV4l2Formats) {
+      if (format == d.format) out << YAML::Key << "format" << YAML::Value << std::string(word);
+    }
+    out << YAML::Key << "fps" << YAML::Value << d.fps;
+    out << YAML::Key << "buffers" << YAML::Value << d.buffers;
+    out << YAML::Key << "timeout_ms" << YAML::Value << d.timeout.count();
+    if (!d.controls.empty()) {
+      out << YAML::Key << "controls" << YAML::Value << YAML::BeginMap;
+      for (const auto& control : d.controls) {
+        out << YAML::Key << control.name << YAML::Value << control.value;
+      }
+      out << YAML::EndMap;
+    }
     out << YAML::EndMap;
   }
   out << YAML::Key << "lens" << YAML::Value << YAML::BeginMap;

@@ -4,7 +4,8 @@
 //   cameras:
 //     - name: front
 //       role: source                       # source | target (colour correction)
-//       source: {file: front.mkv}          # relative to the file that names it
+//       source: {file: front.mkv}          # relative to the file that names it, or a live camera:
+//       source: {device: /dev/v4l/by-path/...-video-index0, format: yuyv, fps: 30}
 //       lens: {model: pinhole, width_px: 1280, height_px: 720, fx_px: .., fy_px: .., cx_px: ..,
 //              cy_px: .., distortion: [k1, k2, p1, p2, k3]}
 //       mount: {x_m: .., y_m: .., z_m: .., yaw_deg: .., pitch_deg: .., roll_deg: ..}
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "capture/file_source.hpp"
+#include "capture/v4l2_source.hpp"
 #include "daemon/yaml_reader.hpp"
 #include "processing/rig.hpp"
 
@@ -26,7 +28,10 @@ namespace surroundd::daemon {
 
 struct RigCamera {
   processing::CameraCalibration calibration;
-  std::optional<capture::FileSourceSettings> source;  // absent in rig presets (generator input)
+  // Where the frames come from: a file (replay), or a live V4L2 device. Both absent in rig presets
+  // (generator input).
+  std::optional<capture::FileSourceSettings> source;
+  std::optional<capture::V4l2Settings> device;
 };
 
 // Reads and validates the `cameras` list of `rig`; errors go to the object's Diagnostics.

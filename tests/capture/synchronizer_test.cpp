@@ -106,6 +106,38 @@ TEST_F(SynchronizerTest, FramesGoBackToThePoolWhenDropped) {
   EXPECT_EQ(pool_.available(), pool_.capacity());
 }
 
+// Live: a camera that has not delivered does not hold the others back past the deadline; the set
+// goes without it, counted, and the skew of what was sent is kept.
+TEST_F(SynchronizerTest, ALateCameraIsLeftOutAfterTheDeadline) {
+  Synchronizer sync(3, milliseconds(10));
+  sync.offer(0, frameAt(100));
+  sync.offer(1, frameAt(104));
+  EXPECT_FALSE(sync.pop().has_value());  // camera 2 has not delivered
+  EXPECT_FALSE(sync.popLate(milliseconds(140), milliseconds(50)).has_value());  // still in time
+  const auto set = sync.popLate(milliseconds(151), milliseconds(50));
+  ASSERT_TRUE(set.has_value());
+  EXPECT_NE(set->frame(0), nullptr);
+  EXPECT_NE(set->frame(1), nullptr);
+  EXPECT_EQ(set->frame(2), nullptr);
+  EXPECT_EQ(sync.stats().lateMissing[2], 1u);
+  EXPECT_EQ(sync.stats().lateMissing[0], 0u);
+  EXPECT_EQ(sync.stats().maxSpread, milliseconds(4));
+  EXPECT_EQ(sync.stats().meanSpread(), milliseconds(4));
+  // The late camera's next frame meets the others' next ones as usual.
+  sync.offer(0, frameAt(133));
+  sync.offer(1, frameAt(137));
+  sync.offer(2, frameAt(135));
+  const auto next = sync.pop();
+  ASSERT_TRUE(next.has_value());
+  EXPECT_NE(next->frame(2), nullptr);
+  EXPECT_EQ(sync.stats().meanSpread(), milliseconds(4));  // (4 + 4) / 2
+}
+
+TEST_F(SynchronizerTest, NothingIsSentLateWhenNoCameraHasDelivered) {
+  Synchronizer sync(2, milliseconds(10));
+  EXPECT_FALSE(sync.popLate(milliseconds(1000), milliseconds(50)).has_value());
+}
+
 TEST_F(SynchronizerTest, RejectsImpossibleCameraCounts) {
   EXPECT_THROW(Synchronizer(0, milliseconds(10)), std::invalid_argument);
   EXPECT_THROW(Synchronizer(kMaxCameras + 1, milliseconds(10)), std::invalid_argument);

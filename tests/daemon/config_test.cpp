@@ -46,6 +46,17 @@ class ConfigTest : public ::testing::Test {
     dir_.write("left.mkv", "");
   }
 
+  // The good config with both cameras live: front on /dev/video0, left's source as given.
+  std::filesystem::path liveConfigWith(std::string_view leftSource) {
+    std::string text(kGoodConfig);
+    const auto replace = [&](std::string_view from, std::string_view to) {
+      text.replace(text.find(from), from.size(), to);
+    };
+    replace("source: {file: front.mkv}", "source: {device: /dev/video0}");
+    replace("source: {file: left.mkv}", leftSource);
+    return dir_.write("config.yaml", text);
+  }
+
   // The good config with `from` replaced by `to` (which must occur).
   std::filesystem::path configWith(std::string_view from, std::string_view to) {
     std::string text(kGoodConfig);
@@ -128,6 +139,42 @@ TEST_F(ConfigTest, SurroundOutputsTakeTheirOwnViewOrTheRenderDefault) {
   EXPECT_DOUBLE_EQ(config.render.views.orbitPeriodS, 12.0);
   EXPECT_DOUBLE_EQ(config.render.car.lengthM, 4.2);
   EXPECT_EQ(config.render.platform, render::EglPlatform::kSurfaceless);
+}
+
+TEST_F(ConfigTest, ALiveCameraIsAV4l2DeviceOfTheLensSize) {
+  const Config config = loadConfig(liveConfigWith(
+      "source: {device: /dev/v4l/by-path/pci-0000:00:14.0-usb-0:1:1.0-video-index0, format: "
+      "mjpeg, fps: 25, timeout_ms: 300, controls: {gain: 40, exposure_auto: 1}}"));
+  const auto& left = config.cameras[1];
+  EXPECT_FALSE(left.source.has_value());
+  ASSERT_TRUE(left.device.has_value());
+  EXPECT_EQ(left.device->device, "/dev/v4l/by-path/pci-0000:00:14.0-usb-0:1:1.0-video-index0");
+  EXPECT_EQ(left.device->format, capture::V4l2Format::kMjpeg);
+  EXPECT_EQ(left.device->size, cv::Size(640, 360));
+  EXPECT_DOUBLE_EQ(left.device->fps, 25.0);
+  EXPECT_EQ(left.device->timeout, std::chrono::milliseconds(300));
+  EXPECT_EQ(left.device->controls,
+            (std::vector<capture::V4l2Control>{{"exposure_auto", 1}, {"gain", 40}}));
+
+  // And back through a rig file.
+  writeRigFile(dir_ / "rig.yaml", config.cameras, "test");
+  const auto cameras = loadRigFile(dir_ / "rig.yaml");
+  ASSERT_TRUE(cameras[1].device.has_value());
+  EXPECT_EQ(*cameras[1].device, *left.device);
+}
+
+TEST_F(ConfigTest, ALiveCameraWithAnUnknownFormatOrControlOrMixedWithFilesIsRefused) {
+  for (const auto& [source, message] :
+       {std::pair{"source: {device: /dev/video3, format: h264}", "rig.cameras[1].source.format"},
+        std::pair{"source: {device: /dev/video3, controls: {shutter_speed: 3}}",
+                  "rig.cameras[1].source.controls.shutter_speed: unknown key"},
+        std::pair{"source: {file: left.mkv}",
+                  "mixes live devices and files: the cameras of a rig are either all live or all "
+                  "replayed"}}) {
+    const auto messages = errorsOf(liveConfigWith(source));
+    ASSERT_EQ(messages.size(), 1u) << ::testing::PrintToString(messages);
+    EXPECT_THAT(messages[0], HasSubstr(message));
+  }
 }
 
 TEST_F(ConfigTest, AViewOnlyBelongsToASurroundOutput) {

@@ -230,6 +230,31 @@ TEST(EndToEnd, BadConfigOpensNothing) {
   EXPECT_FALSE(std::filesystem::exists(dir / "out"));
 }
 
+// A live rig whose camera is not plugged in: one message naming the camera and its device path.
+TEST(EndToEnd, ALiveCameraThatIsNotThereIsNamed) {
+  const testing::TempDir dir;
+  const auto rig = daemon::loadRigFile(kRecording / "rig.yaml");
+  std::vector<daemon::RigCamera> live(rig.begin(), rig.end());
+  for (auto& camera : live) {
+    camera.source.reset();
+    camera.device = capture::V4l2Settings{};
+    camera.device->device = "/dev/v4l/by-id/usb-surroundd-test-" + camera.calibration.name;
+    camera.device->size = camera.calibration.intrinsics.imageSize;
+  }
+  daemon::writeRigFile(dir / "rig.yaml", live, "live rig");
+  const auto config = dir.write("config.yaml", R"(rig: {file: rig.yaml}
+outputs:
+  - {type: video, stream: mosaic, path: out/mosaic.mp4}
+)");
+  testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--config", config.string()},
+                                  dir / "log.txt");
+  EXPECT_EQ(surroundd.wait(), 1);
+  EXPECT_THAT(surroundd.output(),
+              HasSubstr("camera 'front': /dev/v4l/by-id/usb-surroundd-test-front: cannot open: No "
+                        "such file or directory"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "out/mosaic.mp4"));
+}
+
 TEST(EndToEnd, UnknownOptionIsAUsageError) {
   const testing::TempDir dir;
   testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--confg", "x.yaml"}, dir / "log.txt");

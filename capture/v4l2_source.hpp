@@ -1,0 +1,93 @@
+#pragma once
+// A live camera through V4L2 (video4linux2): opened by a stable path (/dev/v4l/by-path/...,
+// /dev/v4l/by-id/...) or /dev/videoN, the pixel format, size and frame rate negotiated from the
+// settings, MMAP streaming, frames converted to BGR once (YUYV, UYVY, NV12; MJPEG through
+// libjpeg-turbo) with the driver's monotonic timestamps.
+//
+// Faults at run time are read() statuses: no frame within the timeout, the device gone (ENODEV,
+// EIO), a corrupt frame. A device that stops delivering or disappears is closed and reopened with
+// a growing backoff, and resumes streaming without anyone restarting anything.
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "capture/frame_source.hpp"
+#include "capture/jpeg_decoder.hpp"
+#include "capture/v4l2_device.hpp"
+
+namespace surroundd::capture {
+
+enum class V4l2Format { kAuto, kYuyv, kUyvy, kNv12, kMjpeg };
+const char* toString(V4l2Format format);
+
+// A V4L2 control by its name in the config: exposure_auto, exposure_absolute, gain,
+// white_balance_auto, white_balance_temperature, brightness, contrast, saturation.
+struct V4l2Control {
+  std::string name;
+  std::int32_t value = 0;
+  bool operator==(const V4l2Control&) const = default;
+};
+
+struct V4l2Settings {
+  std::filesystem::path device;
+  cv::Size size{1280, 720};
+  double fps = 30;
+  V4l2Format format = V4l2Format::kAuto;        // auto: YUYV, UYVY, NV12, MJPEG, the first offered
+  int buffers = 4;                              // driver buffers, 2..32
+  std::chrono::milliseconds timeout{500};       // no frame for this long: the camera is lost
+  std::chrono::milliseconds firstBackoff{100};  // reopening: first wait, doubled up to maxBackoff
+  std::chrono::milliseconds maxBackoff{2000};
+  std::vector<V4l2Control> controls;
+  bool operator==(const V4l2Settings&) const = default;
+};
+
+class V4l2Source final : public FrameSource {
+ public:
+  // Opens and starts the device. Throws CaptureError naming the camera and device: it cannot be
+  // opened, cannot stream, does not offer the format and size (the message lists what it offers),
+  // or refuses a control.
+  V4l2Source(std::string cameraName, V4l2Settings settings,
+             std::unique_ptr<V4l2Device> device = makeKernelV4l2Device());
+  ~V4l2Source() override;
+
+  cv::Size frameSize() const override { return settings_.size; }
+  Timestamp nominalPeriod() const override { return period_; }
+  ReadStatus read(Frame& out) override;
+  const std::string& lastError() const override { return error_; }
+
+  V4l2Format format() const { return format_; }  // as negotiated
+  std::uint64_t reopened() const { return reopened_; }
+
+ private:
+  struct MappedBuffer {
+    void* address = nullptr;
+    std::size_t length = 0;
+  };
+
+  void start();  // open, negotiate, map, stream; throws CaptureError
+  void stop();   // stream off, unmap, close; never throws
+  ReadStatus fault(std::string message, bool reopen);
+  ReadStatus reopen();
+  bool convert(const std::uint8_t* data, std::size_t bytes, cv::Mat& bgr);
+  std::string where() const;
+
+  std::string camera_;
+  V4l2Settings settings_;
+  std::unique_ptr<V4l2Device> device_;
+  JpegDecoder jpeg_;
+  V4l2Format format_ = V4l2Format::kAuto;
+  std::uint32_t bytesPerLine_ = 0;
+  Timestamp period_{0};
+  std::vector<MappedBuffer> buffers_;
+  bool streaming_ = false;
+  std::chrono::milliseconds backoff_{0};
+  std::chrono::steady_clock::time_point nextAttempt_{};
+  std::uint64_t reopened_ = 0;
+  std::string error_;
+};
+
+}  // namespace surroundd::capture
