@@ -96,6 +96,7 @@ Pipeline::Pipeline(const Config& config)
                                 [](const RigCamera& c) { return c.device.has_value(); })),
       lateAfter_(std::chrono::duration_cast<capture::Timestamp>(
           std::chrono::duration<double, std::milli>(config.capture.lateAfterMs))),
+      health_(cameras_.size()),
       pool_(config.pipeline.threads),
       mosaic_(cv::Size(config.render.widthPx, config.render.heightPx), cameraNames(config)),
       canvas_(mosaic_.outputSize(), CV_8UC3, cv::Scalar::all(0)) {
@@ -105,6 +106,7 @@ Pipeline::Pipeline(const Config& config)
   if (shows(OutputStream::kPanorama) || shows(OutputStream::kSurround)) {
     lut_ = std::make_unique<processing::PanoramaLut>(obtainPanoramaLut(config, pool_));
     stitcher_ = std::make_unique<processing::Stitcher>(*lut_, pool_);
+    ownership_ = std::make_unique<processing::PanoramaOwnership>(*lut_);
     panorama_.create(lut_->size, CV_8UC3);
     for (const auto& size : lut_->cameraSizes) {
       blackFrames_.emplace_back(size, CV_8UC3, cv::Scalar::all(0));
@@ -260,18 +262,21 @@ void Pipeline::process(const capture::FrameSet& set) {
   auto since = std::chrono::steady_clock::now();
   if (!firstTimestamp_) firstTimestamp_ = set.timestamp;
   lastStreamTime_ = set.timestamp - *firstTimestamp_;
+  followHealth(set);
   std::array<const cv::Mat*, capture::kMaxCameras> images{};
   for (std::size_t c = 0; c < set.cameraCount; ++c) {
     images[c] = set.frame(c) != nullptr ? &set.frame(c)->image : nullptr;
   }
   if (wanted(OutputStream::kMosaic, lastStreamTime_)) {
-    mosaic_.compose(std::span(images.data(), set.cameraCount), canvas_);
+    mosaic_.compose(std::span(images.data(), set.cameraCount), canvas_,
+                    std::span(faults_.data(), set.cameraCount));
     timed(Stage::kMosaic, since);
   }
   // The panorama is made for every set, wanted or not: colour correction follows it over time.
   if (stitcher_) {
     for (std::size_t c = 0; c < set.cameraCount; ++c) {
-      frames_[c] = images[c] != nullptr ? *images[c] : cv::Mat();
+      // A faulty camera's picture would pull its neighbours' colours: correction goes without it.
+      frames_[c] = images[c] != nullptr && faults_[c] == nullptr ? *images[c] : cv::Mat();
       stitchInputs_[c] = images[c] != nullptr ? *images[c] : blackFrames_[c];
     }
     stitcher_->stitch(stitchInputs_, panorama_);
@@ -286,6 +291,9 @@ void Pipeline::process(const capture::FrameSet& set) {
       gains_->update(frames_);
       gains_->apply(panorama_);
     }
+    for (std::size_t c = 0; c < set.cameraCount; ++c) {
+      if (faults_[c] != nullptr) ownership_->markFaulty(panorama_, c);
+    }
     timed(Stage::kCorrect, since);
   }
   deliverSurround();
@@ -296,6 +304,24 @@ void Pipeline::process(const capture::FrameSet& set) {
     guarded(output, [&] { output.sink->consume(imageOf(output.stream), lastStreamTime_); });
   }
   timed(Stage::kOutput, since);
+}
+
+void Pipeline::followHealth(const capture::FrameSet& set) {
+  for (const capture::HealthChange& change : health_.observe(set, synchronizer_.stats())) {
+    const auto& name = cameras_[change.camera]->name();
+    const double at = std::chrono::duration<double>(lastStreamTime_).count();
+    if (change.to == capture::CameraHealth::kOk) {
+      spdlog::info("camera '{}': back to normal at {:.3f} s (was {})", name, at,
+                   capture::toString(change.from));
+      faults_[change.camera] = nullptr;
+    } else {
+      spdlog::warn("camera '{}': {} at {:.3f} s; its part of the view is marked", name,
+                   capture::toString(change.to), at);
+      faults_[change.camera] = capture::toString(change.to);
+    }
+    healthChanges_.push_back(change);
+    healthChanges_.back().at = lastStreamTime_;
+  }
 }
 
 void Pipeline::renderSurround(const capture::FrameSet& set, std::chrono::nanoseconds streamTime) {
@@ -357,6 +383,7 @@ void Pipeline::finish(RunSummary& summary) {
   summary.failedOutputs = failedSinks_;
   summary.sync = synchronizer_.stats();
   summary.stageTime = stageTime_;
+  summary.healthChanges = healthChanges_;
   if (gl_) summary.renderer = gl_->description();
   for (const auto& camera : cameras_) {
     summary.cameraNames.push_back(camera->name());

@@ -21,11 +21,13 @@
 #include <string>
 #include <vector>
 
+#include "capture/camera_health.hpp"
 #include "capture/camera_stream.hpp"
 #include "capture/synchronizer.hpp"
 #include "common/work_pool.hpp"
 #include "daemon/config.hpp"
 #include "processing/gain_compensation.hpp"
+#include "processing/panorama_ownership.hpp"
 #include "processing/poisson_correction.hpp"
 #include "processing/stitcher.hpp"
 #include "render/egl_context.hpp"
@@ -49,6 +51,7 @@ struct RunSummary {
   std::vector<std::string> outputs;  // what each output wrote
   std::uint64_t failedOutputs = 0;
   std::array<std::chrono::nanoseconds, static_cast<std::size_t>(Stage::kCount)> stageTime{};
+  std::vector<capture::HealthChange> healthChanges;  // in order; `at` is stream time
   std::string renderer;  // the EGL context's description, when there were surround outputs
 
   double framesPerSecond() const {
@@ -79,6 +82,7 @@ class Pipeline {
 
   void fillNeeds(const std::atomic<bool>& stop);
   void process(const capture::FrameSet& set);
+  void followHealth(const capture::FrameSet& set);
   void renderSurround(const capture::FrameSet& set, std::chrono::nanoseconds streamTime);
   void deliverSurround();
   void finish(RunSummary& summary);
@@ -95,6 +99,9 @@ class Pipeline {
   capture::Synchronizer synchronizer_;
   bool live_;  // V4L2 cameras: sets go without a late camera
   capture::Timestamp lateAfter_;
+  capture::CameraHealthMonitor health_;
+  std::array<const char*, capture::kMaxCameras> faults_{};  // per camera: what is wrong, or null
+  std::vector<capture::HealthChange> healthChanges_;
   WorkPool pool_;
   render::Mosaic mosaic_;
   cv::Mat canvas_;                                  // the composed mosaic; reused for every set
@@ -102,6 +109,7 @@ class Pipeline {
   std::unique_ptr<processing::Stitcher> stitcher_;  // borrows *lut_ and pool_
   std::unique_ptr<processing::PoissonColourCorrection> poisson_;  // colour_correction: poisson
   std::unique_ptr<processing::GainCompensation> gains_;           // colour_correction: gain
+  std::unique_ptr<processing::PanoramaOwnership> ownership_;      // marks faulty cameras
   std::vector<cv::Mat> frames_;        // this set's images (headers only); empty where missing
   std::vector<cv::Mat> stitchInputs_;  // the same, with black frames for missing cameras
   std::vector<cv::Mat> blackFrames_;

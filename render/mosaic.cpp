@@ -36,7 +36,8 @@ Mosaic::Mosaic(cv::Size outputSize, std::vector<std::string> labels)
   }
 }
 
-void Mosaic::compose(std::span<const cv::Mat* const> frames, cv::Mat& out) const {
+void Mosaic::compose(std::span<const cv::Mat* const> frames, cv::Mat& out,
+                     std::span<const char* const> faults) const {
   const cv::Scalar background(0, 0, 0);
   const cv::Scalar missing(96, 96, 96);
   CV_Assert(out.type() == CV_8UC3 && out.size() == outputSize_ && frames.size() == tiles_.size());
@@ -53,7 +54,13 @@ void Mosaic::compose(std::span<const cv::Mat* const> frames, cv::Mat& out) const
     // Writes into the view of `out` in place: the destination already has the requested size.
     cv::Mat target = out(fit);
     cv::resize(*frame, target, fit.size(), 0, 0, cv::INTER_AREA);
-    drawLabel(tile, labels_[i]);
+    const char* fault = i < faults.size() ? faults[i] : nullptr;
+    if (fault != nullptr) {
+      target.convertTo(target, -1, 0.4, 40);  // dimmed, in place
+      drawLabel(tile, labels_[i] + ": " + fault);
+    } else {
+      drawLabel(tile, labels_[i]);
+    }
   }
 }
 

@@ -15,9 +15,11 @@ class Mosaic {
  public:
   Mosaic(cv::Size outputSize, std::vector<std::string> labels);
 
-  // `frames[i]` is camera i's 8-bit BGR image, or nullptr when it has none. `out` must be 8-bit BGR
-  // of outputSize(); it is drawn over completely.
-  void compose(std::span<const cv::Mat* const> frames, cv::Mat& out) const;
+  // `frames[i]` is camera i's 8-bit BGR image, or nullptr when it has none; `faults[i]`, when
+  // given and not null, says what is wrong with camera i (its tile is dimmed and says so). `out`
+  // must be 8-bit BGR of outputSize(); it is drawn over completely.
+  void compose(std::span<const cv::Mat* const> frames, cv::Mat& out,
+               std::span<const char* const> faults = {}) const;
 
   cv::Size outputSize() const { return outputSize_; }
   // Tile of camera i in the output image.

@@ -17,3 +17,6 @@ surroundd_fixture(synth_small_identity --rig ${paper} ${small} --seconds 1 --see
 # One camera leaves out every third frame: for replay and synchronizer tests.
 surroundd_fixture(synth_drop --rig ${paper} ${small} --seconds 2 --seed 11 --drop-every right:3)
 surroundd_fixture(synth_fisheye --rig ${fisheye} ${small} --seconds 1 --seed 5)
+# From 0.5 s on, 'left' freezes, 'right' goes black and 'back' stops: for camera health.
+surroundd_fixture(synth_faults --rig ${paper} ${small} --seconds 1 --seed 13
+                  --fault left:freeze@0.5 --fault right:black@0.5 --fault back:stop@0.5)

@@ -52,7 +52,8 @@ processing::Intrinsics scaleIntrinsics(const processing::Intrinsics& in, cv::Siz
 
 bool RecordingPlan::dropped(std::size_t camera, int frame) const {
   const int n = cameras[camera].dropEvery;
-  return n > 0 && frame % n == n - 1;
+  return (n > 0 && frame % n == n - 1) ||
+         cameras[camera].faulty(frame, SynthOptions::Fault::Kind::kStop);
 }
 
 std::chrono::microseconds RecordingPlan::timestamp(std::size_t camera, int frame) const {
@@ -111,6 +112,16 @@ RecordingPlan planRecording(const SynthOptions& options) {
     camera.startOffsetS = timing.uniform(0, 0.004);
     heightSum += camera.camera.calibration.pose.position[2];
     plan.cameras.push_back(std::move(camera));
+  }
+  for (const auto& fault : options.faults) {
+    const auto it = std::find_if(plan.cameras.begin(), plan.cameras.end(), [&](const auto& c) {
+      return c.camera.calibration.name == fault.camera;
+    });
+    if (it == plan.cameras.end()) {
+      throw UsageError(fmt::format("--fault: the rig has no camera named '{}'", fault.camera));
+    }
+    it->fault = fault.kind;
+    it->faultFrame = static_cast<int>(std::lround(fault.fromS * options.fps));
   }
   for (const auto& [name, n] : options.dropEvery) {
     const std::string& wanted = name;  // clang-tidy (clang 14) cannot capture the binding

@@ -24,6 +24,11 @@ struct CameraPlan {
   CameraPhotometrics photometrics;
   double startOffsetS = 0;  // 0 .. 4 ms: cameras are not triggered together
   int dropEvery = 0;        // 0: none; N: frames N-1, 2N-1, ... are not recorded
+  std::optional<SynthOptions::Fault::Kind> fault;  // from faultFrame on
+  int faultFrame = 0;
+  bool faulty(int frame, SynthOptions::Fault::Kind kind) const {
+    return fault == kind && frame >= faultFrame;
+  }
 };
 
 struct RecordingPlan {

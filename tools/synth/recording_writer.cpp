@@ -135,19 +135,32 @@ RecordingResult writeRecording(const SynthOptions& options, std::ostream& log) {
   std::vector<cv::Mat> truth(plan.cameras.size());
   for (std::size_t c = 0; c < plan.cameras.size(); ++c) truth[c].create(rays[c]->size(), CV_8UC3);
   std::vector<int> framesWritten(plan.cameras.size(), 0);
+  std::vector<cv::Mat> frozen(plan.cameras.size());  // the picture a frozen camera repeats
   auto nextTruth = plan.groundTruthFrames.begin();
   for (int k = 0; k < plan.frames; ++k) {
     const double t = plan.frameTime(k);
     const VehiclePose pose = VehiclePath::poseAt(t);
     jobs.clear();
     for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
+      const CameraPlan& camera = plan.cameras[c];
       if (plan.dropped(c, k)) continue;
-      jobs.push_back(
-          {rays[c].get(), sensors[c].get(), sensors[c]->frame(k, t), &encoders[c]->acquire()});
+      cv::Mat& slot = encoders[c]->acquire();
+      // Faults: a black picture, or the picture of the fault's first frame again and again.
+      if (camera.faulty(k, SynthOptions::Fault::Kind::kBlack)) {
+        slot.setTo(cv::Scalar::all(0));
+      } else if (camera.faulty(k, SynthOptions::Fault::Kind::kFreeze) && k > camera.faultFrame) {
+        frozen[c].copyTo(slot);
+      } else {
+        jobs.push_back({rays[c].get(), sensors[c].get(), sensors[c]->frame(k, t), &slot});
+      }
     }
     renderer.render(pose, jobs);
     for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
       if (plan.dropped(c, k)) continue;
+      if (plan.cameras[c].faulty(k, SynthOptions::Fault::Kind::kFreeze) &&
+          k == plan.cameras[c].faultFrame) {
+        encoders[c]->acquire().copyTo(frozen[c]);
+      }
       encoders[c]->submit(plan.timestamp(c, k));
       ++framesWritten[c];
     }

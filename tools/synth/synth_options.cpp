@@ -75,6 +75,12 @@ std::string SynthOptions::canonical() const {
     s << "default";
   }
   s << " panorama_size=" << panoramaSize.width << "x" << panoramaSize.height << " crf=" << crf;
+  if (!faults.empty()) {  // only then: earlier recordings keep their keys
+    s << " faults=";
+    for (const auto& f : faults) {
+      s << f.camera << ":" << static_cast<int>(f.kind) << "@" << fmt::format("{}", f.fromS) << ";";
+    }
+  }
   return s.str();
 }
 
@@ -130,6 +136,24 @@ SynthOptions parseSynthArguments(std::span<const std::string_view> arguments) {
       o.dropEvery.emplace_back(std::string(v.substr(0, colon)),
                                parseNumber<int>(option, v.substr(colon + 1), 2, 1'000'000,
                                                 "CAMERA:N with N >= 2 (e.g. right:3)"));
+    } else if (option == "--fault") {
+      const auto v = value();
+      const auto colon = v.find(':');
+      const auto at = v.find('@');
+      const auto kind = colon != std::string_view::npos && at != std::string_view::npos && colon < at
+                            ? v.substr(colon + 1, at - colon - 1)
+                            : std::string_view();
+      if (colon == 0 || (kind != "freeze" && kind != "black" && kind != "stop")) {
+        throw UsageError(fmt::format(
+            "{}: expected CAMERA:freeze|black|stop@SECONDS (e.g. left:freeze@0.5), got '{}'",
+            option, v));
+      }
+      o.faults.push_back({std::string(v.substr(0, colon)),
+                          kind == "freeze"  ? SynthOptions::Fault::Kind::kFreeze
+                          : kind == "black" ? SynthOptions::Fault::Kind::kBlack
+                                            : SynthOptions::Fault::Kind::kStop,
+                          parseNumber<double>(option, v.substr(at + 1), 0.0, 3600.0,
+                                              "CAMERA:KIND@SECONDS with 0 <= SECONDS <= 3600")});
     } else if (option == "--ground-truth-frames") {
       o.groundTruthFrames = parseFrames(option, value());
     } else if (option == "--panorama-size") {
@@ -179,6 +203,8 @@ usage: surround-synth --rig FILE --out DIR [options]
   --no-drift                 no slow exposure drift
   --noise-sigma X            sensor noise in 8-bit levels (default 1.5)
   --drop-every NAME:N        omit every Nth frame of camera NAME (repeatable)
+  --fault NAME:KIND@S        from S seconds on, camera NAME freezes (repeats one picture), goes
+                             black, or stops (its video ends); KIND freeze|black|stop (repeatable)
   --ground-truth-frames LIST frames with ground truth images (default: first, middle, last)
   --panorama-size WxH        ground-truth panorama size (default 2048x1024)
   --crf N                    x264 CRF of the videos (default 14, visually lossless)

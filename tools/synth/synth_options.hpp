@@ -36,6 +36,14 @@ struct SynthOptions {
   bool drift = true;                                   // slow exposure drift
   double noiseSigma = 1.5;                             // sensor noise, 8-bit levels
   std::vector<std::pair<std::string, int>> dropEvery;  // camera name, N: omit every Nth frame
+  // A camera that fails from a time on: its picture freezes, goes black, or it stops delivering.
+  struct Fault {
+    enum class Kind { kFreeze, kBlack, kStop };
+    std::string camera;
+    Kind kind = Kind::kStop;
+    double fromS = 0;
+  };
+  std::vector<Fault> faults;
   std::optional<std::vector<int>> groundTruthFrames;   // default: first, middle, last
   cv::Size panoramaSize{2048, 1024};
   int crf = 14;        // x264 CRF: visually lossless camera masters
