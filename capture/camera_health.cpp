@@ -66,15 +66,17 @@ CameraHealth CameraHealthMonitor::judge(Camera& camera, const Frame* frame, Time
   camera.lastFrame = now;
 
   const cv::Mat& image = frame->image;
-  std::array<std::uint8_t, kSamplesAcross * kSamplesDown * 3> samples{};
+  std::array<std::uint8_t, static_cast<std::size_t>(kSamplesAcross) * kSamplesDown * 3> samples{};
   std::uint64_t sum = 0;
+  std::size_t index = 0;
   for (int j = 0; j < kSamplesDown; ++j) {
     const auto* row = image.ptr<std::uint8_t>((2 * j + 1) * image.rows / (2 * kSamplesDown));
     for (int i = 0; i < kSamplesAcross; ++i) {
-      const std::uint8_t* pixel = row + 3 * ((2 * i + 1) * image.cols / (2 * kSamplesAcross));
+      const std::size_t column = static_cast<std::size_t>((2 * i + 1) * image.cols) /
+                                 (2 * static_cast<std::size_t>(kSamplesAcross));
+      const std::uint8_t* pixel = row + 3 * column;
       for (int k = 0; k < 3; ++k) {
-        const auto index = static_cast<std::size_t>((j * kSamplesAcross + i) * 3 + k);
-        samples[index] = pixel[k];
+        samples[index++] = pixel[k];
         sum += pixel[k];
       }
     }
@@ -83,8 +85,8 @@ CameraHealth CameraHealthMonitor::judge(Camera& camera, const Frame* frame, Time
   for (std::size_t i = 0; i < samples.size(); ++i) {
     change += std::abs(static_cast<int>(samples[i]) - static_cast<int>(camera.samples[i]));
   }
-  const bool same = static_cast<double>(change) <
-                    settings_.frozenChange * static_cast<double>(samples.size());
+  const bool same =
+      static_cast<double>(change) < settings_.frozenChange * static_cast<double>(samples.size());
   camera.sameFrames = same ? camera.sameFrames + 1 : 0;
   camera.samples = samples;
   const double mean = static_cast<double>(sum) / static_cast<double>(samples.size());

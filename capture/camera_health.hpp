@@ -58,7 +58,7 @@ class CameraHealthMonitor {
   struct Camera {
     CameraHealth health = CameraHealth::kOk;
     std::optional<Timestamp> lastFrame;
-    std::array<std::uint8_t, kSamplesAcross * kSamplesDown * 3> samples{};
+    std::array<std::uint8_t, static_cast<std::size_t>(kSamplesAcross) * kSamplesDown * 3> samples{};
     int sameFrames = 0;  // consecutive frames whose samples equal the previous frame's
     std::uint64_t unmatchedBefore = 0;
     std::uint64_t outOfOrderBefore = 0;

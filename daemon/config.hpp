@@ -101,7 +101,8 @@ struct RenderConfig {
 // What an output shows: the labelled camera grid, the stitched panorama, or the rendered
 // surround view.
 enum class OutputStream { kMosaic, kPanorama, kSurround };
-enum class OutputKind { kVideo, kSnapshot };
+// A recording is not a picture of the pipeline but the cameras' own streams (RigRecorder).
+enum class OutputKind { kVideo, kSnapshot, kRecording };
 
 struct OutputConfig {
   OutputKind kind = OutputKind::kVideo;
@@ -114,6 +115,8 @@ struct OutputConfig {
   std::string pixelFormat = "yuv420p";
   // snapshot
   double atSeconds = 1.0;  // stream time of the snapshot; the last frame if the run is shorter
+  // recording (a folder): bit for bit, or H.264 4:4:4 at crf / preset
+  bool lossless = true;
 
   bool operator==(const OutputConfig&) const = default;
 };

@@ -171,8 +171,12 @@ void readRender(YamlObject& section, RenderConfig& r) {
 OutputConfig readOutput(YamlObject& item) {
   OutputConfig o;
   o.kind = item.choice("type", o.kind,
-                       {{"video", OutputKind::kVideo}, {"snapshot", OutputKind::kSnapshot}});
-  if (!item.has("type")) item.errorHere("missing key 'type' (one of 'video' 'snapshot')");
+                       {{"video", OutputKind::kVideo},
+                        {"snapshot", OutputKind::kSnapshot},
+                        {"recording", OutputKind::kRecording}});
+  if (!item.has("type")) {
+    item.errorHere("missing key 'type' (one of 'video' 'snapshot' 'recording')");
+  }
   o.stream = item.choice("stream", o.stream,
                          {{"mosaic", OutputStream::kMosaic},
                           {"panorama", OutputStream::kPanorama},
@@ -201,6 +205,15 @@ OutputConfig readOutput(YamlObject& item) {
     if (!o.path.empty() && extension != ".mp4" && extension != ".mkv") {
       item.error("path",
                  fmt::format("expected a file ending in .mp4 or .mkv, got '{}'", o.path.string()));
+    }
+  } else if (o.kind == OutputKind::kRecording) {
+    o.lossless = item.boolean("lossless", o.lossless);
+    o.crf = item.integer("crf", o.crf, 0, 51);
+    std::error_code ec;
+    if (!o.path.empty() && std::filesystem::exists(o.path, ec) &&
+        !std::filesystem::is_directory(o.path, ec)) {
+      item.error("path", fmt::format("expected a folder for the recording, got the file '{}'",
+                                     o.path.string()));
     }
   } else {
     o.atSeconds = item.number("at_s", o.atSeconds, {0.0, 1e7, false, "seconds of stream time"});

@@ -118,6 +118,12 @@ Pipeline::Pipeline(const Config& config)
   if (shows(OutputStream::kSurround)) setUpSurround(config);
   const double nominalFps = 1e9 / static_cast<double>(cameras_.front()->nominalPeriod().count());
   for (const auto& output : config.outputs) {
+    if (output.kind == OutputKind::kRecording) {
+      recorders_.push_back(std::make_unique<RigRecorder>(
+          RecordingSettings{output.path, output.lossless, output.crf, output.preset},
+          config.cameras, nominalFps));
+      continue;
+    }
     const cv::Size size =
         output.stream == OutputStream::kPanorama ? lut_->size : mosaic_.outputSize();
     Output out;
@@ -263,6 +269,16 @@ void Pipeline::process(const capture::FrameSet& set) {
   if (!firstTimestamp_) firstTimestamp_ = set.timestamp;
   lastStreamTime_ = set.timestamp - *firstTimestamp_;
   followHealth(set);
+  for (auto& recorder : recorders_) {
+    if (!recorder) continue;
+    try {
+      recorder->record(set);
+    } catch (const std::exception& e) {
+      spdlog::error("recording failed, dropping it: {}", e.what());
+      ++failedSinks_;
+      recorder.reset();
+    }
+  }
   std::array<const cv::Mat*, capture::kMaxCameras> images{};
   for (std::size_t c = 0; c < set.cameraCount; ++c) {
     images[c] = set.frame(c) != nullptr ? &set.frame(c)->image : nullptr;
@@ -379,6 +395,16 @@ void Pipeline::finish(RunSummary& summary) {
       output.sink->finish(last, lastStreamTime_);
       summary.outputs.push_back(output.sink->describe());
     });
+  }
+  for (auto& recorder : recorders_) {
+    if (!recorder) continue;
+    try {
+      recorder->finish();
+      summary.outputs.push_back(recorder->describe());
+    } catch (const std::exception& e) {
+      spdlog::error("recording failed to finish: {}", e.what());
+      ++failedSinks_;
+    }
   }
   summary.failedOutputs = failedSinks_;
   summary.sync = synchronizer_.stats();

@@ -26,6 +26,7 @@
 #include "capture/synchronizer.hpp"
 #include "common/work_pool.hpp"
 #include "daemon/config.hpp"
+#include "daemon/rig_recorder.hpp"
 #include "processing/gain_compensation.hpp"
 #include "processing/panorama_ownership.hpp"
 #include "processing/poisson_correction.hpp"
@@ -119,6 +120,7 @@ class Pipeline {
   std::unique_ptr<render::SurroundScene> scene_;
   std::size_t splitCamera_ = 0;
   std::vector<Output> outputs_;
+  std::vector<std::unique_ptr<RigRecorder>> recorders_;  // null once failed
   std::array<std::chrono::nanoseconds, static_cast<std::size_t>(Stage::kCount)> stageTime_{};
   std::uint64_t failedSinks_ = 0;
   std::optional<capture::Timestamp> firstTimestamp_;

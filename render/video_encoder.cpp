@@ -58,17 +58,23 @@ void VideoEncoder::Impl::open() {
                      settings.size.height));
   }
   const AVPixelFormat pixelFormat = av_get_pix_fmt(settings.pixelFormat.c_str());
-  if (pixelFormat != AV_PIX_FMT_YUV420P && pixelFormat != AV_PIX_FMT_YUV444P) {
-    fail(fmt::format("pixel format must be yuv420p or yuv444p, got '{}'", settings.pixelFormat));
+  if (pixelFormat != AV_PIX_FMT_YUV420P && pixelFormat != AV_PIX_FMT_YUV444P &&
+      pixelFormat != AV_PIX_FMT_BGR24) {
+    fail(fmt::format("pixel format must be yuv420p, yuv444p or bgr24, got '{}'",
+                     settings.pixelFormat));
   }
+  // bgr24 is H.264 on the pictures' own channels (libx264rgb): with crf 0 the frames come back
+  // bit for bit.
+  const bool rgb = pixelFormat == AV_PIX_FMT_BGR24;
   if (!(settings.nominalFps > 0 && settings.nominalFps <= 1000)) {
     fail(fmt::format("nominal frame rate must be in (0, 1000], got {}", settings.nominalFps));
   }
   if (settings.crf < 0 || settings.crf > 51) {
     fail(fmt::format("crf must be in 0..51 (0 = lossless), got {}", settings.crf));
   }
-  const AVCodec* encoder = avcodec_find_encoder_by_name("libx264");
-  if (encoder == nullptr) fail("this FFmpeg has no libx264 encoder");
+  const char* encoderName = rgb ? "libx264rgb" : "libx264";
+  const AVCodec* encoder = avcodec_find_encoder_by_name(encoderName);
+  if (encoder == nullptr) fail(fmt::format("this FFmpeg has no {} encoder", encoderName));
 
   partPath = settings.path;
   partPath += ".part";
@@ -90,10 +96,10 @@ void VideoEncoder::Impl::open() {
   codec->framerate = av_d2q(settings.nominalFps, 1 << 16);
   codec->thread_count = settings.threads;
   // BT.601 limited range, tagged, so that every decoder converts back the way sws converted here.
-  codec->colorspace = AVCOL_SPC_SMPTE170M;
+  codec->colorspace = rgb ? AVCOL_SPC_RGB : AVCOL_SPC_SMPTE170M;
   codec->color_primaries = AVCOL_PRI_SMPTE170M;
   codec->color_trc = AVCOL_TRC_SMPTE170M;
-  codec->color_range = AVCOL_RANGE_MPEG;
+  codec->color_range = rgb ? AVCOL_RANGE_JPEG : AVCOL_RANGE_MPEG;
   if (settings.bitExact) codec->flags |= AV_CODEC_FLAG_BITEXACT;
   if ((format->oformat->flags & AVFMT_GLOBALHEADER) != 0)
     codec->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
@@ -141,8 +147,10 @@ void VideoEncoder::Impl::open() {
                            SWS_BICUBIC | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT | SWS_BITEXACT,
                            nullptr, nullptr, nullptr));
   if (!sws) fail("cannot set up the colour conversion");
-  const int* bt601 = sws_getCoefficients(SWS_CS_ITU601);
-  sws_setColorspaceDetails(sws.get(), bt601, 1, bt601, 0, 0, 1 << 16, 1 << 16);
+  if (!rgb) {
+    const int* bt601 = sws_getCoefficients(SWS_CS_ITU601);
+    sws_setColorspaceDetails(sws.get(), bt601, 1, bt601, 0, 0, 1 << 16, 1 << 16);
+  }
 }
 
 void VideoEncoder::Impl::drain(bool flushing) {

@@ -37,8 +37,9 @@ struct VideoEncoderSettings {
   double nominalFps = 30.0;    // rate hint for the container; timestamps decide the real timing
   int crf = 20;                // x264 constant rate factor; 0 = lossless
   std::string preset = "veryfast";  // x264 preset
-  std::string pixelFormat =
-      "yuv420p";          // yuv420p (plays everywhere) or yuv444p (camera-master quality)
+  // yuv420p (plays everywhere), yuv444p (camera-master quality) or bgr24 (libx264rgb; with crf 0
+  // the pictures come back bit for bit)
+  std::string pixelFormat = "yuv420p";
   int threads = 0;        // encoder threads; 0 = codec's choice. Fix it for identical bytes.
   bool bitExact = false;  // leave out version strings so the same input gives the same bytes
 

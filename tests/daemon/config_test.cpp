@@ -177,6 +177,21 @@ TEST_F(ConfigTest, ALiveCameraWithAnUnknownFormatOrControlOrMixedWithFilesIsRefu
   }
 }
 
+TEST_F(ConfigTest, ARecordingIsAFolder) {
+  const Config config = loadConfig(configWith(
+      "  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+      "  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}\n"
+      "  - {type: recording, path: out/drive, lossless: false, crf: 20}"));
+  ASSERT_EQ(config.outputs.size(), 3u);
+  EXPECT_EQ(config.outputs[2].kind, OutputKind::kRecording);
+  EXPECT_EQ(config.outputs[2].path, dir_ / "out/drive");
+  EXPECT_FALSE(config.outputs[2].lossless);
+  EXPECT_EQ(config.outputs[2].crf, 20);
+  expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "  - {type: recording, path: front.mkv}",
+                 {"outputs[1].path: expected a folder for the recording, got the file"});
+}
+
 TEST_F(ConfigTest, AViewOnlyBelongsToASurroundOutput) {
   expectOneError("{type: snapshot, path: out/mosaic.png,",
                  "{type: snapshot, view: top, path: out/mosaic.png,",

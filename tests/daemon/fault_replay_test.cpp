@@ -6,8 +6,8 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "daemon/pipeline.hpp"
 #include "daemon/panorama_setup.hpp"
+#include "daemon/pipeline.hpp"
 #include "daemon/rig_yaml.hpp"
 #include "processing/panorama_ownership.hpp"
 #include "tests/support/temp_dir.hpp"
@@ -54,10 +54,9 @@ TEST(CameraHealth, FaultsAreDetectedWithin200MsAndMarkedWhileTheOthersGoOn) {
     return -1.0;
   };
   // Front: camera 0, right 1, back 2, left 3; the faults start at 0.5 s (frame 15).
-  for (const auto& [camera, health] :
-       {std::pair{std::size_t{3}, capture::CameraHealth::kFrozen},
-        std::pair{std::size_t{1}, capture::CameraHealth::kBlack},
-        std::pair{std::size_t{2}, capture::CameraHealth::kLost}}) {
+  for (const auto& [camera, health] : {std::pair{std::size_t{3}, capture::CameraHealth::kFrozen},
+                                       std::pair{std::size_t{1}, capture::CameraHealth::kBlack},
+                                       std::pair{std::size_t{2}, capture::CameraHealth::kLost}}) {
     const double at = detected(camera, health);
     SCOPED_TRACE(capture::toString(health));
     EXPECT_GE(at, 0.49);
