@@ -9,7 +9,6 @@
 
 #include <fmt/format.h>
 #include <linux/videodev2.h>
-#include <opencv2/imgproc.hpp>
 
 namespace surroundd::capture {
 namespace {
@@ -17,11 +16,14 @@ namespace {
 struct FormatCode {
   V4l2Format format;
   std::uint32_t fourcc;
+  PixelLayout layout;
 };
-constexpr std::array<FormatCode, 4> kFormats{{{V4l2Format::kYuyv, V4L2_PIX_FMT_YUYV},
-                                              {V4l2Format::kUyvy, V4L2_PIX_FMT_UYVY},
-                                              {V4l2Format::kNv12, V4L2_PIX_FMT_NV12},
-                                              {V4l2Format::kMjpeg, V4L2_PIX_FMT_MJPEG}}};
+constexpr std::array<FormatCode, 4> kFormats{{
+    {V4l2Format::kYuyv, V4L2_PIX_FMT_YUYV, PixelLayout::kYuyv},
+    {V4l2Format::kUyvy, V4L2_PIX_FMT_UYVY, PixelLayout::kUyvy},
+    {V4l2Format::kNv12, V4L2_PIX_FMT_NV12, PixelLayout::kNv12},
+    {V4l2Format::kMjpeg, V4L2_PIX_FMT_MJPEG, PixelLayout::kMjpeg},
+}};
 
 struct ControlName {
   const char* name;
@@ -113,19 +115,8 @@ std::string errorText(int error) { return std::strerror(error); }  // NOLINT(con
 }  // namespace
 
 const char* toString(V4l2Format format) {
-  switch (format) {
-    case V4l2Format::kAuto:
-      return "auto";
-    case V4l2Format::kYuyv:
-      return "YUYV";
-    case V4l2Format::kUyvy:
-      return "UYVY";
-    case V4l2Format::kNv12:
-      return "NV12";
-    case V4l2Format::kMjpeg:
-      return "MJPEG";
-  }
-  return "?";
+  const auto known = std::ranges::find(kFormats, format, &FormatCode::format);
+  return known == kFormats.end() ? "auto" : toString(known->layout);
 }
 
 V4l2Source::V4l2Source(std::string cameraName, V4l2Settings settings,
@@ -192,6 +183,7 @@ void V4l2Source::start() {
     throw cannot();
   }
   format_ = chosen->format;
+  layout_ = chosen->layout;
   bytesPerLine_ = format.fmt.pix.bytesperline;
 
   // The frame rate, where the driver lets it be set; the nominal period is what it answers.
@@ -339,31 +331,7 @@ ReadStatus V4l2Source::read(Frame& out) {
 }
 
 bool V4l2Source::convert(const std::uint8_t* data, std::size_t bytes, cv::Mat& bgr) {
-  const int width = settings_.size.width;
-  const int height = settings_.size.height;
-  auto* pixels = const_cast<std::uint8_t*>(data);  // cv::Mat has no read-only header
-  switch (format_) {
-    case V4l2Format::kYuyv:
-    case V4l2Format::kUyvy: {
-      if (bytes < static_cast<std::size_t>(bytesPerLine_) * height) break;
-      const cv::Mat packed(height, width, CV_8UC2, pixels, bytesPerLine_);
-      cv::cvtColor(packed, bgr,
-                   format_ == V4l2Format::kYuyv ? cv::COLOR_YUV2BGR_YUYV : cv::COLOR_YUV2BGR_UYVY);
-      return true;
-    }
-    case V4l2Format::kNv12: {
-      if (bytes < static_cast<std::size_t>(bytesPerLine_) * height * 3 / 2) break;
-      const cv::Mat planes(height * 3 / 2, width, CV_8UC1, pixels, bytesPerLine_);
-      cv::cvtColor(planes, bgr, cv::COLOR_YUV2BGR_NV12);
-      return true;
-    }
-    case V4l2Format::kMjpeg:
-      return jpeg_.decode(std::span(data, bytes), bgr, error_);
-    case V4l2Format::kAuto:
-      break;
-  }
-  error_ = fmt::format("a {} frame of {} bytes is too short", toString(format_), bytes);
-  return false;
+  return convertToBgr(layout_, std::span(data, bytes), bytesPerLine_, jpeg_, bgr, error_);
 }
 
 }  // namespace surroundd::capture

@@ -17,6 +17,7 @@
 
 #include "capture/frame_source.hpp"
 #include "capture/jpeg_decoder.hpp"
+#include "capture/pixel_conversion.hpp"
 #include "capture/v4l2_device.hpp"
 
 namespace surroundd::capture {
@@ -80,6 +81,7 @@ class V4l2Source final : public FrameSource {
   std::unique_ptr<V4l2Device> device_;
   JpegDecoder jpeg_;
   V4l2Format format_ = V4l2Format::kAuto;
+  PixelLayout layout_ = PixelLayout::kYuyv;
   std::uint32_t bytesPerLine_ = 0;
   Timestamp period_{0};
   std::vector<MappedBuffer> buffers_;

@@ -35,14 +35,14 @@ void readRig(YamlObject& root, Config& config) {
   }
   rig->finish();
   for (const auto& camera : config.cameras) {
-    if (!camera.source && !camera.device) {
+    if (!camera.source && !camera.live()) {
       rig->errorHere(fmt::format("camera '{}' has no 'source' (surroundd needs one per camera)",
                                  camera.calibration.name));
     }
   }
   // Live devices and files run on different clocks; their frames could never be matched.
-  const auto live = std::ranges::count_if(config.cameras,
-                                          [](const RigCamera& c) { return c.device.has_value(); });
+  const auto live =
+      std::ranges::count_if(config.cameras, [](const RigCamera& c) { return c.live(); });
   if (live > 0 && live < static_cast<std::ptrdiff_t>(config.cameras.size())) {
     rig->errorHere(
         "mixes live devices and files: the cameras of a rig are either all live or all replayed");

@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include "capture/file_source.hpp"
+#include "capture/libcamera_source.hpp"
 #include "capture/v4l2_source.hpp"
 #include "daemon/panorama_setup.hpp"
 
@@ -27,7 +28,11 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
     std::unique_ptr<capture::FrameSource> source;
     std::string origin;
     int maxConsecutiveFaults = 30;  // a replay that keeps failing ends
-    if (camera.device) {
+    if (camera.libcamera) {
+      source = std::make_unique<capture::LibcameraSource>(name, *camera.libcamera);
+      origin = fmt::format("libcamera {}", camera.libcamera->camera);
+      maxConsecutiveFaults = 0;
+    } else if (camera.device) {
       auto device = std::make_unique<capture::V4l2Source>(name, *camera.device);
       origin = fmt::format("{} ({})", camera.device->device.string(),
                            capture::toString(device->format()));
@@ -92,8 +97,7 @@ Pipeline::Pipeline(const Config& config)
       synchronizer_(cameras_.size(),
                     std::chrono::duration_cast<capture::Timestamp>(
                         std::chrono::duration<double, std::milli>(config.capture.syncToleranceMs))),
-      live_(std::ranges::any_of(config.cameras,
-                                [](const RigCamera& c) { return c.device.has_value(); })),
+      live_(std::ranges::any_of(config.cameras, [](const RigCamera& c) { return c.live(); })),
       lateAfter_(std::chrono::duration_cast<capture::Timestamp>(
           std::chrono::duration<double, std::milli>(config.capture.lateAfterMs))),
       health_(cameras_.size()),

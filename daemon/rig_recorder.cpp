@@ -18,6 +18,7 @@ RigRecorder::RigRecorder(RecordingSettings settings, std::vector<RigCamera> rig,
     encoders_.push_back(std::make_unique<render::VideoEncoder>(std::move(video)));
     // The replayed rig: the same calibration, its source this file.
     camera.device.reset();
+    camera.libcamera.reset();
     camera.source = capture::FileSourceSettings{};
     camera.source->path = settings_.folder / (camera.calibration.name + ".mp4");
   }

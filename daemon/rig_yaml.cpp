@@ -98,6 +98,16 @@ capture::V4l2Settings readDevice(YamlObject& source) {
   return settings;
 }
 
+capture::LibcameraSettings readLibcamera(YamlObject& source) {
+  capture::LibcameraSettings settings;
+  settings.camera = source.string("libcamera", "");
+  settings.fps = source.number("fps", settings.fps, {1.0, 1000.0, false, "frames per second"});
+  settings.buffers = source.integer("buffers", settings.buffers, 2, 32);
+  settings.timeout = std::chrono::milliseconds(source.integer("timeout_ms", 500, 20, 60'000));
+  source.finish();
+  return settings;
+}
+
 processing::Intrinsics readLens(YamlObject& lens) {
   processing::Intrinsics in;
   in.model = lens.choice("model", LensModel::kPinhole,
@@ -201,6 +211,9 @@ std::vector<RigCamera> readRigCameras(YamlObject& rig) {
       if (source->has("device")) {
         camera.device = readDevice(*source);
         camera.device->size = calibration.intrinsics.imageSize;
+      } else if (source->has("libcamera")) {
+        camera.libcamera = readLibcamera(*source);
+        camera.libcamera->size = calibration.intrinsics.imageSize;
       } else {
         camera.source = readSource(*source);
       }
@@ -236,6 +249,15 @@ void emitCamera(YAML::Emitter& out, const RigCamera& camera, const std::filesyst
     out << YAML::Key << "source" << YAML::Value << YAML::Flow << YAML::BeginMap;
     out << YAML::Key << "file" << YAML::Value << (inside ? path.filename() : path).string();
     if (camera.source->loop) out << YAML::Key << "loop" << YAML::Value << true;
+    out << YAML::EndMap;
+  }
+  if (camera.libcamera) {
+    const auto& l = *camera.libcamera;
+    out << YAML::Key << "source" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "libcamera" << YAML::Value << l.camera;
+    out << YAML::Key << "fps" << YAML::Value << l.fps;
+    out << YAML::Key << "buffers" << YAML::Value << l.buffers;
+    out << YAML::Key << "timeout_ms" << YAML::Value << l.timeout.count();
     out << YAML::EndMap;
   }
   if (camera.device) {

@@ -6,6 +6,7 @@
 //       role: source                       # source | target (colour correction)
 //       source: {file: front.mkv}          # relative to the file that names it, or a live camera:
 //       source: {device: /dev/v4l/by-path/...-video-index0, format: yuyv, fps: 30}
+//       source: {libcamera: "/base/soc/i2c0mux/i2c@1/imx219@10"}  # an id, or part of one
 //       lens: {model: pinhole, width_px: 1280, height_px: 720, fx_px: .., fy_px: .., cx_px: ..,
 //              cy_px: .., distortion: [k1, k2, p1, p2, k3]}
 //       mount: {x_m: .., y_m: .., z_m: .., yaw_deg: .., pitch_deg: .., roll_deg: ..}
@@ -20,6 +21,7 @@
 #include <vector>
 
 #include "capture/file_source.hpp"
+#include "capture/libcamera_source.hpp"
 #include "capture/v4l2_source.hpp"
 #include "daemon/yaml_reader.hpp"
 #include "processing/rig.hpp"
@@ -32,6 +34,8 @@ struct RigCamera {
   // (generator input).
   std::optional<capture::FileSourceSettings> source;
   std::optional<capture::V4l2Settings> device;
+  std::optional<capture::LibcameraSettings> libcamera;
+  bool live() const { return device.has_value() || libcamera.has_value(); }
 };
 
 // Reads and validates the `cameras` list of `rig`; errors go to the object's Diagnostics.

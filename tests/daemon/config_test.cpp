@@ -177,11 +177,22 @@ TEST_F(ConfigTest, ALiveCameraWithAnUnknownFormatOrControlOrMixedWithFilesIsRefu
   }
 }
 
+TEST_F(ConfigTest, ALibcameraCameraIsNamedByItsId) {
+  const Config config = loadConfig(liveConfigWith("source: {libcamera: imx219@10, fps: 25}"));
+  const auto& left = config.cameras[1];
+  ASSERT_TRUE(left.libcamera.has_value());
+  EXPECT_EQ(left.libcamera->camera, "imx219@10");
+  EXPECT_EQ(left.libcamera->size, cv::Size(640, 360));
+  EXPECT_DOUBLE_EQ(left.libcamera->fps, 25.0);
+  writeRigFile(dir_ / "rig.yaml", config.cameras, "test");
+  EXPECT_EQ(*loadRigFile(dir_ / "rig.yaml")[1].libcamera, *left.libcamera);
+}
+
 TEST_F(ConfigTest, ARecordingIsAFolder) {
-  const Config config = loadConfig(configWith(
-      "  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
-      "  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}\n"
-      "  - {type: recording, path: out/drive, lossless: false, crf: 20}"));
+  const Config config =
+      loadConfig(configWith("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                            "  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}\n"
+                            "  - {type: recording, path: out/drive, lossless: false, crf: 20}"));
   ASSERT_EQ(config.outputs.size(), 3u);
   EXPECT_EQ(config.outputs[2].kind, OutputKind::kRecording);
   EXPECT_EQ(config.outputs[2].path, dir_ / "out/drive");

@@ -1,0 +1,28 @@
+// Built instead of libcamera_source.cpp where configure found no libcamera.
+#include <fmt/format.h>
+
+#include "capture/libcamera_source.hpp"
+
+namespace surroundd::capture {
+
+bool libcameraAvailable() { return false; }
+
+struct LibcameraSource::Impl {};
+
+LibcameraSource::LibcameraSource(std::string cameraName, LibcameraSettings /*settings*/) {
+  throw CaptureError(fmt::format(
+      "camera '{}': this surroundd was built without libcamera (install libcamera-dev and "
+      "rebuild)",
+      cameraName));
+}
+
+LibcameraSource::~LibcameraSource() = default;
+cv::Size LibcameraSource::frameSize() const { return {}; }
+Timestamp LibcameraSource::nominalPeriod() const { return {}; }
+ReadStatus LibcameraSource::read(Frame& /*out*/) { return ReadStatus::kEndOfStream; }
+const std::string& LibcameraSource::lastError() const {
+  static const std::string kNone;
+  return kNone;
+}
+
+}  // namespace surroundd::capture

@@ -1,0 +1,53 @@
+#include "capture/pixel_conversion.hpp"
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+namespace surroundd::capture {
+
+const char* toString(PixelLayout layout) {
+  switch (layout) {
+    case PixelLayout::kYuyv:
+      return "YUYV";
+    case PixelLayout::kUyvy:
+      return "UYVY";
+    case PixelLayout::kNv12:
+      return "NV12";
+    case PixelLayout::kBgr:
+      return "BGR";
+    case PixelLayout::kMjpeg:
+      return "MJPEG";
+  }
+  return "?";
+}
+
+bool convertToBgr(PixelLayout layout, std::span<const std::uint8_t> data, std::size_t bytesPerLine,
+                  JpegDecoder& jpeg, cv::Mat& bgr, std::string& error) {
+  if (layout == PixelLayout::kMjpeg) return jpeg.decode(data, bgr, error);
+  const int rows = layout == PixelLayout::kNv12 ? bgr.rows * 3 / 2 : bgr.rows;
+  if (data.size() < bytesPerLine * static_cast<std::size_t>(rows)) {
+    error = fmt::format("a {} frame of {} bytes is too short for {}x{}", toString(layout),
+                        data.size(), bgr.cols, bgr.rows);
+    return false;
+  }
+  auto* pixels = const_cast<std::uint8_t*>(data.data());  // cv::Mat has no read-only header
+  switch (layout) {
+    case PixelLayout::kYuyv:
+    case PixelLayout::kUyvy:
+      cv::cvtColor(cv::Mat(bgr.rows, bgr.cols, CV_8UC2, pixels, bytesPerLine), bgr,
+                   layout == PixelLayout::kYuyv ? cv::COLOR_YUV2BGR_YUYV : cv::COLOR_YUV2BGR_UYVY);
+      return true;
+    case PixelLayout::kNv12:
+      cv::cvtColor(cv::Mat(rows, bgr.cols, CV_8UC1, pixels, bytesPerLine), bgr,
+                   cv::COLOR_YUV2BGR_NV12);
+      return true;
+    case PixelLayout::kBgr:
+      cv::Mat(bgr.rows, bgr.cols, CV_8UC3, pixels, bytesPerLine).copyTo(bgr);
+      return true;
+    case PixelLayout::kMjpeg:
+      break;
+  }
+  return false;
+}
+
+}  // namespace surroundd::capture

@@ -1,0 +1,25 @@
+#pragma once
+// Camera pixel formats to the pipeline's 8-bit BGR, once per frame, into the frame's own image:
+// packed 4:2:2 (YUYV, UYVY), NV12, 24-bit BGR, and MJPEG through libjpeg-turbo. Shared by the
+// live sources (V4L2, libcamera).
+
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "capture/jpeg_decoder.hpp"
+
+namespace surroundd::capture {
+
+enum class PixelLayout { kYuyv, kUyvy, kNv12, kBgr, kMjpeg };
+const char* toString(PixelLayout layout);
+
+// `bytesPerLine` is the stride of the (first) plane. False, with `error` set, for a frame too
+// short for its size or an MJPEG frame that does not decode; `bgr` (of the frame's size) is then
+// not a valid picture.
+bool convertToBgr(PixelLayout layout, std::span<const std::uint8_t> data, std::size_t bytesPerLine,
+                  JpegDecoder& jpeg, cv::Mat& bgr, std::string& error);
+
+}  // namespace surroundd::capture
