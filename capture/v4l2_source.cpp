@@ -7,8 +7,10 @@
 #include <span>
 #include <thread>
 
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <linux/videodev2.h>
+#include <unistd.h>
 
 namespace surroundd::capture {
 namespace {
@@ -243,6 +245,11 @@ void V4l2Source::start() {
     void* address = device_->map(buffer.length, buffer.m.offset);
     if (address == nullptr) throw CaptureError(fmt::format("{}: cannot map buffer {}", where(), i));
     buffers_.push_back({address, buffer.length});
+    v4l2_exportbuffer exported{};
+    exported.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    exported.index = i;
+    exported.flags = O_CLOEXEC | O_RDONLY;
+    if (device_->ioctl(VIDIOC_EXPBUF, &exported) == 0) dmabufs_.push_back(exported.fd);
     if (const int error = device_->ioctl(VIDIOC_QBUF, &buffer); error != 0) {
       throw CaptureError(fmt::format("{}: queueing buffer {}: {}", where(), i, errorText(error)));
     }
@@ -260,6 +267,8 @@ void V4l2Source::stop() {
     device_->ioctl(VIDIOC_STREAMOFF, &type);
     streaming_ = false;
   }
+  for (const int fd : dmabufs_) ::close(fd);
+  dmabufs_.clear();
   for (const auto& buffer : buffers_) device_->unmap(buffer.address, buffer.length);
   if (!buffers_.empty()) {
     v4l2_requestbuffers release{};

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,9 @@ class V4l2Source final : public FrameSource {
 
   V4l2Format format() const { return format_; }  // as negotiated
   std::uint64_t reopened() const { return reopened_; }
+  // The driver buffers as DMABUF file descriptors, where the driver exports them (VIDIOC_EXPBUF),
+  // for importing frames into a GPU without a copy; empty where it does not.
+  std::span<const int> dmabufs() const { return dmabufs_; }
 
  private:
   struct MappedBuffer {
@@ -85,6 +89,7 @@ class V4l2Source final : public FrameSource {
   std::uint32_t bytesPerLine_ = 0;
   Timestamp period_{0};
   std::vector<MappedBuffer> buffers_;
+  std::vector<int> dmabufs_;
   bool streaming_ = false;
   std::chrono::milliseconds backoff_{0};
   std::chrono::steady_clock::time_point nextAttempt_{};

@@ -15,6 +15,7 @@
 #include <memory>
 #include <vector>
 
+#include <fcntl.h>
 #include <linux/videodev2.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -74,8 +75,9 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
     std::vector<v4l2_queryctrl> controls;
     std::vector<v4l2_control> controlsSet;
     bool plugged = true;
-    int stalledPolls = 0;      // the next polls time out
-    bool corruptNext = false;  // the next MJPEG frame is cut short
+    int stalledPolls = 0;        // the next polls time out
+    bool corruptNext = false;    // the next MJPEG frame is cut short
+    bool exportsDmabuf = false;  // VIDIOC_EXPBUF answers (with /dev/null descriptors)
     int opens = 0;
     std::uint64_t produced = 0;
     std::int64_t firstTimestampUs = 1'000'000;
@@ -196,6 +198,11 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
         if (buffer->index >= buffers_.size()) return EINVAL;
         buffer->length = static_cast<std::uint32_t>(buffers_[buffer->index].size());
         buffer->m.offset = buffer->index << 16;
+        return 0;
+      }
+      case VIDIOC_EXPBUF: {
+        if (!state_->exportsDmabuf) return ENOTTY;
+        static_cast<v4l2_exportbuffer*>(argument)->fd = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
         return 0;
       }
       case VIDIOC_QBUF:

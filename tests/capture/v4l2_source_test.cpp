@@ -170,6 +170,15 @@ TEST(V4l2Source, ACorruptMjpegFrameIsAFaultAndTheStreamGoesOn) {
   EXPECT_EQ(state->opens, 1);  // not reopened
 }
 
+TEST(V4l2Source, ExportsItsBuffersAsDmabufWhereTheDriverCan) {
+  const auto state = deviceOffering({{V4L2_PIX_FMT_YUYV, kSize}});
+  EXPECT_TRUE(sourceOn(state).dmabufs().empty());
+  state->exportsDmabuf = true;
+  V4l2Source source = sourceOn(state);
+  ASSERT_EQ(source.dmabufs().size(), 4u);
+  for (const int fd : source.dmabufs()) EXPECT_GE(fd, 0);
+}
+
 TEST(V4l2Source, TheKernelPathSaysWhatIsWrongWithTheNode) {
   V4l2Settings missing = settingsFor();
   missing.device = "/dev/v4l/by-id/no-such-camera";
