@@ -215,10 +215,19 @@ RunSummary Pipeline::run(const std::atomic<bool>& stop) {
     }
     if (const auto now = std::chrono::steady_clock::now(); now >= nextProgress) {
       nextProgress += kProgressInterval;
-      spdlog::info("{} frame sets, {:.1f} fps, {} frames dropped by sync", summary.frameSets,
-                   static_cast<double>(summary.frameSets) /
-                       std::chrono::duration<double>(now - start).count(),
-                   synchronizer_.stats().totalDropped());
+      std::string cameras;  // once per interval: the status line's camera health
+      for (std::size_t c = 0; c < cameras_.size(); ++c) {
+        cameras += fmt::format("{}{} {}", c == 0 ? "" : ", ", cameras_[c]->name(),
+                               capture::toString(health_.health(c)));
+      }
+      spdlog::info(
+          "{} frame sets, {:.1f} fps, {} frames dropped by sync, mean skew {:.1f} ms; {}",
+          summary.frameSets,
+          static_cast<double>(summary.frameSets) /
+              std::chrono::duration<double>(now - start).count(),
+          synchronizer_.stats().totalDropped(),
+          std::chrono::duration<double, std::milli>(synchronizer_.stats().meanSpread()).count(),
+          cameras);
     }
   }
   if (stop) spdlog::info("stop requested: finalizing outputs");
