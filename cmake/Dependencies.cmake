@@ -7,6 +7,7 @@ find_package(spdlog REQUIRED)
 find_package(fmt REQUIRED)
 find_package(ZLIB REQUIRED)
 pkg_check_modules(FFMPEG REQUIRED IMPORTED_TARGET libavformat libavcodec libavutil libswscale)
+pkg_check_modules(SYSTEMD REQUIRED IMPORTED_TARGET libsystemd)  # sd_notify: readiness, watchdog
 
 # SuiteSparse CHOLMOD (libsuitesparse-dev). SuiteSparse 7 installs a CMake config with this
 # target; Debian 12's 5.12 has neither that nor a pkg-config file, so look for it directly.

@@ -126,7 +126,8 @@ int main(int argc, char** argv) {
 
   try {
     daemon::Pipeline pipeline(config);
-    const auto summary = pipeline.run(stopRequested);
+    auto service = daemon::ServiceNotifier::fromEnvironment();
+    const auto summary = pipeline.run(stopRequested, &service);
     logSummary(summary);
     return summary.failedOutputs == 0 ? 0 : 1;
   } catch (const std::exception& e) {

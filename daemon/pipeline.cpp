@@ -192,7 +192,22 @@ void Pipeline::setView(ViewKind view) {
   }
 }
 
-RunSummary Pipeline::run(const std::atomic<bool>& stop) {
+std::string Pipeline::statusLine(std::uint64_t frameSets,
+                                 std::chrono::duration<double> elapsed) const {
+  std::string cameras;
+  for (std::size_t c = 0; c < cameras_.size(); ++c) {
+    cameras += fmt::format("{}{} {}", c == 0 ? "" : ", ", cameras_[c]->name(),
+                           capture::toString(health_.health(c)));
+  }
+  return fmt::format(
+      "{:.1f} fps, {} frames dropped by sync, mean skew {:.1f} ms; {}",
+      elapsed.count() > 0 ? static_cast<double>(frameSets) / elapsed.count() : 0.0,
+      synchronizer_.stats().totalDropped(),
+      std::chrono::duration<double, std::milli>(synchronizer_.stats().meanSpread()).count(),
+      cameras);
+}
+
+RunSummary Pipeline::run(const std::atomic<bool>& stop, ServiceNotifier* service) {
   RunSummary summary;
   for (auto& camera : cameras_) camera->start();
   const auto start = std::chrono::steady_clock::now();
@@ -213,23 +228,18 @@ RunSummary Pipeline::run(const std::atomic<bool>& stop) {
         ++summary.frameSets;
       }
     }
-    if (const auto now = std::chrono::steady_clock::now(); now >= nextProgress) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= nextProgress) {
       nextProgress += kProgressInterval;
-      std::string cameras;  // once per interval: the status line's camera health
-      for (std::size_t c = 0; c < cameras_.size(); ++c) {
-        cameras += fmt::format("{}{} {}", c == 0 ? "" : ", ", cameras_[c]->name(),
-                               capture::toString(health_.health(c)));
-      }
-      spdlog::info(
-          "{} frame sets, {:.1f} fps, {} frames dropped by sync, mean skew {:.1f} ms; {}",
-          summary.frameSets,
-          static_cast<double>(summary.frameSets) /
-              std::chrono::duration<double>(now - start).count(),
-          synchronizer_.stats().totalDropped(),
-          std::chrono::duration<double, std::milli>(synchronizer_.stats().meanSpread()).count(),
-          cameras);
+      spdlog::info("{} frame sets, {}", summary.frameSets,
+                   statusLine(summary.frameSets, now - start));
+    }
+    if (service != nullptr) {
+      service->tick(now, summary.frameSets);
+      if (service->statusDue(now)) service->status(now, statusLine(summary.frameSets, now - start));
     }
   }
+  if (service != nullptr) service->stopping();
   if (stop) spdlog::info("stop requested: finalizing outputs");
   finish(summary);
   summary.wallTime = std::chrono::steady_clock::now() - start;

@@ -27,6 +27,7 @@
 #include "common/work_pool.hpp"
 #include "daemon/config.hpp"
 #include "daemon/rig_recorder.hpp"
+#include "daemon/service_notifier.hpp"
 #include "processing/gain_compensation.hpp"
 #include "processing/panorama_ownership.hpp"
 #include "processing/poisson_correction.hpp"
@@ -68,7 +69,8 @@ class Pipeline {
   Pipeline& operator=(const Pipeline&) = delete;
 
   // Runs until every camera has ended or `stop` becomes true, then finalizes every output.
-  RunSummary run(const std::atomic<bool>& stop);
+  // `service`, when given, hears of readiness, progress (watchdog) and status.
+  RunSummary run(const std::atomic<bool>& stop, ServiceNotifier* service = nullptr);
 
   // Switches every surround output to `view` (takes effect with the next frame set).
   void setView(ViewKind view);
@@ -82,6 +84,8 @@ class Pipeline {
   };
 
   void fillNeeds(const std::atomic<bool>& stop);
+  // "20.9 fps, 0 frames dropped by sync, mean skew 1.7 ms; front ok, right black, ..."
+  std::string statusLine(std::uint64_t frameSets, std::chrono::duration<double> elapsed) const;
   void process(const capture::FrameSet& set);
   void followHealth(const capture::FrameSet& set);
   void renderSurround(const capture::FrameSet& set, std::chrono::nanoseconds streamTime);

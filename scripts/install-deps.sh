@@ -9,7 +9,7 @@ PACKAGES="
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   libsuitesparse-dev
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
-  libturbojpeg0-dev libcamera-dev
+  libturbojpeg0-dev libcamera-dev libsystemd-dev
   libgtest-dev libgmock-dev
 "
 

@@ -17,7 +17,9 @@ namespace surroundd::testing {
 
 class ChildProcess {
  public:
-  ChildProcess(std::vector<std::string> arguments, std::filesystem::path stderrFile)
+  // `environment`: NAME=VALUE entries added to the child's environment.
+  ChildProcess(std::vector<std::string> arguments, std::filesystem::path stderrFile,
+               std::vector<std::string> environment = {})
       : stderrFile_(std::move(stderrFile)) {
     std::vector<char*> argv;
     for (auto& argument : arguments) argv.push_back(argument.data());
@@ -27,6 +29,7 @@ class ChildProcess {
       const int fd = ::open(stderrFile_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       ::dup2(fd, STDERR_FILENO);
       ::dup2(fd, STDOUT_FILENO);
+      for (auto& entry : environment) ::putenv(entry.data());
       ::execv(argv[0], argv.data());
       ::_exit(127);
     }

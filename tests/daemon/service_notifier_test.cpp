@@ -1,0 +1,153 @@
+// What surroundd tells systemd: ready after the first frame set, status lines, and watchdog pings
+// only while frame sets keep coming. Unit-tested on the notifier, and end to end: surroundd run
+// with NOTIFY_SOCKET on a socket of the test's own; and the unit file's hardening.
+
+#include "daemon/service_notifier.hpp"
+
+#include <regex>
+
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include "tests/support/child_process.hpp"
+#include "tests/support/temp_dir.hpp"
+
+namespace surroundd::daemon {
+namespace {
+
+using ::testing::HasSubstr;
+using Clock = ServiceNotifier::Clock;
+using std::chrono::milliseconds;
+
+class ServiceNotifierTest : public ::testing::Test {
+ protected:
+  ServiceNotifier notifier_{std::chrono::microseconds(1'000'000),
+                            [this](std::string_view message) { sent_.emplace_back(message); }};
+  std::vector<std::string> sent_;
+  Clock::time_point t0_ = Clock::now();
+};
+
+TEST_F(ServiceNotifierTest, ReadyOnlyOnceTheFirstFrameSetIsThrough) {
+  notifier_.tick(t0_, 0);
+  EXPECT_TRUE(sent_.empty());
+  notifier_.tick(t0_ + milliseconds(10), 1);
+  ASSERT_GE(sent_.size(), 1u);
+  EXPECT_EQ(sent_[0], "READY=1");
+  EXPECT_TRUE(notifier_.statusDue(t0_ + milliseconds(10)));
+  notifier_.status(t0_ + milliseconds(10), "30.0 fps; front ok");
+  EXPECT_EQ(sent_.back(), "STATUS=30.0 fps; front ok");
+  EXPECT_FALSE(notifier_.statusDue(t0_ + milliseconds(20)));
+  EXPECT_TRUE(notifier_.statusDue(t0_ + milliseconds(10) + ServiceNotifier::kStatusInterval));
+}
+
+TEST_F(ServiceNotifierTest, PingsTheWatchdogOnlyWhileFrameSetsKeepComing) {
+  std::uint64_t sets = 0;
+  int pings = 0;
+  const auto pingsIn = [&](int fromMs, int toMs, bool progressing) {
+    pings = 0;
+    for (int ms = fromMs; ms < toMs; ms += 33) {
+      if (progressing) ++sets;
+      const std::size_t before = sent_.size();
+      notifier_.tick(t0_ + milliseconds(ms), sets);
+      for (std::size_t i = before; i < sent_.size(); ++i) pings += sent_[i] == "WATCHDOG=1" ? 1 : 0;
+    }
+    return pings;
+  };
+  EXPECT_EQ(pingsIn(0, 2000, true), 4);  // every half of the 1 s watchdog
+  // Stalled: the sets since the last ping earn one more; then none, and systemd restarts it.
+  EXPECT_LE(pingsIn(2000, 2600, false), 1);
+  EXPECT_EQ(pingsIn(2600, 5000, false), 0);
+  EXPECT_EQ(pingsIn(5000, 6000, true), 2);  // going again
+}
+
+// A datagram socket standing in for systemd's notification socket.
+class NotifySocket {
+ public:
+  explicit NotifySocket(std::filesystem::path path) : path_(std::move(path)) {
+    fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    sockaddr_un address{};
+    address.sun_family = AF_UNIX;
+    std::snprintf(address.sun_path, sizeof(address.sun_path), "%s", path_.c_str());
+    ::bind(fd_, reinterpret_cast<sockaddr*>(&address), sizeof(address));
+    timeval timeout{0, 100'000};
+    ::setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof(timeout));
+  }
+  ~NotifySocket() { ::close(fd_); }
+  NotifySocket(const NotifySocket&) = delete;
+  NotifySocket& operator=(const NotifySocket&) = delete;
+
+  // Every message received until STOPPING=1, or until nothing comes for 5 s.
+  std::vector<std::string> messages() {
+    std::vector<std::string> all;
+    std::array<char, 4096> buffer{};
+    for (int idle = 0; idle < 50;) {
+      const auto n = ::recv(fd_, buffer.data(), buffer.size(), 0);
+      if (n <= 0) {
+        ++idle;
+        continue;
+      }
+      idle = 0;
+      all.emplace_back(buffer.data(), static_cast<std::size_t>(n));
+      if (all.back().find("STOPPING=1") != std::string::npos) break;  // the last one
+    }
+    return all;
+  }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+  int fd_ = -1;
+};
+
+TEST(ServiceNotifications, SurroundedTellsSystemdItIsReadyAliveAndStopping) {
+  const testing::TempDir dir;
+  NotifySocket socket(dir / "notify");
+  const auto recording = std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
+  const auto config = dir.write("config.yaml", fmt::format(R"(rig: {{file: {}}}
+capture: {{pacing: realtime}}
+outputs:
+  - {{type: video, stream: mosaic, path: out/mosaic.mp4}}
+)",
+                                                           (recording / "rig.yaml").string()));
+  testing::ChildProcess surroundd(
+      {SURROUNDD_EXECUTABLE, "--config", config.string()}, dir / "log.txt",
+      {"NOTIFY_SOCKET=" + socket.path().string(), "WATCHDOG_USEC=200000"});
+  const auto messages = socket.messages();
+  EXPECT_EQ(surroundd.wait(), 0) << surroundd.output();
+  ASSERT_FALSE(messages.empty()) << surroundd.output();
+  EXPECT_EQ(messages.front(), "READY=1");
+  const auto count = [&](const std::string& text) {
+    return std::ranges::count_if(messages, [&](const auto& m) { return m.starts_with(text); });
+  };
+  EXPECT_GE(count("STATUS="), 1);
+  const auto status =
+      std::ranges::find_if(messages, [](const auto& m) { return m.starts_with("STATUS="); });
+  ASSERT_NE(status, messages.end());
+  EXPECT_THAT(*status, HasSubstr("fps"));
+  EXPECT_THAT(*status, HasSubstr("front ok, right ok, back ok, left ok"));
+  // A 1 s recording at its own pace, pinged every 100 ms.
+  EXPECT_GE(count("WATCHDOG=1"), 5);
+  EXPECT_THAT(messages.back(), HasSubstr("STOPPING=1"));
+}
+
+TEST(ServiceUnit, IsHardenedToAnExposureOfAtMost2Point5) {
+  const testing::TempDir dir;
+  const auto unit = std::filesystem::path(SURROUNDD_SOURCE_DIR) / "systemd/surroundd.service";
+  if (::access("/usr/bin/systemd-analyze", X_OK) != 0) GTEST_SKIP() << "no systemd-analyze";
+  testing::ChildProcess analyze(
+      {"/usr/bin/systemd-analyze", "security", "--offline=yes", unit.string()}, dir / "out.txt");
+  analyze.wait();
+  std::smatch match;
+  const std::string output = analyze.output();
+  const std::regex overall("Overall exposure level for surroundd.service: ([0-9.]+)");
+  ASSERT_TRUE(std::regex_search(output, match, overall)) << output;
+  RecordProperty("exposure", match[1].str());
+  EXPECT_LE(std::stod(match[1].str()), 2.5);
+}
+
+}  // namespace
+}  // namespace surroundd::daemon
