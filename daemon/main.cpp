@@ -22,9 +22,11 @@ namespace {
 using namespace surroundd;
 
 constexpr std::string_view kUsage =
-    R"(usage: surroundd --config FILE [--log-level LEVEL] [--pacing MODE]
+    R"(usage: surroundd --config FILE [--log-level LEVEL] [--pacing MODE] [--check-config]
 
   --config FILE       the YAML config (see config/surroundd.reference.yaml)
+  --check-config      check the config, say what is wrong (exit 2) or that it is good (exit 0),
+                      and open nothing
   --log-level LEVEL   trace, debug, info, warning, error or off; overrides logging.level
   --pacing MODE       realtime or as_fast_as_possible; overrides capture.pacing
   --help              this text
@@ -48,6 +50,7 @@ struct Arguments {
   std::string configFile;
   std::optional<spdlog::level::level_enum> logLevel;
   std::optional<capture::Pacing> pacing;
+  bool checkOnly = false;
 };
 
 // nullopt after printing what was wrong (or the help text, with `help` set).
@@ -63,6 +66,10 @@ std::optional<Arguments> parseArguments(int argc, char** argv, bool& help) {
       help = true;
       fmt::print("{}", kUsage);
       return std::nullopt;
+    }
+    if (flag == "--check-config") {
+      arguments.checkOnly = true;
+      continue;
     }
     if (i + 1 >= argc) return fail(fmt::format("'{}' needs a value", flag));
     const std::string_view value = argv[++i];
@@ -119,6 +126,11 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "surroundd: {} error(s) in the config; nothing was started\n",
                e.messages().size());
     return 2;
+  }
+  if (arguments->checkOnly) {
+    fmt::print("surroundd: {}: good ({} cameras, {} outputs)\n", arguments->configFile,
+               config.cameras.size(), config.outputs.size());
+    return 0;
   }
   if (arguments->pacing) config.capture.pacing = *arguments->pacing;
   daemon::setUpLogging(arguments->logLevel.value_or(config.logLevel));
