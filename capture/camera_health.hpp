@@ -50,7 +50,6 @@ class CameraHealthMonitor {
   const std::vector<HealthChange>& observe(const FrameSet& set, const SyncStats& sync);
 
   CameraHealth health(std::size_t camera) const { return cameras_[camera].health; }
-  std::size_t cameraCount() const { return cameras_.size(); }
 
  private:
   static constexpr int kSamplesAcross = 32;

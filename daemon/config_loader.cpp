@@ -207,6 +207,9 @@ OutputConfig readOutput(YamlObject& item) {
                  fmt::format("expected a file ending in .mp4 or .mkv, got '{}'", o.path.string()));
     }
   } else if (o.kind == OutputKind::kRecording) {
+    if (item.has("stream")) {
+      item.error("stream", "a recording writes every camera's own stream; it takes no 'stream'");
+    }
     o.lossless = item.boolean("lossless", o.lossless);
     o.crf = item.integer("crf", o.crf, 0, 51);
     std::error_code ec;

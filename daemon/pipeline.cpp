@@ -104,10 +104,10 @@ Pipeline::Pipeline(const Config& config)
       pool_(config.pipeline.threads),
       mosaic_(cv::Size(config.render.widthPx, config.render.heightPx), cameraNames(config)),
       canvas_(mosaic_.outputSize(), CV_8UC3, cv::Scalar::all(0)) {
-  const auto shows = [&](OutputStream stream) {
+  const auto configured = [&](OutputStream stream) {
     return std::ranges::any_of(config.outputs, [&](const auto& o) { return o.stream == stream; });
   };
-  if (shows(OutputStream::kPanorama) || shows(OutputStream::kSurround)) {
+  if (configured(OutputStream::kPanorama) || configured(OutputStream::kSurround)) {
     lut_ = std::make_unique<processing::PanoramaLut>(obtainPanoramaLut(config, pool_));
     stitcher_ = std::make_unique<processing::Stitcher>(*lut_, pool_);
     ownership_ = std::make_unique<processing::PanoramaOwnership>(*lut_);
@@ -119,7 +119,7 @@ Pipeline::Pipeline(const Config& config)
     stitchInputs_.resize(cameras_.size());
     setUpColourCorrection(config);
   }
-  if (shows(OutputStream::kSurround)) setUpSurround(config);
+  if (configured(OutputStream::kSurround)) setUpSurround(config);
   const double nominalFps = 1e9 / static_cast<double>(cameras_.front()->nominalPeriod().count());
   for (const auto& output : config.outputs) {
     if (output.kind == OutputKind::kRecording) {
@@ -281,10 +281,9 @@ void Pipeline::fillNeeds(const std::atomic<bool>& stop) {
   }
 }
 
-bool Pipeline::wanted(OutputStream stream, std::chrono::nanoseconds streamTime) const {
-  return std::ranges::any_of(outputs_, [&](const Output& o) {
-    return o.stream == stream && o.sink && o.sink->wantsFrame(streamTime);
-  });
+bool Pipeline::shows(OutputStream stream) const {
+  return std::ranges::any_of(outputs_,
+                             [&](const Output& o) { return o.stream == stream && o.sink; });
 }
 
 void Pipeline::process(const capture::FrameSet& set) {
@@ -306,7 +305,9 @@ void Pipeline::process(const capture::FrameSet& set) {
   for (std::size_t c = 0; c < set.cameraCount; ++c) {
     images[c] = set.frame(c) != nullptr ? &set.frame(c)->image : nullptr;
   }
-  if (wanted(OutputStream::kMosaic, lastStreamTime_)) {
+  // Every set's mosaic, even when no sink wants this frame: it may be the last one, which a
+  // snapshot asked for after the end is given. (Surround views are rendered again at the end.)
+  if (shows(OutputStream::kMosaic)) {
     mosaic_.compose(std::span(images.data(), set.cameraCount), canvas_,
                     std::span(faults_.data(), set.cameraCount));
     timed(Stage::kMosaic, since);

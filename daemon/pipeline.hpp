@@ -96,7 +96,7 @@ class Pipeline {
   void guarded(Output& output, Step&& step);
   void timed(Stage stage, std::chrono::steady_clock::time_point& since);
   const cv::Mat& imageOf(OutputStream stream) const;
-  bool wanted(OutputStream stream, std::chrono::nanoseconds streamTime) const;
+  bool shows(OutputStream stream) const;  // a working output shows it
   void setUpColourCorrection(const Config& config);
   void setUpSurround(const Config& config);
 

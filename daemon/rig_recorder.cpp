@@ -1,6 +1,7 @@
 #include "daemon/rig_recorder.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 namespace surroundd::daemon {
 
@@ -39,7 +40,12 @@ void RigRecorder::finish() {
   for (std::size_t c = 0; c < encoders_.size(); ++c) {
     if (encoders_[c]->framesWritten() == 0) {
       missing += " " + rig_[c].calibration.name;
-      encoders_[c].reset();  // leaves no file
+      try {
+        encoders_[c]->close();  // refuses to make an empty video: no file is left, as wanted here
+      } catch (const render::EncoderError&) {
+      }
+      spdlog::warn("recording {}: camera '{}' delivered no frames; it is left out of rig.yaml",
+                   settings_.folder.string(), rig_[c].calibration.name);
       continue;
     }
     encoders_[c]->close();
@@ -56,9 +62,7 @@ void RigRecorder::finish() {
 
 std::string RigRecorder::describe() const {
   std::uint64_t frames = 0;
-  for (const auto& encoder : encoders_) {
-    if (encoder) frames += encoder->framesWritten();
-  }
+  for (const auto& encoder : encoders_) frames += encoder->framesWritten();
   return fmt::format("recording {} ({} frames of {} cameras, {})", settings_.folder.string(),
                      frames, encoders_.size(), settings_.lossless ? "lossless" : "H.264");
 }

@@ -32,10 +32,4 @@ void PanoramaOwnership::markFaulty(cv::Mat& panorama, std::size_t camera) const 
   }
 }
 
-std::size_t PanoramaOwnership::pixelsOf(std::size_t camera) const {
-  std::size_t pixels = 0;
-  for (const Run& run : runs_.at(camera)) pixels += run.end - run.begin;
-  return pixels;
-}
-
 }  // namespace surroundd::processing

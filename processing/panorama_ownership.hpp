@@ -20,8 +20,6 @@ class PanoramaOwnership {
   // to be trusted". `panorama` is 8-bit BGR of the LUT's size.
   void markFaulty(cv::Mat& panorama, std::size_t camera) const;
 
-  std::size_t pixelsOf(std::size_t camera) const;
-
  private:
   struct Run {
     std::uint16_t row;

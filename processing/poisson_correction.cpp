@@ -127,7 +127,12 @@ void PoissonColourCorrection::followLostCameras(std::span<const cv::Mat> frames)
   active_ = &configurationFor(present);
   activeCameras_ = present;
   if (!firstTime) return;
-  changes_ = active_->domain.notes;
+  // What the start-up domain already said is not news.
+  for (const auto& note : active_->domain.notes) {
+    if (std::ranges::find(full_->domain.notes, note) == full_->domain.notes.end()) {
+      changes_.push_back(note);
+    }
+  }
   changes_.push_back(fmt::format(
       "colour correction domain rebuilt for the cameras present in {:.0f} ms: {} region(s), "
       "solver {}",

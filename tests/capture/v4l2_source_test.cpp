@@ -4,6 +4,8 @@
 
 #include "capture/v4l2_source.hpp"
 
+#include <functional>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -44,6 +46,17 @@ V4l2Settings settingsFor(cv::Size size = kSize) {
 V4l2Source sourceOn(const std::shared_ptr<FakeV4l2Device::State>& state,
                     V4l2Settings settings = settingsFor()) {
   return V4l2Source("front", std::move(settings), std::make_unique<FakeV4l2Device>(state));
+}
+
+// The message of the CaptureError that opening throws; a test failure if it throws none.
+std::string errorOpening(const std::function<void()>& open) {
+  try {
+    open();
+  } catch (const CaptureError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "opened without an error";
+  return {};
 }
 
 Frame frameOf(cv::Size size) {
@@ -87,14 +100,11 @@ TEST(V4l2Source, ARequestTheDeviceCannotMeetSaysWhatItOffers) {
   const auto state = deviceOffering({{V4L2_PIX_FMT_YUYV, {640, 480}},
                                      {V4L2_PIX_FMT_YUYV, kSize},
                                      {V4L2_PIX_FMT_MJPEG, {1280, 720}}});
-  try {
-    sourceOn(state, settingsFor({1920, 1080}));
-    FAIL() << "1920x1080 was accepted";
-  } catch (const CaptureError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("camera 'front': /dev/v4l/by-path/fake-video-index0: does not "
-                                    "offer auto 1920x1080 (it offers: YUYV 640x480, 320x240; MJPG "
-                                    "1280x720)"));
-  }
+  EXPECT_THAT(errorOpening([&] {
+                sourceOn(state, settingsFor({1920, 1080}));
+              }),
+              HasSubstr("camera 'front': /dev/v4l/by-path/fake-video-index0: does not offer auto "
+                        "1920x1080 (it offers: YUYV 640x480, 320x240; MJPG 1280x720)"));
   V4l2Settings nv12 = settingsFor();
   nv12.format = V4l2Format::kNv12;
   EXPECT_THROW(sourceOn(state, nv12), CaptureError);
@@ -113,12 +123,7 @@ TEST(V4l2Source, ControlsAreSetWithinTheirRangesAndRefusedOtherwise) {
         std::pair{V4l2Control{"exposure_absolute", 10}, "has no control 'exposure_absolute'"},
         std::pair{V4l2Control{"shutter", 1}, "unknown control 'shutter'"}}) {
     settings.controls = {control};
-    try {
-      sourceOn(state, settings);
-      ADD_FAILURE() << message;
-    } catch (const CaptureError& e) {
-      EXPECT_THAT(e.what(), HasSubstr(message));
-    }
+    EXPECT_THAT(errorOpening([&] { sourceOn(state, settings); }), HasSubstr(message));
   }
 }
 
@@ -180,22 +185,14 @@ TEST(V4l2Source, ExportsItsBuffersAsDmabufWhereTheDriverCan) {
 }
 
 TEST(V4l2Source, TheKernelPathSaysWhatIsWrongWithTheNode) {
-  V4l2Settings missing = settingsFor();
-  missing.device = "/dev/v4l/by-id/no-such-camera";
-  try {
-    V4l2Source("left", missing);
-    FAIL();
-  } catch (const CaptureError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("camera 'left': /dev/v4l/by-id/no-such-camera: cannot open: "
-                                    "No such file or directory"));
-  }
-  V4l2Settings notVideo = settingsFor();
-  notVideo.device = "/dev/null";
-  try {
-    V4l2Source("left", notVideo);
-    FAIL();
-  } catch (const CaptureError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("camera 'left': /dev/null: not a V4L2 device"));
+  for (const auto& [device, message] :
+       {std::pair{"/dev/v4l/by-id/no-such-camera",
+                  "camera 'left': /dev/v4l/by-id/no-such-camera: cannot open: No such file or "
+                  "directory"},
+        std::pair{"/dev/null", "camera 'left': /dev/null: not a V4L2 device"}}) {
+    V4l2Settings settings = settingsFor();
+    settings.device = device;
+    EXPECT_THAT(errorOpening([&] { V4l2Source("left", settings); }), HasSubstr(message));
   }
 }
 

@@ -201,6 +201,9 @@ TEST_F(ConfigTest, ARecordingIsAFolder) {
   expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
                  "  - {type: recording, path: front.mkv}",
                  {"outputs[1].path: expected a folder for the recording, got the file"});
+  expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "  - {type: recording, stream: panorama, path: out/drive}",
+                 {"outputs[1].stream: a recording writes every camera's own stream"});
 }
 
 TEST_F(ConfigTest, AViewOnlyBelongsToASurroundOutput) {

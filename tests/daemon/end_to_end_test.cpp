@@ -199,6 +199,35 @@ outputs:
             40.0);
 }
 
+// A mosaic snapshot asked for after the end, with no other mosaic output: the last frame set's
+// mosaic, not an empty canvas.
+TEST(EndToEnd, AMosaicSnapshotAfterTheEndShowsTheLastFrameSet) {
+  const testing::TempDir dir;
+  const auto config = dir.write("config.yaml", fmt::format(R"(rig: {{file: {}}}
+capture: {{pacing: as_fast_as_possible}}
+render: {{width_px: {}, height_px: {}}}
+outputs:
+  - {{type: snapshot, stream: mosaic, path: out/last.png, at_s: 1000}}
+)",
+                                                           (kRecording / "rig.yaml").string(),
+                                                           kOutputSize.width, kOutputSize.height));
+  testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--config", config.string()},
+                                  dir / "log.txt");
+  ASSERT_EQ(surroundd.wait(), 0) << surroundd.output();
+  const auto rig = daemon::loadRigFile(kRecording / "rig.yaml");
+  std::vector<std::string> names;
+  std::vector<cv::Mat> last;
+  for (const auto& camera : rig) {
+    names.push_back(camera.calibration.name);
+    last.push_back(testing::decodeAll(camera.source->path).images.back());
+  }
+  std::vector<const cv::Mat*> frames;
+  for (const auto& image : last) frames.push_back(&image);
+  cv::Mat expected(kOutputSize, CV_8UC3);
+  render::Mosaic(kOutputSize, names).compose(frames, expected);
+  EXPECT_GE(cv::PSNR(expected, cv::imread((dir / "out/last.png").string())), 40.0);
+}
+
 TEST(EndToEnd, SigtermLeavesAPlayableFile) {
   const testing::TempDir dir;
   testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--config", writeConfig(dir).string()},
