@@ -69,6 +69,7 @@ void CameraStream::run() {
 }
 
 void CameraStream::push(FrameRef frame, std::chrono::nanoseconds readTime) {
+  frame->arrival = std::chrono::steady_clock::now();
   {
     const std::lock_guard lock(mutex_);
     // Never full: the queue has a slot for every buffer of the pool.
@@ -94,6 +95,11 @@ CameraStream::Next CameraStream::next(FrameRef& out, std::chrono::milliseconds t
 CameraStreamStats CameraStream::stats() const {
   const std::lock_guard lock(mutex_);
   return stats_;
+}
+
+std::size_t CameraStream::queued() const {
+  const std::lock_guard lock(mutex_);
+  return size_;
 }
 
 }  // namespace surroundd::capture

@@ -53,6 +53,7 @@ class CameraStream {
   cv::Size frameSize() const { return pool_.frameSize(); }
   Timestamp nominalPeriod() const { return nominalPeriod_; }
   CameraStreamStats stats() const;
+  std::size_t queued() const;  // frames waiting to be taken by next()
 
  private:
   void run();

@@ -196,7 +196,11 @@ bool FileSource::Impl::restart() {
   }
   avcodec_flush_buffers(codec.get());
   draining = false;
-  loopOffset += lastTimestamp - firstTimestamp + period;
+  // A whole number of nominal periods: the cameras of a rig loop by the same offset, whatever the
+  // jitter of their last frames' timestamps (which would otherwise pull them apart, pass by pass).
+  const auto periods = std::llround(static_cast<double>((lastTimestamp - firstTimestamp).count()) /
+                                    static_cast<double>(period.count()));
+  loopOffset += (periods + 1) * period;
   lastTimestamp = firstTimestamp - period;
   return true;
 }

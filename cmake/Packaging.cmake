@@ -3,7 +3,7 @@
 # service's state (the LUT cache) lives in systemd's StateDirectory=surroundd, created by systemd.
 include(GNUInstallDirs)
 
-install(TARGETS surroundd surround-synth surround-calibrate surround-bench
+install(TARGETS surroundd surroundctl surround-synth surround-calibrate surround-bench
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(FILES systemd/surroundd.service DESTINATION lib/systemd/system)
 install(FILES config/surroundd.yaml DESTINATION /etc/surroundd)

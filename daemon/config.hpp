@@ -102,23 +102,42 @@ struct RenderConfig {
 // surround view.
 enum class OutputStream { kMosaic, kPanorama, kSurround };
 // A recording is not a picture of the pipeline but the cameras' own streams (RigRecorder).
-enum class OutputKind { kVideo, kSnapshot, kRecording };
+enum class OutputKind { kVideo, kNetwork, kHttp, kWindow, kDisplay, kSnapshot, kRecording };
 
 struct OutputConfig {
   OutputKind kind = OutputKind::kVideo;
   OutputStream stream = OutputStream::kMosaic;
   std::filesystem::path path;    // parent folders are created at start
   std::optional<ViewKind> view;  // surround: the view it starts with; default render.view
-  // video
+  // video and network
   int crf = 23;
   std::string preset = "veryfast";
   std::string pixelFormat = "yuv420p";
+  double segmentS = 0.0;  // video: a new file every this many seconds of stream time; 0 = one file
+  std::string url;        // network: udp://HOST:PORT (MPEG-TS)
+  // http: MJPEG and the live page
+  std::string listenAddress = "127.0.0.1";  // only this machine, unless configured otherwise
+  int listenPort = 8080;
+  int jpegQuality = 80;
+  // window (X11)
+  std::string display;  // empty: $DISPLAY
+  std::string title = "surroundd";
+  // display (DRM/KMS)
+  std::filesystem::path device;  // empty: the first card with a connected connector
+  std::string connector;         // e.g. HDMI-A-1; empty: the first connected one
   // snapshot
   double atSeconds = 1.0;  // stream time of the snapshot; the last frame if the run is shorter
   // recording (a folder): bit for bit, or H.264 4:4:4 at crf / preset
   bool lossless = true;
 
   bool operator==(const OutputConfig&) const = default;
+};
+
+struct ControlConfig {
+  // The control socket (surroundctl); empty: defaultControlSocket(), and none if that is empty.
+  std::filesystem::path socket;
+
+  bool operator==(const ControlConfig&) const = default;
 };
 
 struct Config {
@@ -131,6 +150,7 @@ struct Config {
   ColourCorrectionConfig colour;
   MeshConfig mesh;
   RenderConfig render;
+  ControlConfig control;
   std::vector<OutputConfig> outputs;
 };
 

@@ -1,9 +1,11 @@
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <set>
 #include <span>
 
+#include <arpa/inet.h>
 #include <fmt/format.h>
 
 #include "daemon/config.hpp"
@@ -168,14 +170,42 @@ void readRender(YamlObject& section, RenderConfig& r) {
   section.finish();
 }
 
+// "ADDRESS:PORT" of an IPv4 address; port 0 picks a free one.
+void readListen(YamlObject& item, OutputConfig& o) {
+  const std::string listen =
+      item.string("listen", fmt::format("{}:{}", o.listenAddress, o.listenPort));
+  const auto colon = listen.rfind(':');
+  int port = -1;
+  if (colon != std::string::npos) {
+    const std::string_view digits = std::string_view(listen).substr(colon + 1);
+    const auto [end, failed] = std::from_chars(digits.data(), digits.data() + digits.size(), port);
+    if (failed != std::errc() || end != digits.data() + digits.size()) port = -1;
+  }
+  in_addr address{};
+  if (colon == std::string::npos || port < 0 || port > 65535 ||
+      inet_pton(AF_INET, listen.substr(0, colon).c_str(), &address) != 1) {
+    item.error("listen",
+               fmt::format("expected IPv4-ADDRESS:PORT (e.g. 127.0.0.1:8080), got '{}'", listen));
+    return;
+  }
+  o.listenAddress = listen.substr(0, colon);
+  o.listenPort = port;
+}
+
 OutputConfig readOutput(YamlObject& item) {
   OutputConfig o;
   o.kind = item.choice("type", o.kind,
                        {{"video", OutputKind::kVideo},
+                        {"network", OutputKind::kNetwork},
+                        {"http", OutputKind::kHttp},
+                        {"window", OutputKind::kWindow},
+                        {"display", OutputKind::kDisplay},
                         {"snapshot", OutputKind::kSnapshot},
                         {"recording", OutputKind::kRecording}});
   if (!item.has("type")) {
-    item.errorHere("missing key 'type' (one of 'video' 'snapshot' 'recording')");
+    item.errorHere(
+        "missing key 'type' (one of 'video' 'network' 'http' 'window' 'display' 'snapshot' "
+        "'recording')");
   }
   o.stream = item.choice("stream", o.stream,
                          {{"mosaic", OutputStream::kMosaic},
@@ -189,9 +219,25 @@ OutputConfig readOutput(YamlObject& item) {
       item.error("view", "only a surround output has a view");
     }
   }
-  o.path = item.outputPath("path").value_or("");
+  if (o.kind == OutputKind::kNetwork) {
+    o.url = item.string("url", "");
+    if (!o.url.starts_with("udp://") || o.url.size() <= 6) {
+      item.error("url", fmt::format("expected udp://HOST:PORT, got '{}'", o.url));
+    }
+  } else if (o.kind == OutputKind::kHttp) {
+    readListen(item, o);
+    o.jpegQuality = item.integer("quality", o.jpegQuality, 1, 100);
+  } else if (o.kind == OutputKind::kWindow) {
+    o.display = item.string("display", o.display);
+    o.title = item.string("title", o.title);
+  } else if (o.kind == OutputKind::kDisplay) {
+    o.device = item.string("device", "");
+    o.connector = item.string("connector", o.connector);
+  } else {
+    o.path = item.outputPath("path").value_or("");
+  }
   const auto extension = o.path.extension().string();
-  if (o.kind == OutputKind::kVideo) {
+  if (o.kind == OutputKind::kVideo || o.kind == OutputKind::kNetwork) {
     o.crf = item.integer("crf", o.crf, 0, 51);
     o.preset = item.choice<std::string>("preset", o.preset,
                                         {{"ultrafast", "ultrafast"},
@@ -202,7 +248,10 @@ OutputConfig readOutput(YamlObject& item) {
                                          {"medium", "medium"}});
     o.pixelFormat = item.choice<std::string>("pixel_format", o.pixelFormat,
                                              {{"yuv420p", "yuv420p"}, {"yuv444p", "yuv444p"}});
-    if (!o.path.empty() && extension != ".mp4" && extension != ".mkv") {
+    if (o.kind == OutputKind::kVideo) {
+      o.segmentS = item.number("segment_s", o.segmentS, {0.0, 86400.0, false, "seconds"});
+    }
+    if (o.kind == OutputKind::kVideo && extension != ".mp4" && extension != ".mkv") {
       item.error("path",
                  fmt::format("expected a file ending in .mp4 or .mkv, got '{}'", o.path.string()));
     }
@@ -218,7 +267,7 @@ OutputConfig readOutput(YamlObject& item) {
       item.error("path", fmt::format("expected a folder for the recording, got the file '{}'",
                                      o.path.string()));
     }
-  } else {
+  } else if (o.kind == OutputKind::kSnapshot) {
     o.atSeconds = item.number("at_s", o.atSeconds, {0.0, 1e7, false, "seconds of stream time"});
     if (!o.path.empty() && extension != ".png") {
       item.error("path", fmt::format("expected a file ending in .png, got '{}'", o.path.string()));
@@ -273,6 +322,10 @@ Config loadConfig(const std::filesystem::path& file) {
         })) {
       s.error("split_camera", fmt::format("no camera is named '{}'", split));
     }
+  });
+  readSection("control", [&](YamlObject& s) {
+    config.control.socket = s.outputPath("socket").value_or("");
+    s.finish();
   });
   std::set<std::filesystem::path> paths;
   for (auto& item : root.objectList("outputs", 1, 32)) {

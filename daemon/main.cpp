@@ -1,4 +1,5 @@
-// surroundd: replays (later: captures) four cameras and writes the configured outputs.
+// surroundd: captures or replays the rig's cameras and writes the configured outputs, until
+// SIGTERM/SIGINT (every output finalized) or the end of a replay; SIGHUP reloads the config.
 //
 // Exit codes: 0 done, 1 failed at run time or start-up (a camera or output could not be opened),
 // 2 bad command line or config (nothing was opened).
@@ -15,7 +16,7 @@
 
 #include "daemon/config.hpp"
 #include "daemon/logging.hpp"
-#include "daemon/pipeline.hpp"
+#include "daemon/service.hpp"
 
 namespace {
 
@@ -32,18 +33,25 @@ constexpr std::string_view kUsage =
   --help              this text
 )";
 
-// Set from the signal handler; a lock-free atomic is async-signal-safe.
-std::atomic<bool> stopRequested{false};
+// Set from the signal handlers; lock-free atomics are async-signal-safe.
+daemon::ServiceSignals signals;
 static_assert(std::atomic<bool>::is_always_lock_free);
 
-extern "C" void requestStop(int /*signal*/) { stopRequested = true; }
+extern "C" void requestStop(int /*signal*/) { signals.stop = true; }
+extern "C" void requestReload(int /*signal*/) { signals.reload = true; }
 
 void installSignalHandlers() {
   struct sigaction action {};
-  action.sa_handler = requestStop;
   sigemptyset(&action.sa_mask);
+  action.sa_handler = requestStop;
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
+  action.sa_handler = requestReload;
+  sigaction(SIGHUP, &action, nullptr);
+  // A network or control client that goes away must not kill the daemon: writes to it fail with
+  // EPIPE instead, and that output is dropped.
+  action.sa_handler = SIG_IGN;
+  sigaction(SIGPIPE, &action, nullptr);
 }
 
 struct Arguments {
@@ -94,23 +102,6 @@ std::optional<Arguments> parseArguments(int argc, char** argv, bool& help) {
   return arguments;
 }
 
-void logSummary(const daemon::RunSummary& summary) {
-  spdlog::info(
-      "{} frame sets in {:.2f} s: {:.1f} fps; sync dropped {} frames, max spread {:.2f} ms",
-      summary.frameSets, summary.wallTime.count(), summary.framesPerSecond(),
-      summary.sync.totalDropped(),
-      std::chrono::duration<double, std::milli>(summary.sync.maxSpread).count());
-  for (std::size_t c = 0; c < summary.cameras.size(); ++c) {
-    spdlog::info(
-        "camera '{}': {} frames, {} faults, {} dropped unmatched, {} out of order, {} sets sent "
-        "without it",
-        summary.cameraNames[c], summary.cameras[c].frames, summary.cameras[c].faults,
-        summary.sync.unmatchedDropped[c], summary.sync.outOfOrderDropped[c],
-        summary.sync.lateMissing[c]);
-  }
-  for (const auto& output : summary.outputs) spdlog::info("wrote {}", output);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -137,11 +128,8 @@ int main(int argc, char** argv) {
   installSignalHandlers();
 
   try {
-    daemon::Pipeline pipeline(config);
-    auto service = daemon::ServiceNotifier::fromEnvironment();
-    const auto summary = pipeline.run(stopRequested, &service);
-    logSummary(summary);
-    return summary.failedOutputs == 0 ? 0 : 1;
+    daemon::Service service(std::move(config), signals, daemon::ServiceNotifier::fromEnvironment());
+    return service.run();
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());
     return 1;

@@ -9,6 +9,10 @@
 #include "capture/libcamera_source.hpp"
 #include "capture/v4l2_source.hpp"
 #include "daemon/panorama_setup.hpp"
+#include "render/drm_display_sink.hpp"
+#include "render/http_stream_sink.hpp"
+#include "render/queued_sink.hpp"
+#include "render/x11_window_sink.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -18,6 +22,7 @@ namespace {
 constexpr std::chrono::milliseconds kCameraWait{200};
 constexpr std::chrono::milliseconds kLiveCameraWait{2};
 constexpr std::chrono::seconds kProgressInterval{10};
+constexpr std::chrono::seconds kPageStatusInterval{1};
 
 std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& config) {
   // Each camera's queue, plus one frame waiting in the synchronizer and one being composed.
@@ -66,8 +71,34 @@ std::vector<std::string> cameraNames(const Config& config) {
   return names;
 }
 
+// Pictures that may wait for an encoder: enough to ride out a slow frame, few enough that a live
+// view stays current.
+constexpr std::size_t kEncoderQueue = 3;
+
+std::unique_ptr<render::HttpStreamSink> openHttp(const OutputConfig& output, ViewKind view) {
+  render::HttpStreamSettings settings;
+  settings.address = output.listenAddress;
+  settings.port = output.listenPort;
+  settings.jpegQuality = output.jpegQuality;
+  if (output.stream == OutputStream::kSurround) {
+    for (const ViewKind kind : render::kViewKinds) settings.views.emplace_back(toString(kind));
+    settings.initialView = toString(view);
+  }
+  auto sink = std::make_unique<render::HttpStreamSink>(std::move(settings));
+  spdlog::info("HTTP stream: http://{}:{}/", output.listenAddress, sink->port());
+  return sink;
+}
+
 std::unique_ptr<render::FrameSink> openSink(const OutputConfig& output, cv::Size videoSize,
-                                            double nominalFps) {
+                                            double nominalFps, bool live) {
+  if (output.kind == OutputKind::kWindow) {
+    return std::make_unique<render::X11WindowSink>(
+        render::X11WindowSettings{output.display, output.title, videoSize});
+  }
+  if (output.kind == OutputKind::kDisplay) {
+    return std::make_unique<render::DrmDisplaySink>(
+        render::DrmDisplaySettings{output.device, output.connector});
+  }
   if (output.path.has_parent_path()) std::filesystem::create_directories(output.path.parent_path());
   if (output.kind == OutputKind::kSnapshot) {
     return std::make_unique<render::SnapshotSink>(
@@ -81,16 +112,17 @@ std::unique_ptr<render::FrameSink> openSink(const OutputConfig& output, cv::Size
   settings.crf = output.crf;
   settings.preset = output.preset;
   settings.pixelFormat = output.pixelFormat;
-  return std::make_unique<render::VideoFileSink>(std::move(settings));
+  settings.url = output.url;
+  auto video = std::make_unique<render::VideoSink>(
+      std::move(settings), std::chrono::duration_cast<std::chrono::nanoseconds>(
+                               std::chrono::duration<double>(output.segmentS)));
+  // Encoding runs beside the next frame set's stitching; live, the newest picture wins.
+  return std::make_unique<render::QueuedSink>(
+      std::move(video), videoSize, kEncoderQueue,
+      live ? render::QueuedSink::WhenFull::kDropOldest : render::QueuedSink::WhenFull::kWait);
 }
 
 }  // namespace
-
-const char* toString(Stage stage) {
-  constexpr std::array<const char*, static_cast<std::size_t>(Stage::kCount)> kNames{
-      "sync", "mosaic", "stitch", "correct", "render", "read-back", "output"};
-  return kNames.at(static_cast<std::size_t>(stage));
-}
 
 Pipeline::Pipeline(const Config& config)
     : cameras_(openCameras(config)),
@@ -132,10 +164,16 @@ Pipeline::Pipeline(const Config& config)
         output.stream == OutputStream::kPanorama ? lut_->size : mosaic_.outputSize();
     Output out;
     out.stream = output.stream;
-    out.sink = openSink(output, size, nominalFps);
+    const ViewKind view = output.view.value_or(config.render.view);
+    if (output.kind == OutputKind::kHttp) {
+      auto http = openHttp(output, view);
+      out.http = http.get();
+      out.sink = std::move(http);
+    } else {
+      out.sink = openSink(output, size, nominalFps, live_);
+    }
     if (output.stream == OutputStream::kSurround) {
-      out.view = std::make_unique<render::SurroundView>(
-          *scene_, size, output.view.value_or(config.render.view), config.render.views);
+      out.view = std::make_unique<render::SurroundView>(*scene_, size, view, config.render.views);
     }
     outputs_.push_back(std::move(out));
   }
@@ -192,64 +230,113 @@ void Pipeline::setView(ViewKind view) {
   }
 }
 
-std::string Pipeline::statusLine(std::uint64_t frameSets,
-                                 std::chrono::duration<double> elapsed) const {
-  std::string cameras;
+PipelineReport Pipeline::report() const {
+  PipelineReport report;
+  report.elapsed = Clock::now() - start_;
+  report.frameSets = frameSets_;
+  report.staleDropped = staleDropped_;
+  report.sync = synchronizer_.stats();
   for (std::size_t c = 0; c < cameras_.size(); ++c) {
-    cameras += fmt::format("{}{} {}", c == 0 ? "" : ", ", cameras_[c]->name(),
-                           capture::toString(health_.health(c)));
+    report.cameras.push_back(
+        {cameras_[c]->name(), health_.health(c), cameras_[c]->stats(), cameras_[c]->queued()});
   }
-  return fmt::format(
-      "{:.1f} fps, {} frames dropped by sync, mean skew {:.1f} ms; {}",
-      elapsed.count() > 0 ? static_cast<double>(frameSets) / elapsed.count() : 0.0,
-      synchronizer_.stats().totalDropped(),
-      std::chrono::duration<double, std::milli>(synchronizer_.stats().meanSpread()).count(),
-      cameras);
+  report.stages = stageHistograms_;
+  report.latency = latency_;
+  report.outputs = outputs_.size() + recorders_.size();
+  report.failedOutputs = failedSinks_;
+  if (gl_) report.renderer = gl_->description();
+  return report;
 }
 
-RunSummary Pipeline::run(const std::atomic<bool>& stop, ServiceNotifier* service) {
+cv::Mat Pipeline::latestPicture() const {
+  const auto shown = [](const Output& o) { return !o.latest.empty(); };
+  const auto surround =
+      std::ranges::find_if(outputs_, [&](const Output& o) { return o.view && shown(o); });
+  if (surround != outputs_.end()) return surround->latest;
+  const auto any = std::ranges::find_if(outputs_, shown);
+  return any != outputs_.end() ? any->latest : cv::Mat();
+}
+
+RunSummary Pipeline::run(const std::atomic<bool>& stop, PipelineObserver* observer) {
   RunSummary summary;
   for (auto& camera : cameras_) camera->start();
-  const auto start = std::chrono::steady_clock::now();
-  auto nextProgress = start + kProgressInterval;
+  start_ = Clock::now();
+  auto nextProgress = start_ + kProgressInterval;
   while (!stop && !synchronizer_.finished()) {
-    auto since = std::chrono::steady_clock::now();
+    auto since = Clock::now();
     fillNeeds(stop);
-    timed(Stage::kSync, since);
-    while (auto set = synchronizer_.pop()) {
+    setStageTime_[static_cast<std::size_t>(Stage::kSync)] += Clock::now() - since;
+    while (auto set = nextSet()) {
+      stageTime_[static_cast<std::size_t>(Stage::kSync)] +=
+          setStageTime_[static_cast<std::size_t>(Stage::kSync)];
+      setStagesRun_.set(static_cast<std::size_t>(Stage::kSync));
       process(*set);
-      ++summary.frameSets;
+      ++frameSets_;
     }
-    // Live timestamps are CLOCK_MONOTONIC, which is steady_clock here.
-    if (live_) {
-      if (auto set = synchronizer_.popLate(std::chrono::steady_clock::now().time_since_epoch(),
-                                           lateAfter_)) {
-        process(*set);
-        ++summary.frameSets;
-      }
-    }
-    const auto now = std::chrono::steady_clock::now();
+    const auto now = Clock::now();
+    followPages(now);
     if (now >= nextProgress) {
       nextProgress += kProgressInterval;
-      spdlog::info("{} frame sets, {}", summary.frameSets,
-                   statusLine(summary.frameSets, now - start));
+      spdlog::info("{} frame sets, {}", frameSets_, statusLine(report()));
     }
-    if (service != nullptr) {
-      service->tick(now, summary.frameSets);
-      if (service->statusDue(now)) service->status(now, statusLine(summary.frameSets, now - start));
-    }
+    if (observer != nullptr) observer->onLoop(*this, now, frameSets_);
   }
-  if (service != nullptr) service->stopping();
+  if (observer != nullptr) observer->onStopping();
   if (stop) spdlog::info("stop requested: finalizing outputs");
   finish(summary);
-  summary.wallTime = std::chrono::steady_clock::now() - start;
+  summary.frameSets = frameSets_;
+  summary.wallTime = Clock::now() - start_;
   return summary;
 }
 
-void Pipeline::timed(Stage stage, std::chrono::steady_clock::time_point& since) {
-  const auto now = std::chrono::steady_clock::now();
-  stageTime_[static_cast<std::size_t>(stage)] += now - since;
+std::optional<capture::FrameSet> Pipeline::nextSet() {
+  if (!live_) return synchronizer_.pop();
+  // Live timestamps are CLOCK_MONOTONIC, which is steady_clock here.
+  auto newest = synchronizer_.pop();
+  if (!newest) return synchronizer_.popLate(Clock::now().time_since_epoch(), lateAfter_);
+  while (auto newer = synchronizer_.pop()) {
+    ++staleDropped_;
+    newest = std::move(newer);
+  }
+  return newest;
+}
+
+void Pipeline::timed(Stage stage, Clock::time_point& since) {
+  const auto now = Clock::now();
+  const auto index = static_cast<std::size_t>(stage);
+  stageTime_[index] += now - since;
+  setStageTime_[index] += now - since;
+  setStagesRun_.set(index);
   since = now;
+}
+
+void Pipeline::recordStages() {
+  for (std::size_t s = 0; s < kStageCount; ++s) {
+    if (setStagesRun_.test(s)) stageHistograms_[s].record(setStageTime_[s]);
+  }
+  setStageTime_.fill(std::chrono::nanoseconds(0));
+  setStagesRun_.reset();
+}
+
+Pipeline::Clock::time_point Pipeline::captureTimeOf(const capture::FrameSet& set) const {
+  auto oldest = Clock::time_point::max();
+  for (std::size_t c = 0; c < set.cameraCount; ++c) {
+    const capture::Frame* frame = set.frame(c);
+    if (frame == nullptr) continue;
+    // A live camera's timestamp is its driver's capture time on CLOCK_MONOTONIC; a replayed
+    // frame's "capture" is when its decoder handed it over.
+    oldest = std::min(oldest, live_ ? Clock::time_point(frame->timestamp) : frame->arrival);
+  }
+  return oldest;
+}
+
+void Pipeline::handOver(Output& output, const cv::Mat& picture, std::chrono::nanoseconds streamTime,
+                        Clock::time_point origin) {
+  guarded(output, [&] {
+    output.sink->consume(picture, streamTime);
+    output.latest = picture;
+    latency_.record(Clock::now() - origin);
+  });
 }
 
 template <typename Step>
@@ -287,7 +374,8 @@ bool Pipeline::shows(OutputStream stream) const {
 }
 
 void Pipeline::process(const capture::FrameSet& set) {
-  auto since = std::chrono::steady_clock::now();
+  auto since = Clock::now();
+  const Clock::time_point origin = captureTimeOf(set);
   if (!firstTimestamp_) firstTimestamp_ = set.timestamp;
   lastStreamTime_ = set.timestamp - *firstTimestamp_;
   followHealth(set);
@@ -337,13 +425,14 @@ void Pipeline::process(const capture::FrameSet& set) {
     timed(Stage::kCorrect, since);
   }
   deliverSurround();
-  renderSurround(set, lastStreamTime_);
-  since = std::chrono::steady_clock::now();
+  renderSurround(set, origin);
+  since = Clock::now();
   for (auto& output : outputs_) {
     if (output.view || !output.sink || !output.sink->wantsFrame(lastStreamTime_)) continue;
-    guarded(output, [&] { output.sink->consume(imageOf(output.stream), lastStreamTime_); });
+    handOver(output, imageOf(output.stream), lastStreamTime_, origin);
   }
   timed(Stage::kOutput, since);
+  recordStages();
 }
 
 void Pipeline::followHealth(const capture::FrameSet& set) {
@@ -364,9 +453,26 @@ void Pipeline::followHealth(const capture::FrameSet& set) {
   }
 }
 
-void Pipeline::renderSurround(const capture::FrameSet& set, std::chrono::nanoseconds streamTime) {
+void Pipeline::followPages(Clock::time_point now) {
+  const bool statusDue = now >= nextPageStatus_;
+  if (statusDue) nextPageStatus_ = now + kPageStatusInterval;
+  std::string status;
+  for (auto& output : outputs_) {
+    if (output.http == nullptr || !output.sink) continue;
+    if (const auto name = output.http->takeViewRequest(); name && output.view) {
+      if (const auto view = render::parseViewKind(*name)) output.view->setView(*view);
+    }
+    if (statusDue) {
+      if (status.empty()) status = statusJson(report());
+      output.http->setStatus(status);
+    }
+  }
+}
+
+void Pipeline::renderSurround(const capture::FrameSet& set, Clock::time_point origin) {
   if (!scene_) return;
-  auto since = std::chrono::steady_clock::now();
+  const std::chrono::nanoseconds streamTime = lastStreamTime_;
+  auto since = Clock::now();
   bool panoramaUploaded = false;
   bool cameraUploaded = false;
   for (auto& output : outputs_) {
@@ -383,6 +489,7 @@ void Pipeline::renderSurround(const capture::FrameSet& set, std::chrono::nanosec
       }
       output.view->draw(std::chrono::duration<double>(streamTime).count());
       output.pendingTime = streamTime;
+      output.pendingOrigin = origin;
     });
   }
   timed(Stage::kRender, since);
@@ -391,13 +498,12 @@ void Pipeline::renderSurround(const capture::FrameSet& set, std::chrono::nanosec
 void Pipeline::deliverSurround() {
   for (auto& output : outputs_) {
     if (!output.view || !output.view->pending()) continue;
-    guarded(output, [&] {
-      auto since = std::chrono::steady_clock::now();
-      const cv::Mat& picture = output.view->collect();
-      timed(Stage::kReadBack, since);
-      output.sink->consume(picture, output.pendingTime);
-      timed(Stage::kOutput, since);
-    });
+    auto since = Clock::now();
+    cv::Mat picture;
+    guarded(output, [&] { picture = output.view->collect(); });
+    timed(Stage::kReadBack, since);
+    if (!picture.empty()) handOver(output, picture, output.pendingTime, output.pendingOrigin);
+    timed(Stage::kOutput, since);
   }
 }
 
@@ -435,6 +541,7 @@ void Pipeline::finish(RunSummary& summary) {
   summary.stageTime = stageTime_;
   summary.healthChanges = healthChanges_;
   if (gl_) summary.renderer = gl_->description();
+  summary.report = report();
   for (const auto& camera : cameras_) {
     summary.cameraNames.push_back(camera->name());
     summary.cameras.push_back(camera->stats());

@@ -1,13 +1,18 @@
 #pragma once
-// The replay pipeline as it stands: cameras -> synchronizer -> mosaic and/or panorama -> surround
-// views -> outputs.
+// The pipeline: cameras -> synchronizer -> mosaic and/or panorama -> surround views -> outputs.
 //
-// One capture thread per camera (CameraStream); this thread synchronizes, composes the mosaic,
-// stitches and colour-corrects the panorama (on the work pool, only when an output shows it),
-// renders the surround views (OpenGL ES; the EGL context is made current on the thread that
-// constructs the pipeline, which must be the one that runs it) and feeds the outputs. A surround
-// view's read-back is collected while the next frame set is stitched, so its output gets each
-// picture one frame set later.
+// Threads and bounded queues, stage by stage:
+//   capture   one thread per camera (CameraStream), a queue of capture.queue_frames each;
+//   sync .. render  this thread: synchronizes, composes the mosaic, stitches and colour-corrects
+//             the panorama (split over the work pool of pipeline.threads, only when an output shows
+//             it), renders the surround views (OpenGL ES; the EGL context is current on the thread
+//             that constructs the pipeline, which must be the one that runs it). A view's read-back
+//             is collected while the next frame set is stitched, so its output gets each picture
+//             one frame set later;
+//   encode    one thread per video output (QueuedSink), 3 pictures deep.
+// Live, only the newest complete set is processed (latest wins: an
+// older one waiting is counted as stale and dropped, and so is the oldest picture an encoder has
+// not taken yet); a replay processes every set and waits for its slowest output.
 // Construction opens every source and output and throws (CaptureError, EncoderError,
 // std::runtime_error) with a message naming the camera or file; run() does not throw for faults of
 // single cameras or outputs: a failing camera ends its stream, a failing output is logged and
@@ -15,6 +20,7 @@
 
 #include <array>
 #include <atomic>
+#include <bitset>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -26,23 +32,20 @@
 #include "capture/synchronizer.hpp"
 #include "common/work_pool.hpp"
 #include "daemon/config.hpp"
+#include "daemon/pipeline_report.hpp"
 #include "daemon/rig_recorder.hpp"
-#include "daemon/service_notifier.hpp"
 #include "processing/gain_compensation.hpp"
 #include "processing/panorama_ownership.hpp"
 #include "processing/poisson_correction.hpp"
 #include "processing/stitcher.hpp"
 #include "render/egl_context.hpp"
 #include "render/frame_sink.hpp"
+#include "render/http_stream_sink.hpp"
 #include "render/mosaic.hpp"
 #include "render/surround_scene.hpp"
 #include "render/surround_view.hpp"
 
 namespace surroundd::daemon {
-
-// Where the pipeline thread's time goes, summed over the run.
-enum class Stage { kSync, kMosaic, kStitch, kCorrect, kRender, kReadBack, kOutput, kCount };
-const char* toString(Stage stage);
 
 struct RunSummary {
   std::uint64_t frameSets = 0;
@@ -52,13 +55,27 @@ struct RunSummary {
   std::vector<capture::CameraStreamStats> cameras;
   std::vector<std::string> outputs;  // what each output wrote
   std::uint64_t failedOutputs = 0;
-  std::array<std::chrono::nanoseconds, static_cast<std::size_t>(Stage::kCount)> stageTime{};
-  std::vector<capture::HealthChange> healthChanges;  // in order; `at` is stream time
-  std::string renderer;  // the EGL context's description, when there were surround outputs
+  std::array<std::chrono::nanoseconds, kStageCount> stageTime{};  // summed over the run
+  std::vector<capture::HealthChange> healthChanges;               // in order; `at` is stream time
+  std::string renderer;   // the EGL context's description, when there were surround outputs
+  PipelineReport report;  // at the end: per-stage and latency distributions among others
 
   double framesPerSecond() const {
     return wallTime.count() > 0 ? static_cast<double>(frameSets) / wallTime.count() : 0.0;
   }
+};
+
+class Pipeline;
+
+// Hears from the pipeline thread as it loops: at least every 200 ms, whether frame sets come or
+// not, so that it can answer requests (report(), setView(), latestPicture()) and feed a watchdog.
+class PipelineObserver {
+ public:
+  virtual ~PipelineObserver() = default;
+  virtual void onLoop(Pipeline& pipeline, std::chrono::steady_clock::time_point now,
+                      std::uint64_t frameSets) = 0;
+  // The run is ending; the outputs are about to be finalized.
+  virtual void onStopping() = 0;
 };
 
 class Pipeline {
@@ -69,32 +86,46 @@ class Pipeline {
   Pipeline& operator=(const Pipeline&) = delete;
 
   // Runs until every camera has ended or `stop` becomes true, then finalizes every output.
-  // `service`, when given, hears of readiness, progress (watchdog) and status.
-  RunSummary run(const std::atomic<bool>& stop, ServiceNotifier* service = nullptr);
+  RunSummary run(const std::atomic<bool>& stop, PipelineObserver* observer = nullptr);
 
+  // From the pipeline thread (an observer), while it runs:
   // Switches every surround output to `view` (takes effect with the next frame set).
   void setView(ViewKind view);
+  PipelineReport report() const;
+  // The newest picture handed to the first output that shows pictures (a surround view if there
+  // is one); a header over the pipeline's buffer, valid until the next frame set. Empty before.
+  cv::Mat latestPicture() const;
 
  private:
+  using Clock = std::chrono::steady_clock;
   struct Output {
     OutputStream stream = OutputStream::kMosaic;
     std::unique_ptr<render::FrameSink> sink;     // null once it failed
     std::unique_ptr<render::SurroundView> view;  // surround outputs
     std::chrono::nanoseconds pendingTime{0};     // stream time of the view's pending picture
+    Clock::time_point pendingOrigin{};           // capture time of the pending picture's set
+    cv::Mat latest;                              // header over the picture last handed over
+    render::HttpStreamSink* http = nullptr;      // an HTTP output's sink (owned by `sink`)
   };
 
   void fillNeeds(const std::atomic<bool>& stop);
-  // "20.9 fps, 0 frames dropped by sync, mean skew 1.7 ms; front ok, right black, ..."
-  std::string statusLine(std::uint64_t frameSets, std::chrono::duration<double> elapsed) const;
+  // Live: the newest complete set, the older ones counted as stale; replay: the next set.
+  std::optional<capture::FrameSet> nextSet();
   void process(const capture::FrameSet& set);
+  Clock::time_point captureTimeOf(const capture::FrameSet& set) const;
+  void handOver(Output& output, const cv::Mat& picture, std::chrono::nanoseconds streamTime,
+                Clock::time_point origin);
   void followHealth(const capture::FrameSet& set);
-  void renderSurround(const capture::FrameSet& set, std::chrono::nanoseconds streamTime);
+  // HTTP outputs: the views their pages asked for, and their status once a second.
+  void followPages(Clock::time_point now);
+  void renderSurround(const capture::FrameSet& set, Clock::time_point origin);
   void deliverSurround();
   void finish(RunSummary& summary);
   // Runs `step` on the output; an exception drops the output with a logged error.
   template <typename Step>
   void guarded(Output& output, Step&& step);
-  void timed(Stage stage, std::chrono::steady_clock::time_point& since);
+  void timed(Stage stage, Clock::time_point& since);
+  void recordStages();  // this set's stage times into the histograms
   const cv::Mat& imageOf(OutputStream stream) const;
   bool shows(OutputStream stream) const;  // a working output shows it
   void setUpColourCorrection(const Config& config);
@@ -124,8 +155,16 @@ class Pipeline {
   std::unique_ptr<render::SurroundScene> scene_;
   std::size_t splitCamera_ = 0;
   std::vector<Output> outputs_;
-  std::vector<std::unique_ptr<RigRecorder>> recorders_;  // null once failed
-  std::array<std::chrono::nanoseconds, static_cast<std::size_t>(Stage::kCount)> stageTime_{};
+  std::vector<std::unique_ptr<RigRecorder>> recorders_;               // null once failed
+  std::array<std::chrono::nanoseconds, kStageCount> stageTime_{};     // summed over the run
+  std::array<std::chrono::nanoseconds, kStageCount> setStageTime_{};  // this set's
+  std::bitset<kStageCount> setStagesRun_;
+  std::array<DurationHistogram, kStageCount> stageHistograms_;
+  DurationHistogram latency_;
+  std::uint64_t frameSets_ = 0;
+  std::uint64_t staleDropped_ = 0;
+  Clock::time_point start_{};
+  Clock::time_point nextPageStatus_{};
   std::uint64_t failedSinks_ = 0;
   std::optional<capture::Timestamp> firstTimestamp_;
   std::chrono::nanoseconds lastStreamTime_{0};

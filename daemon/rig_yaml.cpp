@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -190,7 +191,14 @@ std::vector<RigCamera> readRigCameras(YamlObject& rig) {
     RigCamera camera;
     auto& calibration = camera.calibration;
     calibration.name = entry.requiredString("name").value_or("");
-    if (!calibration.name.empty() && !names.insert(calibration.name).second) {
+    // Names become file names (recordings), metric labels and JSON keys.
+    const auto allowed = [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_';
+    };
+    if (!std::ranges::all_of(calibration.name, allowed)) {
+      entry.error("name",
+                  fmt::format("expected letters, digits, '-' and '_', got '{}'", calibration.name));
+    } else if (!calibration.name.empty() && !names.insert(calibration.name).second) {
       entry.error("name", fmt::format("duplicate camera name '{}' (names must be unique)",
                                       calibration.name));
     }

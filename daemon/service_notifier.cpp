@@ -35,6 +35,12 @@ void ServiceNotifier::status(Clock::time_point now, std::string_view text) {
   nextStatus_ = now + kStatusInterval;
 }
 
+void ServiceNotifier::reloading() {
+  send_("RELOADING=1\nSTATUS=reloading the config");
+  ready_ = false;
+  pingedAt_ = 0;  // the new pipeline counts its frame sets from zero
+}
+
 void ServiceNotifier::stopping() { send_("STOPPING=1\nSTATUS=finalizing the outputs"); }
 
 }  // namespace surroundd::daemon

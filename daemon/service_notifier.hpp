@@ -34,6 +34,8 @@ class ServiceNotifier {
   void status(Clock::time_point now, std::string_view text);
   // Before finalizing the outputs on the way out.
   void stopping();
+  // Before finalizing the outputs for a reload; READY=1 follows with the new pipeline's first set.
+  void reloading();
 
   static constexpr std::chrono::seconds kStatusInterval{2};
 

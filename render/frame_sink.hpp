@@ -6,6 +6,7 @@
 // the pipeline logs the failure and drops that sink, the others go on.
 
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -35,16 +36,31 @@ class FrameSink {
   virtual std::string describe() const = 0;
 };
 
-// H.264 video file (see VideoEncoder).
-class VideoFileSink final : public FrameSink {
+// H.264 video (see VideoEncoder): one file, a network stream, or files of `segmentLength` stream
+// time each ([0, L), [L, 2L), ... from the first frame set), named <stem>-00001<ext>,
+// <stem>-00002<ext>, ... and each finalized when the next begins, so that a crash or power loss
+// costs at most the segment being written. Numbering goes on after the highest segment already in
+// the folder: a restart never overwrites one.
+class VideoSink final : public FrameSink {
  public:
-  explicit VideoFileSink(VideoEncoderSettings settings) : encoder_(std::move(settings)) {}
+  // Opens the file (the first segment) or the stream; throws EncoderError naming it.
+  explicit VideoSink(VideoEncoderSettings settings,
+                     std::chrono::nanoseconds segmentLength = std::chrono::nanoseconds(0));
   void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) override;
   void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) override;
   std::string describe() const override;
 
  private:
-  VideoEncoder encoder_;
+  std::filesystem::path segmentPath(int number) const;
+  void openSegment();
+
+  VideoEncoderSettings settings_;
+  std::chrono::nanoseconds segmentLength_;  // 0: one file
+  std::optional<VideoEncoder> encoder_;
+  std::optional<std::int64_t> window_;  // which multiple of segmentLength_ is being written
+  int firstSegment_ = 1;
+  int segment_ = 0;  // the one being written
+  std::uint64_t frames_ = 0;
 };
 
 // One still image of the frame at `at` stream time, or of the last frame if the run is shorter.

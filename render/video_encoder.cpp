@@ -1,5 +1,7 @@
 #include "render/video_encoder.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <optional>
 
 #include <fmt/format.h>
@@ -37,9 +39,13 @@ struct VideoEncoder::Impl {
   std::optional<std::int64_t> lastPts;
   bool closed = false;
 
+  bool network() const { return !settings.url.empty(); }
+  std::string target() const { return network() ? settings.url : settings.path.string(); }
+
   [[noreturn]] void fail(std::string_view what, int error = 0) const {
-    throw EncoderError(error == 0 ? fmt::format("video '{}': {}", settings.path.string(), what)
-                                  : fmt::format("video '{}': {}: {}", settings.path.string(), what,
+    const char* kind = network() ? "stream" : "video";
+    throw EncoderError(error == 0 ? fmt::format("{} '{}': {}", kind, target(), what)
+                                  : fmt::format("{} '{}': {}: {}", kind, target(), what,
                                                 ffmpeg::errorText(error)));
   }
 
@@ -49,9 +55,15 @@ struct VideoEncoder::Impl {
 
 void VideoEncoder::Impl::open() {
   const auto extension = settings.path.extension().string();
-  const char* muxer = extension == ".mp4" ? "mp4" : extension == ".mkv" ? "matroska" : nullptr;
+  const char* muxer = network()             ? "mpegts"
+                      : extension == ".mp4" ? "mp4"
+                      : extension == ".mkv" ? "matroska"
+                                            : nullptr;
   if (muxer == nullptr)
     fail(fmt::format("expected a file ending in .mp4 or .mkv, got '{}'", extension));
+  if (network() && !settings.url.starts_with("udp://")) {
+    fail("expected a udp://HOST:PORT address");
+  }
   if (settings.size.width <= 0 || settings.size.height <= 0 || settings.size.width % 2 != 0 ||
       settings.size.height % 2 != 0) {
     fail(fmt::format("frame size must be even and positive, got {}x{}", settings.size.width,
@@ -76,11 +88,19 @@ void VideoEncoder::Impl::open() {
   const AVCodec* encoder = avcodec_find_encoder_by_name(encoderName);
   if (encoder == nullptr) fail(fmt::format("this FFmpeg has no {} encoder", encoderName));
 
-  partPath = settings.path;
-  partPath += ".part";
+  // A file is written under a temporary name until it is finalized; a stream has no name to keep.
+  std::string destination = settings.url;
+  if (!network()) {
+    partPath = settings.path;
+    partPath += ".part";
+    destination = partPath.string();
+  } else if (destination.find("pkt_size=") == std::string::npos) {
+    // Seven 188-byte TS packets per datagram: below every Ethernet MTU, so nothing is fragmented.
+    destination += destination.find('?') == std::string::npos ? "?pkt_size=1316" : "&pkt_size=1316";
+  }
   AVFormatContext* rawFormat = nullptr;
   if (const int error =
-          avformat_alloc_output_context2(&rawFormat, nullptr, muxer, partPath.c_str());
+          avformat_alloc_output_context2(&rawFormat, nullptr, muxer, destination.c_str());
       error < 0) {
     fail("cannot set up the container", error);
   }
@@ -109,6 +129,12 @@ void VideoEncoder::Impl::open() {
   // with x264 164 r3095); without mbtree the same input gives the same bytes on every CPU.
   if (settings.bitExact) av_opt_set(codec->priv_data, "x264-params", "mbtree=0", 0);
   if (pixelFormat == AV_PIX_FMT_YUV444P) av_opt_set(codec->priv_data, "profile", "high444", 0);
+  if (network()) {
+    // A viewer sees each picture as soon as it is encoded (no look-ahead, no B-frames), and one
+    // that joins late waits at most a second for a keyframe.
+    av_opt_set(codec->priv_data, "tune", "zerolatency", 0);
+    codec->gop_size = std::max(1, static_cast<int>(std::lround(settings.nominalFps)));
+  }
   // x264 checks the preset only here.
   if (const int error = avcodec_open2(codec.get(), encoder, nullptr); error < 0) {
     fail(fmt::format("cannot open the H.264 encoder (preset '{}', crf {}, {})", settings.preset,
@@ -125,8 +151,9 @@ void VideoEncoder::Impl::open() {
     fail("cannot describe the video stream", error);
   }
   if (settings.bitExact) format->flags |= AVFMT_FLAG_BITEXACT;
-  if (const int error = avio_open(&format->pb, partPath.c_str(), AVIO_FLAG_WRITE); error < 0) {
-    fail(fmt::format("cannot create '{}'", partPath.string()), error);
+  if (const int error = avio_open(&format->pb, destination.c_str(), AVIO_FLAG_WRITE); error < 0) {
+    fail(network() ? std::string("cannot open") : fmt::format("cannot create '{}'", destination),
+         error);
   }
   AVDictionary* muxerOptions = nullptr;
   if (extension == ".mp4") av_dict_set(&muxerOptions, "movie_timescale", kMp4MovieTimescale, 0);
@@ -161,7 +188,7 @@ void VideoEncoder::Impl::drain(bool flushing) {
     av_packet_rescale_ts(packet.get(), codec->time_base, stream->time_base);
     packet->stream_index = stream->index;
     if (const int error = av_interleaved_write_frame(format.get(), packet.get()); error < 0) {
-      fail("cannot write to the file", error);
+      fail(network() ? "cannot send" : "cannot write to the file", error);
     }
   }
 }
@@ -229,6 +256,7 @@ void VideoEncoder::close() {
   };
   if (s.framesWritten == 0) {
     discard();
+    if (s.network()) return;  // nothing was sent; nothing is lost
     s.fail("no frames written; no file made");
   }
   try {
@@ -242,6 +270,7 @@ void VideoEncoder::close() {
     discard();
     throw;
   }
+  if (s.network()) return;
   std::error_code renamed;
   std::filesystem::rename(s.partPath, s.settings.path, renamed);
   // The finished file is kept under its .part name rather than lost.
@@ -252,6 +281,8 @@ void VideoEncoder::close() {
 }
 
 const std::filesystem::path& VideoEncoder::path() const { return impl_->settings.path; }
+
+std::string VideoEncoder::target() const { return impl_->target(); }
 
 std::uint64_t VideoEncoder::framesWritten() const { return impl_->framesWritten; }
 

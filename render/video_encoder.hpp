@@ -1,5 +1,7 @@
 #pragma once
-// H.264 (libx264 through FFmpeg's libavcodec) into MP4 or MKV (chosen by the file extension).
+// H.264 (libx264 through FFmpeg's libavcodec) into MP4 or MKV (chosen by the file extension), or
+// as MPEG-TS to a network address (`url`, e.g. udp://239.0.0.1:5600: tuned for latency, no
+// B-frames, a keyframe with its parameter sets every second so that a receiver can join any time).
 //
 // The file is written as "<path>.part" and renamed to <path> only when it has been finalized
 // (trailer written), so a finished name always plays and nothing half-written carries it. close()
@@ -32,7 +34,7 @@ class EncoderError : public std::runtime_error {
 };
 
 struct VideoEncoderSettings {
-  std::filesystem::path path;  // .mp4 or .mkv
+  std::filesystem::path path;  // .mp4 or .mkv; unused when `url` is set
   cv::Size size;               // frame size in pixels (even width and height)
   double nominalFps = 30.0;    // rate hint for the container; timestamps decide the real timing
   int crf = 20;                // x264 constant rate factor; 0 = lossless
@@ -42,6 +44,7 @@ struct VideoEncoderSettings {
   std::string pixelFormat = "yuv420p";
   int threads = 0;        // encoder threads; 0 = codec's choice. Fix it for identical bytes.
   bool bitExact = false;  // leave out version strings so the same input gives the same bytes
+  std::string url;        // udp://HOST:PORT: MPEG-TS over UDP instead of a file
 
   bool operator==(const VideoEncoderSettings&) const = default;
 };
@@ -60,6 +63,8 @@ class VideoEncoder {
   void close();
 
   const std::filesystem::path& path() const;
+  // The file's path or the URL, for messages.
+  std::string target() const;
   std::uint64_t framesWritten() const;
 
  private:

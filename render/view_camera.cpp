@@ -1,5 +1,6 @@
 #include "render/view_camera.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -58,6 +59,12 @@ const char* toString(ViewKind view) {
       return "split";
   }
   return "?";
+}
+
+std::optional<ViewKind> parseViewKind(std::string_view name) {
+  const auto* kind =
+      std::ranges::find_if(kViewKinds, [&](ViewKind view) { return name == toString(view); });
+  return kind == kViewKinds.end() ? std::nullopt : std::optional(*kind);
 }
 
 cv::Matx44f topViewProjection(const ViewSettings& settings, cv::Size viewport) {

@@ -9,13 +9,20 @@
 //   split   the orbit view on the left half, one camera's own picture on the right.
 // Matrices take vehicle-frame points to OpenGL clip space, with rows of the picture top first.
 
+#include <array>
+#include <optional>
+#include <string_view>
+
 #include <opencv2/core.hpp>
 
 namespace surroundd::render {
 
 enum class ViewKind { kTop, kPanorama360, kOrbit, kSplit };
+inline constexpr std::array<ViewKind, 4> kViewKinds{ViewKind::kTop, ViewKind::kPanorama360,
+                                                    ViewKind::kOrbit, ViewKind::kSplit};
 
-const char* toString(ViewKind view);
+const char* toString(ViewKind view);  // "top", "360", "orbit", "split"
+std::optional<ViewKind> parseViewKind(std::string_view name);
 
 struct ViewSettings {
   double topRangeM = 8.0;

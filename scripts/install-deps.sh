@@ -9,9 +9,16 @@ PACKAGES="
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   libsuitesparse-dev
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
+  libx11-dev libxext-dev xvfb libdrm-dev libgbm-dev
   libturbojpeg0-dev libcamera-dev libsystemd-dev
   libgtest-dev libgmock-dev
+  libmicrohttpd-dev chromium
 "
+
+# Node.js drives the browser test; Debian's is enough where none is installed.
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  PACKAGES="$PACKAGES nodejs npm"
+fi
 
 missing=""
 for package in $PACKAGES; do

@@ -146,6 +146,44 @@ TEST_F(FileSourceVideo, ReplaysPicturesAndTimestampsWithGaps) {
   });
 }
 
+// Two cameras of a rig whose last frames came a few milliseconds apart (clock jitter) still loop by
+// the same offset: otherwise they would drift apart pass by pass until no frames match.
+TEST_F(FileSourceVideo, CamerasWithJitteredLastFramesLoopByTheSameOffset) {
+  forEachContainer([&] {
+    const auto write = [&](const std::string& stem, microseconds lastJitter) {
+      render::VideoEncoderSettings settings;
+      settings.path = file(stem);
+      settings.size = kSize;
+      settings.threads = 1;
+      render::VideoEncoder encoder(settings);
+      for (int i = 0; i < 10; ++i) {
+        encoder.write(picture(i),
+                      microseconds(33333 * i) + (i == 9 ? lastJitter : microseconds(0)));
+      }
+    };
+    write("early", microseconds(-4000));
+    write("late", microseconds(4000));
+    const auto timestampsOf = [&](const std::string& stem) {
+      FileSource source(stem, fastSettings(file(stem), true));
+      Frame frame;
+      frame.image.create(source.frameSize(), CV_8UC3);
+      std::vector<Timestamp> timestamps;
+      for (int i = 0; i < 50; ++i) {
+        EXPECT_EQ(source.read(frame), ReadStatus::kFrame);
+        timestamps.push_back(frame.timestamp);
+      }
+      return timestamps;
+    };
+    const auto early = timestampsOf("early");
+    const auto late = timestampsOf("late");
+    for (int pass = 1; pass < 5; ++pass) {
+      EXPECT_EQ(early[pass * 10] - early[0], late[pass * 10] - late[0]) << "pass " << pass;
+      EXPECT_NEAR(std::chrono::duration<double>(early[pass * 10] - early[0]).count(),
+                  pass * 10 / 30.0, 1e-3);
+    }
+  });
+}
+
 TEST_F(FileSourceVideo, LoopingRestartsWithIncreasingTimestamps) {
   forEachContainer([&] {
     const auto path = file("loop");
@@ -164,8 +202,8 @@ TEST_F(FileSourceVideo, LoopingRestartsWithIncreasingTimestamps) {
     for (std::size_t i = 1; i < timestamps.size(); ++i) {
       EXPECT_GT(timestamps[i], timestamps[i - 1]) << i;
     }
-    // The next pass starts one period after the last frame of the previous one.
-    EXPECT_EQ(timestamps[5] - timestamps[4], source.nominalPeriod());
+    // The next pass starts a whole number of periods after the first: one after the last frame.
+    EXPECT_EQ(timestamps[5] - timestamps[0], 5 * source.nominalPeriod());
     EXPECT_EQ(timestamps[10] - timestamps[5], timestamps[5] - timestamps[0]);
   });
 }
@@ -174,7 +212,7 @@ TEST_F(FileSourceVideo, TruncatedFileFailsCleanlyOrEnds) {
   forEachContainer([&] {
     const auto path = file("cut");
     {
-      render::VideoEncoder encoder({path, {128, 96}, 30.0, 10, "veryfast", "yuv420p", 1, true});
+      render::VideoEncoder encoder({path, {128, 96}, 30.0, 10, "veryfast", "yuv420p", 1, true, ""});
       for (int i = 0; i < 40; ++i) encoder.write(noise(i), milliseconds(33 * i));
     }
     std::filesystem::resize_file(path, std::filesystem::file_size(path) * 6 / 10);

@@ -206,6 +206,56 @@ TEST_F(ConfigTest, ARecordingIsAFolder) {
                  {"outputs[1].stream: a recording writes every camera's own stream"});
 }
 
+TEST_F(ConfigTest, SegmentedVideoNetworkStreamAndTheControlSocket) {
+  const Config config = loadConfig(
+      configWith("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "  - {type: video, path: out/drive.mkv, segment_s: 60}\n"
+                 "  - {type: network, stream: surround, url: \"udp://239.0.0.1:5600\", crf: 28}\n"
+                 "control: {socket: run/control.sock}"));
+  ASSERT_EQ(config.outputs.size(), 3u);
+  EXPECT_DOUBLE_EQ(config.outputs[1].segmentS, 60.0);
+  EXPECT_EQ(config.outputs[2].kind, OutputKind::kNetwork);
+  EXPECT_EQ(config.outputs[2].url, "udp://239.0.0.1:5600");
+  EXPECT_EQ(config.outputs[2].crf, 28);
+  EXPECT_TRUE(config.outputs[2].path.empty());
+  EXPECT_EQ(config.control.socket, dir_ / "run/control.sock");
+  const Config pages = loadConfig(
+      configWith("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "  - {type: http, stream: surround, listen: \"0.0.0.0:9000\", quality: 60}\n"
+                 "  - {type: window, display: \":3\", title: rig}\n"
+                 "  - {type: http, stream: mosaic}\n"
+                 "  - {type: display, stream: surround, device: /dev/dri/card1, "
+                 "connector: HDMI-A-1}"));
+  ASSERT_EQ(pages.outputs.size(), 5u);
+  EXPECT_EQ(pages.outputs[1].kind, OutputKind::kHttp);
+  EXPECT_EQ(pages.outputs[1].listenAddress, "0.0.0.0");
+  EXPECT_EQ(pages.outputs[1].listenPort, 9000);
+  EXPECT_EQ(pages.outputs[1].jpegQuality, 60);
+  EXPECT_EQ(pages.outputs[2].kind, OutputKind::kWindow);
+  EXPECT_EQ(pages.outputs[2].display, ":3");
+  EXPECT_EQ(pages.outputs[2].title, "rig");
+  EXPECT_EQ(pages.outputs[3].listenAddress, "127.0.0.1");  // only this machine by default
+  EXPECT_EQ(pages.outputs[3].listenPort, 8080);
+  EXPECT_EQ(pages.outputs[4].kind, OutputKind::kDisplay);
+  EXPECT_EQ(pages.outputs[4].device, "/dev/dri/card1");
+  EXPECT_EQ(pages.outputs[4].connector, "HDMI-A-1");
+  expectOneError(
+      "  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+      "  - {type: http, listen: \"localhost\"}",
+      {"outputs[1].listen: expected IPv4-ADDRESS:PORT (e.g. 127.0.0.1:8080), got 'localhost'"});
+  expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "  - {type: http, listen: \"localhost:8080\"}", {"got 'localhost:8080'"});
+  expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "  - {type: network, url: \"http://example.com\"}",
+                 {"outputs[1].url: expected udp://HOST:PORT, got 'http://example.com'"});
+  expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "  - {type: video, path: out/a.mp4, segment_s: -1}",
+                 {"outputs[1].segment_s: expected a number in [0, 86400]"});
+  expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "  - {type: snapshot, path: out/b.png, segment_s: 5}",
+                 {"outputs[1].segment_s: unknown key"});
+}
+
 TEST_F(ConfigTest, AViewOnlyBelongsToASurroundOutput) {
   expectOneError("{type: snapshot, path: out/mosaic.png,",
                  "{type: snapshot, view: top, path: out/mosaic.png,",
@@ -238,6 +288,11 @@ TEST_F(ConfigTest, MissingFile) {
   expectOneError("{file: left.mkv}", "{file: lfet.mkv}",
                  {"rig.cameras[1].source.file: expected an existing video file",
                   (dir_ / "lfet.mkv").string(), "no such file"});
+}
+
+TEST_F(ConfigTest, CameraNamesAreIdentifiers) {
+  expectOneError("name: front", "name: \"front cam\"",
+                 {"name: expected letters, digits, '-' and '_', got 'front cam'"});
 }
 
 TEST_F(ConfigTest, DuplicateCameraNames) {
@@ -326,6 +381,7 @@ TEST(ReferenceConfig, DocumentsTheDefaults) {
   EXPECT_EQ(config.colour, ColourCorrectionConfig{});
   EXPECT_EQ(config.mesh, MeshConfig{});
   EXPECT_EQ(config.render, RenderConfig{});
+  EXPECT_EQ(config.control, ControlConfig{});
   ASSERT_EQ(config.outputs.size(), 2u);
   OutputConfig video;
   video.path = config.outputs[0].path;

@@ -18,6 +18,7 @@
 #include "render/mosaic.hpp"
 #include "render/surround_view.hpp"
 #include "tests/support/child_process.hpp"
+#include "tests/support/stream_receiver.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -289,6 +290,35 @@ TEST(EndToEnd, UnknownOptionIsAUsageError) {
   testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--confg", "x.yaml"}, dir / "log.txt");
   EXPECT_EQ(surroundd.wait(), 2);
   EXPECT_THAT(surroundd.output(), HasSubstr("unknown option '--confg'"));
+}
+
+// The network output: MPEG-TS over UDP on loopback, decoded by FFmpeg as a viewer would, shows
+// the same pictures as the video file of the same view (itself checked against renders above).
+TEST(EndToEnd, TheNetworkStreamDecodesToTheRenderedFrames) {
+  const testing::TempDir dir;
+  const int port = testing::freeUdpPort();
+  const auto config =
+      dir.write("config.yaml", fmt::format(R"(rig: {{file: {}}}
+capture: {{pacing: realtime}}
+pipeline: {{threads: 2}}
+panorama: {{width_px: 512, height_px: 256, cache_dir: lut-cache}}
+render: {{width_px: 320, height_px: 240, view: orbit}}
+outputs:
+  - {{type: network, stream: surround, url: "udp://127.0.0.1:{}", crf: 18}}
+  - {{type: video, stream: surround, path: out/orbit.mkv, crf: 0, pixel_format: yuv444p}}
+)",
+                                           (kRecording / "rig.yaml").string(), port));
+  testing::StreamReceiver receiver(port, std::chrono::seconds(3));
+  testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--config", config.string()},
+                                  dir / "log.txt");
+  ASSERT_EQ(surroundd.wait(), 0) << surroundd.output();
+  EXPECT_THAT(surroundd.output(), HasSubstr(fmt::format("wrote stream udp://127.0.0.1:{}", port)));
+  const auto file = testing::decodeAll(dir / "out/orbit.mkv").images;
+  const auto received = receiver.pictures();
+  ASSERT_EQ(received.size(), file.size()) << receiver.error();
+  for (std::size_t k = 0; k < file.size(); ++k) {
+    EXPECT_GE(cv::PSNR(received[k], file[k]), 32.0) << "frame " << k;
+  }
 }
 
 }  // namespace

@@ -9,11 +9,10 @@
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/socket.h>
-#include <sys/un.h>
 #include <unistd.h>
 
 #include "tests/support/child_process.hpp"
+#include "tests/support/notify_socket.hpp"
 #include "tests/support/temp_dir.hpp"
 
 namespace surroundd::daemon {
@@ -64,48 +63,25 @@ TEST_F(ServiceNotifierTest, PingsTheWatchdogOnlyWhileFrameSetsKeepComing) {
   EXPECT_EQ(pingsIn(5000, 6000, true), 2);  // going again
 }
 
-// A datagram socket standing in for systemd's notification socket.
-class NotifySocket {
- public:
-  explicit NotifySocket(std::filesystem::path path) : path_(std::move(path)) {
-    fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-    sockaddr_un address{};
-    address.sun_family = AF_UNIX;
-    std::snprintf(address.sun_path, sizeof(address.sun_path), "%s", path_.c_str());
-    ::bind(fd_, reinterpret_cast<sockaddr*>(&address), sizeof(address));
-    timeval timeout{0, 100'000};
-    ::setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof(timeout));
-  }
-  ~NotifySocket() { ::close(fd_); }
-  NotifySocket(const NotifySocket&) = delete;
-  NotifySocket& operator=(const NotifySocket&) = delete;
-
-  // Every message received until STOPPING=1, or until nothing comes for 5 s.
-  std::vector<std::string> messages() {
-    std::vector<std::string> all;
-    std::array<char, 4096> buffer{};
-    for (int idle = 0; idle < 50;) {
-      const auto n = ::recv(fd_, buffer.data(), buffer.size(), 0);
-      if (n <= 0) {
-        ++idle;
-        continue;
-      }
-      idle = 0;
-      all.emplace_back(buffer.data(), static_cast<std::size_t>(n));
-      if (all.back().find("STOPPING=1") != std::string::npos) break;  // the last one
+// Every message until STOPPING=1, or until nothing comes for 2.5 s.
+std::vector<std::string> messagesUntilStopping(testing::NotifySocket& socket) {
+  std::vector<std::string> all;
+  for (int idle = 0; idle < 50;) {
+    const auto message = socket.receive();
+    if (!message) {
+      ++idle;
+      continue;
     }
-    return all;
+    idle = 0;
+    all.push_back(message->text);
+    if (all.back().find("STOPPING=1") != std::string::npos) break;  // the last one
   }
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-  int fd_ = -1;
-};
+  return all;
+}
 
 TEST(ServiceNotifications, SurroundedTellsSystemdItIsReadyAliveAndStopping) {
   const testing::TempDir dir;
-  NotifySocket socket(dir / "notify");
+  testing::NotifySocket socket(dir / "notify");
   const auto recording = std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
   const auto config = dir.write("config.yaml", fmt::format(R"(rig: {{file: {}}}
 capture: {{pacing: realtime}}
@@ -116,7 +92,7 @@ outputs:
   testing::ChildProcess surroundd(
       {SURROUNDD_EXECUTABLE, "--config", config.string()}, dir / "log.txt",
       {"NOTIFY_SOCKET=" + socket.path().string(), "WATCHDOG_USEC=200000"});
-  const auto messages = socket.messages();
+  const auto messages = messagesUntilStopping(socket);
   EXPECT_EQ(surroundd.wait(), 0) << surroundd.output();
   ASSERT_FALSE(messages.empty()) << surroundd.output();
   EXPECT_EQ(messages.front(), "READY=1");

@@ -45,6 +45,15 @@ class ChildProcess {
 
   void signal(int number) const { ::kill(pid_, number); }
 
+  // Whether it has not exited yet (if it has, its status is collected and wait() is not needed).
+  bool running() {
+    if (exited_) return false;
+    int status = 0;
+    if (::waitpid(pid_, &status, WNOHANG) == 0) return true;
+    exited_ = true;
+    return false;
+  }
+
   // Exit status, or 128 + signal number when it was killed.
   int wait() {
     int status = 0;

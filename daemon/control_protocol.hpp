@@ -1,0 +1,60 @@
+#pragma once
+// The control protocol of surroundd's Unix socket, shared by the daemon (ControlServer) and
+// surroundctl.
+//
+// A client connects (SOCK_STREAM), sends one request line of at most kMaxRequestBytes including
+// its '\n', and reads one reply; then the server closes the connection.
+//   status            -> the status text (frame rate, stages p50/p99, latency, cameras)
+//   metrics           -> Prometheus text format
+//   view NAME         -> switches every surround output to NAME (top, 360, orbit, split)
+//   snapshot          -> the newest output picture as a PNG
+//   reload            -> reads the config file again; a bad one is rejected, the old one runs on
+// Reply: "ok <body bytes>\n" then the body, or "error <message>\n".
+//
+// Errors: parsing gives a message for the client (never throws); the client functions throw
+// std::runtime_error naming the socket.
+
+#include <chrono>
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace surroundd::daemon {
+
+inline constexpr std::size_t kMaxRequestBytes = 256;
+
+struct ControlRequest {
+  enum class Kind { kStatus, kMetrics, kView, kSnapshot, kReload };
+  Kind kind = Kind::kStatus;
+  std::string argument;  // view: the view's name
+};
+
+struct ParsedRequest {
+  ControlRequest request;
+  std::string error;  // empty when the line was a good request
+};
+
+// `line` without its '\n'.
+ParsedRequest parseControlRequest(std::string_view line);
+
+struct ControlReply {
+  bool ok = false;
+  std::string body;  // ok: the payload; error: the message (one line)
+
+  static ControlReply success(std::string body) { return {true, std::move(body)}; }
+  static ControlReply failure(std::string message) { return {false, std::move(message)}; }
+};
+
+std::string encodeReply(const ControlReply& reply);
+
+// Where the socket is when the config does not say: $RUNTIME_DIRECTORY/control.sock (systemd's
+// RuntimeDirectory=, /run/surroundd), else $XDG_RUNTIME_DIR/surroundd/control.sock; empty if
+// neither is set.
+std::filesystem::path defaultControlSocket();
+
+// Sends `line` and reads the reply, waiting at most `timeout` for it.
+ControlReply sendControlRequest(const std::filesystem::path& socket, std::string_view line,
+                                std::chrono::milliseconds timeout);
+
+}  // namespace surroundd::daemon

@@ -1,0 +1,162 @@
+#include "daemon/pipeline_report.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+namespace surroundd::daemon {
+namespace {
+
+double milliseconds(std::chrono::nanoseconds duration) {
+  return std::chrono::duration<double, std::milli>(duration).count();
+}
+
+double seconds(std::chrono::nanoseconds duration) {
+  return std::chrono::duration<double>(duration).count();
+}
+
+void family(std::string& out, std::string_view name, std::string_view type, std::string_view help) {
+  fmt::format_to(std::back_inserter(out), "# HELP surroundd_{} {}\n# TYPE surroundd_{} {}\n", name,
+                 help, name, type);
+}
+
+// A Prometheus summary: p50, p90 and p99 from the histogram, with its sum and count.
+void summary(std::string& out, std::string_view name, std::string_view labels,
+             const DurationHistogram& histogram) {
+  const std::string separator = labels.empty() ? "" : ",";
+  for (const double q : {0.5, 0.9, 0.99}) {
+    fmt::format_to(std::back_inserter(out), "surroundd_{}{{{}{}quantile=\"{}\"}} {:.6f}\n", name,
+                   labels, separator, q, seconds(histogram.quantile(q)));
+  }
+  const std::string braces = labels.empty() ? "" : fmt::format("{{{}}}", labels);
+  fmt::format_to(std::back_inserter(out), "surroundd_{}_sum{} {:.6f}\nsurroundd_{}_count{} {}\n",
+                 name, braces, seconds(histogram.sum()), name, braces, histogram.count());
+}
+
+}  // namespace
+
+const char* toString(Stage stage) {
+  constexpr std::array<const char*, kStageCount> kNames{"sync",   "mosaic",    "stitch", "correct",
+                                                        "render", "read-back", "output"};
+  return kNames.at(static_cast<std::size_t>(stage));
+}
+
+std::string statusLine(const PipelineReport& report) {
+  std::string cameras;
+  for (const auto& camera : report.cameras) {
+    cameras += fmt::format("{}{} {}", cameras.empty() ? "" : ", ", camera.name,
+                           capture::toString(camera.health));
+  }
+  return fmt::format("{:.1f} fps, {} frames dropped by sync, mean skew {:.1f} ms; {}",
+                     report.framesPerSecond(), report.sync.totalDropped(),
+                     milliseconds(report.sync.meanSpread()), cameras);
+}
+
+std::string statusText(const PipelineReport& report) {
+  std::string out = fmt::format("{} frame sets in {:.1f} s: {}\n", report.frameSets,
+                                report.elapsed.count(), statusLine(report));
+  fmt::format_to(std::back_inserter(out), "stale sets skipped: {}; outputs: {} ({} failed)\n",
+                 report.staleDropped, report.outputs, report.failedOutputs);
+  if (!report.renderer.empty())
+    fmt::format_to(std::back_inserter(out), "render: {}\n", report.renderer);
+  for (std::size_t s = 0; s < kStageCount; ++s) {
+    const auto& stage = report.stages[s];
+    if (stage.count() == 0) continue;
+    fmt::format_to(std::back_inserter(out),
+                   "stage {:<9} p50 {:7.2f} ms  p99 {:7.2f} ms  ({} sets, {:.1f}/s)\n",
+                   toString(static_cast<Stage>(s)), milliseconds(stage.quantile(0.5)),
+                   milliseconds(stage.quantile(0.99)), stage.count(),
+                   static_cast<double>(stage.count()) / std::max(report.elapsed.count(), 1e-9));
+  }
+  if (report.latency.count() > 0) {
+    fmt::format_to(
+        std::back_inserter(out), "latency capture to output: p50 {:.1f} ms  p99 {:.1f} ms\n",
+        milliseconds(report.latency.quantile(0.5)), milliseconds(report.latency.quantile(0.99)));
+  }
+  for (std::size_t c = 0; c < report.cameras.size(); ++c) {
+    const auto& camera = report.cameras[c];
+    fmt::format_to(std::back_inserter(out),
+                   "camera {}: {}, {} frames, {} faults, {} queued, {} dropped by sync, {} sets "
+                   "without it\n",
+                   camera.name, capture::toString(camera.health), camera.stats.frames,
+                   camera.stats.faults, camera.queued,
+                   report.sync.unmatchedDropped[c] + report.sync.outOfOrderDropped[c],
+                   report.sync.lateMissing[c]);
+  }
+  return out;
+}
+
+std::string statusJson(const PipelineReport& report) {
+  std::string cameras;
+  for (const auto& camera : report.cameras) {
+    // Camera names are validated identifiers and health names are fixed words: nothing to escape.
+    fmt::format_to(std::back_inserter(cameras), "{}\"{}\": \"{}\"", cameras.empty() ? "" : ", ",
+                   camera.name, capture::toString(camera.health));
+  }
+  return fmt::format(R"({{"fps": {:.1f}, "frames": {}, "cameras": {{{}}}, "latency_ms": {:.1f}, )"
+                     R"("dropped_by_sync": {}}})",
+                     report.framesPerSecond(), report.frameSets, cameras,
+                     milliseconds(report.latency.quantile(0.5)), report.sync.totalDropped());
+}
+
+std::string prometheusText(const PipelineReport& report) {
+  std::string out;
+  family(out, "frame_sets_total", "counter", "Frame sets that went through the pipeline.");
+  fmt::format_to(std::back_inserter(out), "surroundd_frame_sets_total {}\n", report.frameSets);
+  family(out, "frames_per_second", "gauge", "Frame sets per second since the pipeline started.");
+  fmt::format_to(std::back_inserter(out), "surroundd_frames_per_second {:.3f}\n",
+                 report.framesPerSecond());
+  family(out, "stale_sets_dropped_total", "counter",
+         "Live: complete frame sets skipped because a newer one was ready (latest wins).");
+  fmt::format_to(std::back_inserter(out), "surroundd_stale_sets_dropped_total {}\n",
+                 report.staleDropped);
+  family(out, "stage_seconds", "summary", "Time per frame set in each pipeline stage.");
+  for (std::size_t s = 0; s < kStageCount; ++s) {
+    summary(out, "stage_seconds", fmt::format("stage=\"{}\"", toString(static_cast<Stage>(s))),
+            report.stages[s]);
+  }
+  family(out, "latency_seconds", "summary",
+         "From a frame set's capture (its oldest frame) to its picture handed to an output.");
+  summary(out, "latency_seconds", "", report.latency);
+
+  const auto perCamera = [&](std::string_view name, std::string_view type, std::string_view help,
+                             const auto& value) {
+    family(out, name, type, help);
+    for (std::size_t c = 0; c < report.cameras.size(); ++c) {
+      fmt::format_to(std::back_inserter(out), "surroundd_{}{{camera=\"{}\"}} {}\n", name,
+                     report.cameras[c].name, value(c));
+    }
+  };
+  perCamera("camera_frames_total", "counter", "Frames each camera delivered.",
+            [&](std::size_t c) { return report.cameras[c].stats.frames; });
+  perCamera("camera_faults_total", "counter", "Failed reads of each camera.",
+            [&](std::size_t c) { return report.cameras[c].stats.faults; });
+  perCamera("camera_queue_depth", "gauge", "Frames waiting between a camera and the synchronizer.",
+            [&](std::size_t c) { return report.cameras[c].queued; });
+  perCamera("camera_sync_dropped_total", "counter",
+            "Frames the synchronizer dropped (no partner in time, or out of order).",
+            [&](std::size_t c) {
+              return report.sync.unmatchedDropped[c] + report.sync.outOfOrderDropped[c];
+            });
+  perCamera("camera_sets_without_total", "counter", "Frame sets sent without this camera.",
+            [&](std::size_t c) { return report.sync.lateMissing[c]; });
+  perCamera("camera_healthy", "gauge", "1 while the camera is ok, else 0.", [&](std::size_t c) {
+    return report.cameras[c].health == capture::CameraHealth::kOk ? 1 : 0;
+  });
+  family(out, "camera_health", "gauge",
+         "1 for the camera's current state (ok, lost, frozen, ...).");
+  for (const auto& camera : report.cameras) {
+    fmt::format_to(std::back_inserter(out),
+                   "surroundd_camera_health{{camera=\"{}\",state=\"{}\"}} 1\n", camera.name,
+                   capture::toString(camera.health));
+  }
+  family(out, "sync_skew_seconds", "gauge", "Mean newest-minus-oldest timestamp within a set.");
+  fmt::format_to(std::back_inserter(out), "surroundd_sync_skew_seconds {:.6f}\n",
+                 seconds(report.sync.meanSpread()));
+  family(out, "outputs_failed_total", "counter", "Outputs dropped after an error.");
+  fmt::format_to(std::back_inserter(out), "surroundd_outputs_failed_total {}\n",
+                 report.failedOutputs);
+  return out;
+}
+
+}  // namespace surroundd::daemon

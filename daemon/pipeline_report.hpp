@@ -1,0 +1,58 @@
+#pragma once
+// What the pipeline can say about itself while it runs: the one-line status (log, systemd STATUS=),
+// the longer status of `surroundctl status`, and the Prometheus text of `surroundctl metrics`.
+// A PipelineReport is a plain copy made on request, so formatting never touches the live pipeline.
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "capture/camera_health.hpp"
+#include "capture/camera_stream.hpp"
+#include "capture/synchronizer.hpp"
+#include "daemon/duration_histogram.hpp"
+
+namespace surroundd::daemon {
+
+// The pipeline thread's stages, timed per frame set.
+enum class Stage { kSync, kMosaic, kStitch, kCorrect, kRender, kReadBack, kOutput, kCount };
+inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::kCount);
+const char* toString(Stage stage);
+
+struct CameraReport {
+  std::string name;
+  capture::CameraHealth health = capture::CameraHealth::kOk;
+  capture::CameraStreamStats stats;
+  std::size_t queued = 0;  // frames waiting between its capture thread and the synchronizer
+};
+
+struct PipelineReport {
+  std::chrono::duration<double> elapsed{0};
+  std::uint64_t frameSets = 0;
+  std::uint64_t staleDropped = 0;  // live: complete sets skipped because a newer one was ready
+  capture::SyncStats sync;
+  std::vector<CameraReport> cameras;
+  std::array<DurationHistogram, kStageCount> stages;  // per frame set that went through the stage
+  DurationHistogram latency;  // a frame's capture to its picture handed to an output
+  std::size_t outputs = 0;
+  std::uint64_t failedOutputs = 0;
+  std::string renderer;
+
+  double framesPerSecond() const {
+    return elapsed.count() > 0 ? static_cast<double>(frameSets) / elapsed.count() : 0.0;
+  }
+};
+
+// "20.9 fps, 0 frames dropped by sync, mean skew 1.7 ms; front ok, right black, ..."
+std::string statusLine(const PipelineReport& report);
+// The status line, then one line per stage with p50/p99, the latency, and one line per camera.
+std::string statusText(const PipelineReport& report);
+// For the HTTP page: {"fps": .., "frames": .., "cameras": {"front": "ok", ..}, "latency_ms": ..,
+// "dropped_by_sync": ..}.
+std::string statusJson(const PipelineReport& report);
+// Prometheus text exposition format (version 0.0.4), metric names prefixed surroundd_.
+std::string prometheusText(const PipelineReport& report);
+
+}  // namespace surroundd::daemon

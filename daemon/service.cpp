@@ -1,0 +1,160 @@
+#include "daemon/service.hpp"
+
+#include <opencv2/imgcodecs.hpp>
+#include <spdlog/spdlog.h>
+
+#include "render/view_camera.hpp"
+
+namespace surroundd::daemon {
+namespace {
+
+void logSummary(const RunSummary& summary) {
+  spdlog::info(
+      "{} frame sets in {:.2f} s: {:.1f} fps; sync dropped {} frames, max spread {:.2f} ms",
+      summary.frameSets, summary.wallTime.count(), summary.framesPerSecond(),
+      summary.sync.totalDropped(),
+      std::chrono::duration<double, std::milli>(summary.sync.maxSpread).count());
+  const auto& latency = summary.report.latency;
+  if (latency.count() > 0) {
+    spdlog::info("latency capture to output: p50 {:.1f} ms, p99 {:.1f} ms ({} pictures)",
+                 std::chrono::duration<double, std::milli>(latency.quantile(0.5)).count(),
+                 std::chrono::duration<double, std::milli>(latency.quantile(0.99)).count(),
+                 latency.count());
+  }
+  for (std::size_t c = 0; c < summary.cameras.size(); ++c) {
+    spdlog::info(
+        "camera '{}': {} frames, {} faults, {} dropped unmatched, {} out of order, {} sets sent "
+        "without it",
+        summary.cameraNames[c], summary.cameras[c].frames, summary.cameras[c].faults,
+        summary.sync.unmatchedDropped[c], summary.sync.outOfOrderDropped[c],
+        summary.sync.lateMissing[c]);
+  }
+  for (const auto& output : summary.outputs) spdlog::info("wrote {}", output);
+}
+
+std::filesystem::path numbered(const std::filesystem::path& path, int n) {
+  std::filesystem::path result = path;
+  result.replace_filename(
+      fmt::format("{}-{}{}", path.stem().string(), n, path.extension().string()));
+  return result;
+}
+
+}  // namespace
+
+Config afterReloads(Config config, int reloads) {
+  if (reloads == 0) return config;
+  for (auto& output : config.outputs) {
+    if (!output.path.empty()) output.path = numbered(output.path, reloads);
+  }
+  return config;
+}
+
+Service::Service(Config config, ServiceSignals& signals, ServiceNotifier notifier)
+    : config_(std::move(config)), signals_(signals), notifier_(std::move(notifier)) {
+  const auto socket =
+      config_.control.socket.empty() ? defaultControlSocket() : config_.control.socket;
+  if (socket.empty()) {
+    spdlog::info("control: no socket (set control.socket, or run under systemd)");
+    return;
+  }
+  control_ = std::make_unique<ControlServer>(socket);
+  spdlog::info("control: listening on {}", socket.string());
+}
+
+int Service::run() {
+  std::optional<Config> previous;  // to go back to when a reloaded config cannot start
+  for (;;) {
+    std::unique_ptr<Pipeline> pipeline;
+    try {
+      pipeline = std::make_unique<Pipeline>(afterReloads(config_, reloads_));
+    } catch (const std::exception& e) {
+      if (!previous) {
+        spdlog::critical("{}", e.what());
+        return 1;
+      }
+      spdlog::error("reload: the new config cannot start ({}); starting the previous one again",
+                    e.what());
+      config_ = *std::exchange(previous, std::nullopt);
+      ++reloads_;
+      continue;
+    }
+    endRun_ = false;
+    const RunSummary summary = pipeline->run(endRun_, this);
+    pipeline.reset();
+    logSummary(summary);
+    if (!pending_ || signals_.stop) return summary.failedOutputs == 0 ? 0 : 1;
+    previous = std::exchange(config_, *std::exchange(pending_, std::nullopt));
+    ++reloads_;
+    spdlog::info("reload: starting the pipeline for the new config (outputs get '-{}')", reloads_);
+  }
+}
+
+void Service::onLoop(Pipeline& pipeline, std::chrono::steady_clock::time_point now,
+                     std::uint64_t frameSets) {
+  if (signals_.stop) endRun_ = true;
+  if (signals_.reload.exchange(false)) reload();
+  if (control_) {
+    control_->serve([&](const ControlRequest& request) { return answer(pipeline, request); });
+  }
+  notifier_.tick(now, frameSets);
+  if (notifier_.statusDue(now)) notifier_.status(now, statusLine(pipeline.report()));
+}
+
+void Service::onStopping() {
+  if (pending_ && !signals_.stop) {
+    notifier_.reloading();
+  } else {
+    notifier_.stopping();
+  }
+}
+
+ControlReply Service::reload() {
+  spdlog::info("reload: reading {}", config_.file.string());
+  try {
+    Config fresh = loadConfig(config_.file);
+    if (fresh.control != config_.control) {
+      spdlog::warn("reload: control.socket changes only when surroundd restarts");
+    }
+    pending_ = std::move(fresh);
+    endRun_ = true;
+    return ControlReply::success("the new config is good; restarting the pipeline with it\n");
+  } catch (const ConfigError& e) {
+    std::string messages;
+    for (const auto& message : e.messages()) {
+      spdlog::error("reload rejected: {}", message);
+      messages += (messages.empty() ? "" : "; ") + message;
+    }
+    return ControlReply::failure("config rejected, the running one goes on: " + messages);
+  }
+}
+
+ControlReply Service::answer(Pipeline& pipeline, const ControlRequest& request) {
+  using Kind = ControlRequest::Kind;
+  switch (request.kind) {
+    case Kind::kStatus:
+      return ControlReply::success(statusText(pipeline.report()));
+    case Kind::kMetrics:
+      return ControlReply::success(prometheusText(pipeline.report()));
+    case Kind::kView: {
+      const auto view = render::parseViewKind(request.argument);
+      if (!view) {
+        return ControlReply::failure(
+            fmt::format("unknown view '{}' (top, 360, orbit, split)", request.argument));
+      }
+      pipeline.setView(*view);
+      return ControlReply::success(fmt::format("view {}\n", request.argument));
+    }
+    case Kind::kSnapshot: {
+      const cv::Mat picture = pipeline.latestPicture();
+      if (picture.empty()) return ControlReply::failure("no picture yet");
+      std::vector<uchar> png;
+      cv::imencode(".png", picture, png);
+      return ControlReply::success(std::string(png.begin(), png.end()));
+    }
+    case Kind::kReload:
+      return reload();
+  }
+  return ControlReply::failure("unknown request");
+}
+
+}  // namespace surroundd::daemon

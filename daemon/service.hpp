@@ -1,0 +1,63 @@
+#pragma once
+// surroundd as a service: runs the pipeline for the config until SIGTERM (or the end of a
+// replay), and around it what outlives one pipeline: systemd notifications, the control socket,
+// and reloading.
+//
+// Reload (SIGHUP or `surroundctl reload`): the config file is read again on the pipeline thread.
+// A bad one is rejected with its messages and the running pipeline goes on untouched. A good one
+// ends the run (every output finalized) and a pipeline for it starts; if that cannot start (a
+// camera or output cannot be opened), the previous config is started again. Files written after
+// a reload get "-N" before their extension (N = reload count), so no finished file is
+// overwritten. The control socket stays where it was.
+//
+// Threads: everything here runs on the pipeline thread, but for the signal flags (atomics set by
+// the signal handlers) and the control server's own thread (see ControlServer).
+
+#include <atomic>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include "daemon/config.hpp"
+#include "daemon/control_server.hpp"
+#include "daemon/pipeline.hpp"
+#include "daemon/service_notifier.hpp"
+
+namespace surroundd::daemon {
+
+struct ServiceSignals {
+  std::atomic<bool> stop{false};    // SIGTERM, SIGINT
+  std::atomic<bool> reload{false};  // SIGHUP
+};
+
+class Service final : public PipelineObserver {
+ public:
+  // Opens the control socket (throws std::runtime_error naming it if it cannot).
+  Service(Config config, ServiceSignals& signals, ServiceNotifier notifier);
+
+  // Runs until stopped or the cameras end. Exit code: 0, or 1 when the pipeline could not start
+  // or an output failed.
+  int run();
+
+  void onLoop(Pipeline& pipeline, std::chrono::steady_clock::time_point now,
+              std::uint64_t frameSets) override;
+  void onStopping() override;
+
+ private:
+  ControlReply answer(Pipeline& pipeline, const ControlRequest& request);
+  // Reads the config file again; a good config becomes pending and ends the run.
+  ControlReply reload();
+
+  Config config_;
+  std::optional<Config> pending_;  // a good new config, started when the current run has ended
+  int reloads_ = 0;
+  ServiceSignals& signals_;
+  ServiceNotifier notifier_;
+  std::unique_ptr<ControlServer> control_;
+  std::atomic<bool> endRun_{false};  // read by Pipeline::run; set on this same thread
+};
+
+// The config as run after `reloads` reloads: files get "-N" before the extension (folders: after).
+Config afterReloads(Config config, int reloads);
+
+}  // namespace surroundd::daemon

@@ -1,0 +1,164 @@
+// The control socket in-process: requests parsed or refused with a reason, a round trip through
+// the server to a handler on "the pipeline thread", and clients that misbehave.
+
+#include "daemon/control_server.hpp"
+
+#include <atomic>
+#include <thread>
+
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+namespace surroundd::daemon {
+namespace {
+
+using ::testing::HasSubstr;
+using Kind = ControlRequest::Kind;
+
+// Short: a socket path must fit in 108 bytes.
+std::filesystem::path socketPath(std::string_view name) {
+  return std::filesystem::temp_directory_path() / fmt::format("surroundd-{}-{}", ::getpid(), name) /
+         "control.sock";
+}
+
+TEST(ControlProtocol, ParsesTheRequestsAndSaysWhatIsWrongWithOthers) {
+  EXPECT_EQ(parseControlRequest("status").request.kind, Kind::kStatus);
+  EXPECT_EQ(parseControlRequest("metrics").request.kind, Kind::kMetrics);
+  EXPECT_EQ(parseControlRequest("snapshot").request.kind, Kind::kSnapshot);
+  EXPECT_EQ(parseControlRequest("reload").request.kind, Kind::kReload);
+  const auto view = parseControlRequest("view top");
+  EXPECT_TRUE(view.error.empty());
+  EXPECT_EQ(view.request.kind, Kind::kView);
+  EXPECT_EQ(view.request.argument, "top");
+  EXPECT_THAT(parseControlRequest("view").error, HasSubstr("'view' needs an argument"));
+  EXPECT_THAT(parseControlRequest("status now").error, HasSubstr("'status' takes no argument"));
+  EXPECT_THAT(parseControlRequest("shutdown").error, HasSubstr("unknown request 'shutdown'"));
+  EXPECT_THAT(parseControlRequest("").error, HasSubstr("unknown request ''"));
+  EXPECT_THAT(parseControlRequest("stat\x01us").error, HasSubstr("control or non-ASCII"));
+}
+
+TEST(ControlProtocol, RepliesAreFramedWithTheirLength) {
+  EXPECT_EQ(encodeReply(ControlReply::success("abc\n")), "ok 4\nabc\n");
+  EXPECT_EQ(encodeReply(ControlReply::failure("two\nlines")), "error two lines\n");
+}
+
+// A raw client, for sending what surroundctl never would.
+std::string exchange(const std::filesystem::path& path, std::string_view bytes, bool closeWrite) {
+  const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  std::snprintf(address.sun_path, sizeof(address.sun_path), "%s", path.c_str());
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
+    ::close(fd);
+    return "connect failed";
+  }
+  [[maybe_unused]] const auto sent = ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+  if (closeWrite) ::shutdown(fd, SHUT_WR);
+  std::string reply;
+  std::array<char, 4096> buffer{};
+  for (ssize_t n = 0; (n = ::recv(fd, buffer.data(), buffer.size(), 0)) > 0;) {
+    reply.append(buffer.data(), static_cast<std::size_t>(n));
+  }
+  ::close(fd);
+  return reply;
+}
+
+class ControlServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::filesystem::remove_all(path_.parent_path());
+    server_ = std::make_unique<ControlServer>(path_);
+    // Stands in for the pipeline thread: serves between "frame sets".
+    pipeline_ = std::thread([this] {
+      while (!stop_) {
+        server_->serve([this](const ControlRequest& request) {
+          ++served_;
+          if (request.kind == Kind::kView && request.argument != "top") {
+            return ControlReply::failure("unknown view '" + request.argument + "'");
+          }
+          return ControlReply::success(
+              fmt::format("answer to {} {}", static_cast<int>(request.kind), request.argument));
+        });
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    });
+  }
+  void TearDown() override {
+    stop_ = true;
+    pipeline_.join();
+    server_.reset();
+    std::filesystem::remove_all(path_.parent_path());
+  }
+
+  std::filesystem::path path_ = socketPath("server");
+  std::unique_ptr<ControlServer> server_;
+  std::atomic<bool> stop_{false};
+  std::atomic<int> served_{0};
+  std::thread pipeline_;
+};
+
+TEST_F(ControlServerTest, RequestsRoundTripThroughThePipelineThread) {
+  const auto reply = sendControlRequest(path_, "view top", std::chrono::seconds(5));
+  EXPECT_TRUE(reply.ok);
+  EXPECT_EQ(reply.body, "answer to 2 top");
+  const auto refused = sendControlRequest(path_, "view sideways", std::chrono::seconds(5));
+  EXPECT_FALSE(refused.ok);
+  EXPECT_EQ(refused.body, "unknown view 'sideways'");
+  EXPECT_EQ(served_, 2);
+  // Only the service's user and group may talk to it.
+  struct stat info {};
+  ASSERT_EQ(::stat(path_.c_str(), &info), 0);
+  EXPECT_EQ(info.st_mode & 0777, 0660);
+  EXPECT_TRUE(S_ISSOCK(info.st_mode));
+}
+
+TEST_F(ControlServerTest, MisbehavingClientsGetAnErrorAndTheServerGoesOn) {
+  EXPECT_EQ(exchange(path_, "shutdown\n", false),
+            "error unknown request 'shutdown' (status, metrics, view NAME, snapshot, reload)\n");
+  EXPECT_EQ(exchange(path_, std::string(10000, 'x'), false),
+            fmt::format("error request longer than {} bytes\n", kMaxRequestBytes));
+  EXPECT_EQ(exchange(path_, "status", true), "error the request ended without a newline\n");
+  EXPECT_EQ(exchange(path_, "sta", false), "error no complete request line in time\n");
+  EXPECT_EQ(exchange(path_, std::string("\xff\xfe\n", 3), false),
+            "error request has control or non-ASCII characters\n");
+  EXPECT_EQ(served_, 0);  // none of them reached the pipeline
+  EXPECT_EQ(exchange(path_, "status\n", false), "ok 12\nanswer to 0 ");
+  EXPECT_EQ(served_, 1);
+}
+
+TEST_F(ControlServerTest, ASecondServerOnTheSamePathIsRefusedAndAStaleOneReplaced) {
+  EXPECT_THAT([&] { ControlServer second(path_); }, ::testing::ThrowsMessage<std::runtime_error>(
+                                                        HasSubstr("in use by a running server")));
+  // The first one still answers.
+  EXPECT_TRUE(sendControlRequest(path_, "status", std::chrono::seconds(5)).ok);
+
+  const auto stalePath = socketPath("stale");
+  std::filesystem::create_directories(stalePath.parent_path());
+  {
+    // A socket file left behind by a process that is gone.
+    const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+    sockaddr_un address{};
+    address.sun_family = AF_UNIX;
+    std::snprintf(address.sun_path, sizeof(address.sun_path), "%s", stalePath.c_str());
+    ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)), 0);
+    ::close(fd);
+  }
+  { const ControlServer replaced(stalePath); }
+  EXPECT_FALSE(std::filesystem::exists(stalePath));  // removed with its server
+  std::filesystem::remove_all(stalePath.parent_path());
+}
+
+TEST(ControlClient, SaysWhichSocketItCouldNotReach) {
+  EXPECT_THAT(
+      [] { sendControlRequest("/nonexistent/control.sock", "status", std::chrono::seconds(1)); },
+      ::testing::ThrowsMessage<std::runtime_error>(
+          HasSubstr("/nonexistent/control.sock: cannot connect: No such file or directory")));
+}
+
+}  // namespace
+}  // namespace surroundd::daemon

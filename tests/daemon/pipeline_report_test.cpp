@@ -1,0 +1,130 @@
+// The pipeline's figures: quantiles from the duration histogram, and the Prometheus text they are
+// published in (checked line by line against the exposition format's grammar).
+
+#include "daemon/pipeline_report.hpp"
+
+#include <map>
+#include <random>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace surroundd::daemon {
+namespace {
+
+using std::chrono::microseconds;
+using std::chrono::milliseconds;
+using std::chrono::nanoseconds;
+
+TEST(DurationHistogram, QuantilesLieWithinOneBucketOfTheExactOnes) {
+  DurationHistogram histogram;
+  EXPECT_EQ(histogram.quantile(0.5), nanoseconds(0));
+  std::mt19937 random(3);
+  std::lognormal_distribution<double> durationMs(1.5, 0.8);
+  std::vector<double> exact;
+  for (int i = 0; i < 5000; ++i) {
+    exact.push_back(durationMs(random));
+    histogram.record(std::chrono::duration_cast<nanoseconds>(
+        std::chrono::duration<double, std::milli>(exact.back())));
+  }
+  std::ranges::sort(exact);
+  EXPECT_EQ(histogram.count(), 5000u);
+  for (const double q : {0.5, 0.9, 0.99}) {
+    const double want = exact[static_cast<std::size_t>(q * 5000) - 1];
+    const double got = std::chrono::duration<double, std::milli>(histogram.quantile(q)).count();
+    // The upper edge of the bucket the exact quantile falls in: above it by less than one bucket.
+    EXPECT_GE(got, want) << q;
+    EXPECT_LT(got, want * 1.06) << q;
+  }
+}
+
+TEST(DurationHistogram, EdgesAndOutOfRangeDurations) {
+  DurationHistogram histogram;
+  histogram.record(nanoseconds(10));        // below 1 µs: the first bucket
+  histogram.record(std::chrono::hours(1));  // above 100 s: the last
+  EXPECT_EQ(histogram.quantile(0.5), DurationHistogram::upperEdge(0));
+  EXPECT_EQ(histogram.quantile(1.0), DurationHistogram::upperEdge(DurationHistogram::kBuckets - 1));
+  EXPECT_EQ(DurationHistogram::upperEdge(39), microseconds(10));
+  EXPECT_EQ(DurationHistogram::upperEdge(159), milliseconds(10));
+  DurationHistogram exact;
+  exact.record(milliseconds(10));  // exactly on an edge: the bucket it closes
+  EXPECT_EQ(exact.quantile(0.5), milliseconds(10));
+}
+
+PipelineReport sampleReport() {
+  PipelineReport report;
+  report.elapsed = std::chrono::seconds(10);
+  report.frameSets = 300;
+  report.staleDropped = 4;
+  report.sync.unmatchedDropped[1] = 2;
+  report.sync.lateMissing[2] = 5;
+  report.cameras = {{"front", capture::CameraHealth::kOk, {300, 0, {}}, 1},
+                    {"right", capture::CameraHealth::kFrozen, {298, 1, {}}, 0},
+                    {"back", capture::CameraHealth::kOutOfSync, {295, 0, {}}, 2}};
+  for (int i = 1; i <= 100; ++i) {
+    report.stages[static_cast<std::size_t>(Stage::kStitch)].record(microseconds(100 * i));
+    report.latency.record(milliseconds(30 + i % 7));
+  }
+  report.outputs = 2;
+  return report;
+}
+
+TEST(PipelineReport, StatusNamesEveryCameraStageAndLatency) {
+  const std::string text = statusText(sampleReport());
+  EXPECT_THAT(text, ::testing::HasSubstr("30.0 fps"));
+  EXPECT_THAT(text, ::testing::HasSubstr("front ok, right frozen, back out of sync"));
+  EXPECT_THAT(text, ::testing::HasSubstr("stale sets skipped: 4"));
+  EXPECT_THAT(text, ::testing::ContainsRegex(
+                        "stage stitch +p50 +5\\.01 ms +p99 +10\\.00 ms +\\(100 sets, 10\\.0/s\\)"));
+  EXPECT_THAT(text, ::testing::HasSubstr("latency capture to output: p50 33.5 ms"));
+  EXPECT_THAT(text,
+              ::testing::HasSubstr("camera back: out of sync, 295 frames, 0 faults, 2 queued"));
+  EXPECT_THAT(text, ::testing::Not(::testing::HasSubstr("stage render")));  // nothing recorded
+}
+
+TEST(PipelineReport, PrometheusTextFollowsTheExpositionFormat) {
+  const std::string text = prometheusText(sampleReport());
+  const std::regex help("# HELP (surroundd_[a-z_]+) .+");
+  const std::regex type("# TYPE (surroundd_[a-z_]+) (counter|gauge|summary)");
+  const std::regex sample(
+      R"((surroundd_[a-z_]+)(\{[a-z]+="[^"]*"(,[a-z]+="[^"]*")*\})? (-?[0-9]+(\.[0-9]+)?))");
+  std::istringstream lines(text);
+  std::string line;
+  std::string family;  // the family whose samples may follow
+  std::set<std::string> seen;
+  std::map<std::string, double> values;
+  while (std::getline(lines, line)) {
+    std::smatch match;
+    if (std::regex_match(line, match, help)) {
+      EXPECT_TRUE(seen.insert(match[1]).second) << "family declared twice: " << line;
+      family = match[1];
+      continue;
+    }
+    if (std::regex_match(line, match, type)) {
+      EXPECT_EQ(match[1], family) << line;
+      continue;
+    }
+    ASSERT_TRUE(std::regex_match(line, match, sample)) << "not a sample line: '" << line << "'";
+    const std::string name = match[1];
+    // Samples of a family are together, right after its HELP and TYPE.
+    EXPECT_TRUE(name == family || name == family + "_sum" || name == family + "_count") << line;
+    values[line.substr(0, line.rfind(' '))] = std::stod(match[4]);
+  }
+  EXPECT_EQ(values["surroundd_frame_sets_total"], 300);
+  EXPECT_EQ(values["surroundd_stale_sets_dropped_total"], 4);
+  EXPECT_NEAR(values["surroundd_stage_seconds{stage=\"stitch\",quantile=\"0.5\"}"], 0.00501, 1e-5);
+  EXPECT_EQ(values["surroundd_stage_seconds_count{stage=\"stitch\"}"], 100);
+  EXPECT_EQ(values["surroundd_stage_seconds_count{stage=\"render\"}"], 0);
+  EXPECT_EQ(values["surroundd_latency_seconds_count"], 100);
+  EXPECT_EQ(values["surroundd_camera_healthy{camera=\"right\"}"], 0);
+  EXPECT_EQ(values["surroundd_camera_health{camera=\"right\",state=\"frozen\"}"], 1);
+  EXPECT_EQ(values["surroundd_camera_sync_dropped_total{camera=\"right\"}"], 2);
+  EXPECT_EQ(values["surroundd_camera_sets_without_total{camera=\"back\"}"], 5);
+  EXPECT_EQ(values["surroundd_camera_queue_depth{camera=\"back\"}"], 2);
+}
+
+}  // namespace
+}  // namespace surroundd::daemon

@@ -1,0 +1,224 @@
+// surroundd as a service, end to end: the control socket and surroundctl, reload with a bad and a
+// good config (SIGHUP and `reload`), SIGTERM leaving playable files, and the watchdog going quiet
+// when a stage stalls. The rig replays the small synthetic recording in a loop, in real time.
+
+#include <regex>
+#include <thread>
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "daemon/control_protocol.hpp"
+#include "daemon/rig_yaml.hpp"
+#include "tests/support/child_process.hpp"
+#include "tests/support/notify_socket.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace surroundd::daemon {
+namespace {
+
+using ::testing::HasSubstr;
+using namespace std::chrono_literals;
+
+const std::filesystem::path kRecording =
+    std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
+
+class ServiceTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    // The recording's rig, looping: the daemon runs until it is told to stop.
+    auto cameras = loadRigFile(kRecording / "rig.yaml");
+    for (auto& camera : cameras) camera.source->loop = true;
+    writeRigFile(dir_ / "rig.yaml", cameras, "looping replay");
+    std::filesystem::remove_all(socket_.parent_path());
+  }
+  void TearDown() override { std::filesystem::remove_all(socket_.parent_path()); }
+
+  std::filesystem::path writeConfig(std::string_view outputs, std::string_view extra = "") const {
+    return dir_.write("config.yaml", fmt::format(R"(rig: {{file: rig.yaml}}
+pipeline: {{threads: 2}}
+panorama: {{width_px: 512, height_px: 256, cache_dir: lut-cache}}
+render: {{width_px: 320, height_px: 240, view: orbit}}
+control: {{socket: {}}}
+{}
+outputs:
+{})",
+                                                 socket_.string(), extra, outputs));
+  }
+
+  std::unique_ptr<testing::ChildProcess> start(const std::filesystem::path& config,
+                                               std::vector<std::string> environment = {}) const {
+    return std::make_unique<testing::ChildProcess>(
+        std::vector<std::string>{SURROUNDD_EXECUTABLE, "--config", config.string()},
+        dir_ / "log.txt", std::move(environment));
+  }
+
+  ControlReply request(std::string_view line) const {
+    return sendControlRequest(socket_, line, 20s);
+  }
+
+  // Frame sets of the running pipeline, from `status` (waits for the socket to appear).
+  std::uint64_t frameSets(testing::ChildProcess& surroundd) const {
+    for (auto deadline = std::chrono::steady_clock::now() + 30s;
+         std::chrono::steady_clock::now() < deadline && surroundd.running();
+         std::this_thread::sleep_for(50ms)) {
+      if (!std::filesystem::exists(socket_)) continue;
+      const auto reply = request("status");
+      std::smatch match;
+      if (reply.ok && std::regex_search(reply.body, match, std::regex("^([0-9]+) frame sets"))) {
+        return std::stoull(match[1]);
+      }
+    }
+    ADD_FAILURE() << "no status from surroundd: " << surroundd.output();
+    return 0;
+  }
+  // Waits until the pipeline has gone through at least `sets` frame sets.
+  void waitForSets(testing::ChildProcess& surroundd, std::uint64_t sets) const {
+    const auto deadline = std::chrono::steady_clock::now() + 30s;
+    while (frameSets(surroundd) < sets && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(50ms);
+    }
+  }
+
+  testing::TempDir dir_;
+  // Short: a socket path must fit in 108 bytes.
+  std::filesystem::path socket_ =
+      std::filesystem::temp_directory_path() / fmt::format("sd-svc-{}", ::getpid()) / "c.sock";
+};
+
+TEST_F(ServiceTest, ControlRequestsRoundTripAndSigtermLeavesPlayableFiles) {
+  auto surroundd = start(writeConfig(R"(  - {type: video, stream: surround, path: out/orbit.mp4}
+  - {type: video, stream: mosaic, path: out/mosaic.mkv})"));
+  waitForSets(*surroundd, 10);
+
+  const auto status = request("status");
+  ASSERT_TRUE(status.ok) << status.body;
+  EXPECT_THAT(status.body, HasSubstr("front ok, right ok, back ok, left ok"));
+  for (const char* stage : {"sync", "stitch", "correct", "render", "read-back", "output"}) {
+    EXPECT_THAT(status.body, ::testing::ContainsRegex(fmt::format("stage {} +p50", stage)));
+  }
+  EXPECT_THAT(status.body, HasSubstr("latency capture to output: p50"));
+
+  const auto metrics = request("metrics");
+  ASSERT_TRUE(metrics.ok);
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(metrics.body, match,
+                                std::regex("\nsurroundd_frame_sets_total ([0-9]+)\n")));
+  EXPECT_GE(std::stoi(match[1]), 10);
+  EXPECT_THAT(metrics.body, HasSubstr("surroundd_latency_seconds{quantile=\"0.99\"}"));
+  EXPECT_THAT(metrics.body, HasSubstr("surroundd_camera_healthy{camera=\"left\"} 1"));
+
+  // The view switches: the next snapshot is a top view, unlike the orbit before it.
+  const auto before = request("snapshot");
+  ASSERT_TRUE(before.ok) << before.body;
+  const auto orbit =
+      cv::imdecode(std::vector<uchar>(before.body.begin(), before.body.end()), cv::IMREAD_COLOR);
+  ASSERT_EQ(orbit.size(), cv::Size(320, 240));
+  ASSERT_TRUE(request("view top").ok);
+  const auto sets = frameSets(*surroundd);
+  waitForSets(*surroundd, sets + 3);
+  const auto after = request("snapshot");
+  ASSERT_TRUE(after.ok);
+  const auto top =
+      cv::imdecode(std::vector<uchar>(after.body.begin(), after.body.end()), cv::IMREAD_COLOR);
+  ASSERT_EQ(top.size(), cv::Size(320, 240));
+  EXPECT_GT(cv::norm(orbit, top, cv::NORM_L1) / static_cast<double>(orbit.total() * 3), 10.0);
+  EXPECT_THAT(request("view sideways").body, HasSubstr("unknown view 'sideways'"));
+
+  // surroundctl itself.
+  testing::ChildProcess ctl({SURROUNDCTL_EXECUTABLE, "--socket", socket_.string(), "metrics"},
+                            dir_ / "ctl.txt");
+  EXPECT_EQ(ctl.wait(), 0);
+  EXPECT_THAT(ctl.output(), HasSubstr("# TYPE surroundd_stage_seconds summary"));
+  testing::ChildProcess bad({SURROUNDCTL_EXECUTABLE, "--socket", socket_.string(), "view", "x"},
+                            dir_ / "bad.txt");
+  EXPECT_EQ(bad.wait(), 1);
+  EXPECT_THAT(bad.output(), HasSubstr("surroundctl: surroundd says: unknown view 'x'"));
+
+  surroundd->signal(SIGTERM);
+  EXPECT_EQ(surroundd->wait(), 0) << surroundd->output();
+  EXPECT_THAT(surroundd->output(), HasSubstr("stop requested: finalizing outputs"));
+  EXPECT_FALSE(std::filesystem::exists(socket_));  // removed on the way out
+  for (const char* file : {"out/orbit.mp4", "out/mosaic.mkv"}) {
+    const auto video = testing::decodeAll(dir_ / file);
+    EXPECT_EQ(video.last, capture::ReadStatus::kEndOfStream) << file;
+    EXPECT_GE(video.images.size(), 10u) << file;
+  }
+}
+
+TEST_F(ServiceTest, AReloadWithABadConfigIsRejectedAndAGoodOneRestartsTheOutputs) {
+  const auto config = writeConfig(R"(  - {type: video, stream: mosaic, path: out/first.mp4})");
+  auto surroundd = start(config);
+  waitForSets(*surroundd, 5);
+
+  // A bad config, by SIGHUP: rejected, logged, and the pipeline goes on.
+  writeConfig(R"(  - {type: video, stream: mosaic, path: out/first.mp4, crf: 99})");
+  const auto sets = frameSets(*surroundd);
+  surroundd->signal(SIGHUP);
+  waitForSets(*surroundd, sets + 10);
+  EXPECT_GT(frameSets(*surroundd), sets + 9);  // the same run: its count went on
+  EXPECT_THAT(surroundd->output(), HasSubstr("reload rejected"));
+  EXPECT_THAT(surroundd->output(), HasSubstr("crf"));
+
+  // The same through the socket: the client hears why.
+  const auto rejected = request("reload");
+  EXPECT_FALSE(rejected.ok);
+  EXPECT_THAT(rejected.body, HasSubstr("config rejected, the running one goes on"));
+
+  // A good one: the first file is finalized, the new outputs start under new names.
+  writeConfig(R"(  - {type: video, stream: mosaic, path: out/first.mp4}
+  - {type: snapshot, stream: mosaic, path: out/still.png, at_s: 0.1})");
+  const auto accepted = request("reload");
+  EXPECT_TRUE(accepted.ok) << accepted.body;
+  std::this_thread::sleep_for(300ms);
+  waitForSets(*surroundd, 5);
+  surroundd->signal(SIGTERM);
+  EXPECT_EQ(surroundd->wait(), 0) << surroundd->output();
+  const auto first = testing::decodeAll(dir_ / "out/first.mp4");
+  EXPECT_EQ(first.last, capture::ReadStatus::kEndOfStream);
+  EXPECT_GE(first.images.size(), 15u);
+  const auto second = testing::decodeAll(dir_ / "out/first-1.mp4");
+  EXPECT_EQ(second.last, capture::ReadStatus::kEndOfStream);
+  EXPECT_GE(second.images.size(), 5u);
+  EXPECT_FALSE(cv::imread((dir_ / "out/still-1.png").string()).empty());
+  EXPECT_THAT(surroundd->output(), HasSubstr("reload: starting the pipeline for the new config"));
+}
+
+TEST_F(ServiceTest, AStalledOutputStageStopsTheWatchdogPings) {
+  // The output's file is a FIFO nobody reads: once its buffer is full, writing blocks, like a
+  // storage device that hangs.
+  std::filesystem::create_directories(dir_ / "out");
+  ASSERT_EQ(::mkfifo((dir_ / "out/stall.mkv.part").c_str(), 0600), 0);
+  testing::NotifySocket notify(dir_ / "notify");
+  auto surroundd =
+      start(writeConfig(R"(  - {type: video, stream: mosaic, path: out/stall.mkv, crf: 0})"),
+            {"NOTIFY_SOCKET=" + (dir_ / "notify").string(), "WATCHDOG_USEC=200000"});
+  // Opening the read end lets the daemon's open() return; nothing is ever read.
+  const int reader = ::open((dir_ / "out/stall.mkv.part").c_str(), O_RDONLY | O_NONBLOCK);
+  ASSERT_GE(reader, 0);
+  std::vector<testing::NotifySocket::Message> messages;
+  for (const auto end = std::chrono::steady_clock::now() + 6s;
+       std::chrono::steady_clock::now() < end;) {
+    if (auto message = notify.receive()) messages.push_back(std::move(*message));
+  }
+  ASSERT_TRUE(surroundd->running()) << surroundd->output();
+  ::close(reader);
+  const auto pings =
+      std::ranges::count_if(messages, [](const auto& m) { return m.text == "WATCHDOG=1"; });
+  ASSERT_FALSE(messages.empty());
+  EXPECT_EQ(messages.front().text, "READY=1");
+  EXPECT_GE(pings, 1);
+  // The last ping came early: for the rest of the 6 s (several watchdog periods) there were none.
+  const auto lastPing = std::ranges::find_if(messages.rbegin(), messages.rend(),
+                                             [](const auto& m) { return m.text == "WATCHDOG=1"; });
+  ASSERT_NE(lastPing, messages.rend());
+  EXPECT_GT(std::chrono::steady_clock::now() - lastPing->at, 3s);
+}
+
+}  // namespace
+}  // namespace surroundd::daemon

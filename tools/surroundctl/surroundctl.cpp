@@ -1,0 +1,92 @@
+// surroundctl: asks a running surroundd for its status or metrics, switches its view, takes a
+// snapshot or makes it reload its config (protocol: daemon/control_protocol.hpp).
+//
+// Exit codes: 0 done, 1 surroundd answered with an error or could not be reached, 2 bad usage.
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <string_view>
+
+#include <fmt/format.h>
+
+#include "daemon/control_protocol.hpp"
+
+namespace {
+
+using namespace surroundd;
+
+constexpr std::string_view kUsage = R"(usage: surroundctl [--socket PATH] COMMAND
+
+commands:
+  status            frame rate, per-stage p50/p99 milliseconds, latency, each camera's health
+  metrics           the same and more in Prometheus text format
+  view NAME         switch the surround outputs to top, 360, orbit or split
+  snapshot FILE     save the newest output picture as a PNG
+  reload            read the config file again (a bad one is rejected; the old one keeps running)
+
+  --socket PATH     surroundd's control socket (default: $RUNTIME_DIRECTORY/control.sock, else
+                    $XDG_RUNTIME_DIR/surroundd/control.sock, else /run/surroundd/control.sock)
+)";
+
+// A reload restarts the pipeline; building it can take a few seconds.
+constexpr std::chrono::seconds kTimeout{30};
+
+int usage(std::string_view message) {
+  fmt::print(stderr, "surroundctl: {}\n{}", message, kUsage);
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::filesystem::path socket = daemon::defaultControlSocket();
+  if (socket.empty()) socket = "/run/surroundd/control.sock";
+  int i = 1;
+  if (i < argc && std::string_view(argv[i]) == "--socket") {
+    if (i + 1 >= argc) return usage("--socket needs a path");
+    socket = argv[i + 1];
+    i += 2;
+  }
+  if (i < argc && (std::string_view(argv[i]) == "--help" || std::string_view(argv[i]) == "-h")) {
+    fmt::print("{}", kUsage);
+    return 0;
+  }
+  if (i >= argc) return usage("no command");
+  const std::string_view command = argv[i];
+  std::string request(command);
+  std::filesystem::path snapshotFile;
+  if (command == "view") {
+    if (i + 2 != argc) return usage("view needs one NAME");
+    request += fmt::format(" {}", argv[i + 1]);
+  } else if (command == "snapshot") {
+    if (i + 2 != argc) return usage("snapshot needs one FILE");
+    snapshotFile = argv[i + 1];
+  } else if (i + 1 != argc) {
+    return usage(fmt::format("'{}' takes no argument", command));
+  }
+
+  try {
+    const auto reply = daemon::sendControlRequest(socket, request, kTimeout);
+    if (!reply.ok) {
+      fmt::print(stderr, "surroundctl: surroundd says: {}\n", reply.body);
+      return 1;
+    }
+    if (snapshotFile.empty()) {
+      fmt::print("{}", reply.body);
+      return 0;
+    }
+    std::ofstream out(snapshotFile, std::ios::binary);
+    out.write(reply.body.data(), static_cast<std::streamsize>(reply.body.size()));
+    out.close();
+    if (!out) {
+      fmt::print(stderr, "surroundctl: cannot write {}\n", snapshotFile.string());
+      return 1;
+    }
+    fmt::print("{}: {} bytes\n", snapshotFile.string(), reply.body.size());
+    return 0;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "surroundctl: {}\n", e.what());
+    return 1;
+  }
+}
