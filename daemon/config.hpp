@@ -28,6 +28,10 @@ struct CaptureConfig {
   double syncToleranceMs = 10.0;  // frames further apart than this are not one set
   int queueFrames = 4;        // frames buffered per camera between its thread and the synchronizer
   double lateAfterMs = 50.0;  // live: a set waits this long for a late camera, then goes without
+  // Skip to the newest frame set when every camera has a newer frame waiting (and let an encoder
+  // drop its oldest picture): auto = only with live cameras; always also for replays (to see a
+  // replay as a live rig would show it), never keeps every set.
+  enum class LatestWins { kAuto, kAlways, kNever } latestWins = LatestWins::kAuto;
 
   bool operator==(const CaptureConfig&) const = default;
 };

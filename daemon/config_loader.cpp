@@ -70,6 +70,11 @@ void readCapture(YamlObject& section, CaptureConfig& c) {
   c.queueFrames = section.integer("queue_frames", c.queueFrames, 1, 64);
   c.lateAfterMs =
       section.number("late_after_ms", c.lateAfterMs, {1.0, 10000.0, false, "milliseconds"});
+  using LatestWins = CaptureConfig::LatestWins;
+  c.latestWins = section.choice("latest_wins", c.latestWins,
+                                {{"auto", LatestWins::kAuto},
+                                 {"always", LatestWins::kAlways},
+                                 {"never", LatestWins::kNever}});
   section.finish();
 }
 

@@ -130,6 +130,8 @@ Pipeline::Pipeline(const Config& config)
                     std::chrono::duration_cast<capture::Timestamp>(
                         std::chrono::duration<double, std::milli>(config.capture.syncToleranceMs))),
       live_(std::ranges::any_of(config.cameras, [](const RigCamera& c) { return c.live(); })),
+      latestWins_(config.capture.latestWins == CaptureConfig::LatestWins::kAlways ||
+                  (config.capture.latestWins == CaptureConfig::LatestWins::kAuto && live_)),
       lateAfter_(std::chrono::duration_cast<capture::Timestamp>(
           std::chrono::duration<double, std::milli>(config.capture.lateAfterMs))),
       health_(cameras_.size()),
@@ -170,7 +172,7 @@ Pipeline::Pipeline(const Config& config)
       out.http = http.get();
       out.sink = std::move(http);
     } else {
-      out.sink = openSink(output, size, nominalFps, live_);
+      out.sink = openSink(output, size, nominalFps, latestWins_);
     }
     if (output.stream == OutputStream::kSurround) {
       out.view = std::make_unique<render::SurroundView>(*scene_, size, view, config.render.views);
@@ -244,6 +246,8 @@ PipelineReport Pipeline::report() const {
   report.latency = latency_;
   report.outputs = outputs_.size() + recorders_.size();
   report.failedOutputs = failedSinks_;
+  for (const auto& output : outputs_)
+    report.outputDropped += output.sink ? output.sink->dropped() : 0;
   if (gl_) report.renderer = gl_->description();
   return report;
 }
@@ -266,7 +270,7 @@ RunSummary Pipeline::run(const std::atomic<bool>& stop, PipelineObserver* observ
     auto since = Clock::now();
     fillNeeds(stop);
     setStageTime_[static_cast<std::size_t>(Stage::kSync)] += Clock::now() - since;
-    while (auto set = nextSet()) {
+    while (auto set = nextSet(stop)) {
       stageTime_[static_cast<std::size_t>(Stage::kSync)] +=
           setStageTime_[static_cast<std::size_t>(Stage::kSync)];
       setStagesRun_.set(static_cast<std::size_t>(Stage::kSync));
@@ -289,16 +293,20 @@ RunSummary Pipeline::run(const std::atomic<bool>& stop, PipelineObserver* observ
   return summary;
 }
 
-std::optional<capture::FrameSet> Pipeline::nextSet() {
-  if (!live_) return synchronizer_.pop();
-  // Live timestamps are CLOCK_MONOTONIC, which is steady_clock here.
-  auto newest = synchronizer_.pop();
-  if (!newest) return synchronizer_.popLate(Clock::now().time_since_epoch(), lateAfter_);
-  while (auto newer = synchronizer_.pop()) {
+std::optional<capture::FrameSet> Pipeline::nextSet(const std::atomic<bool>& stop) {
+  auto set = synchronizer_.pop();
+  const auto newerWaiting = [this] {
+    return std::ranges::all_of(cameras_, [](const auto& camera) { return camera->queued() > 0; });
+  };
+  while (latestWins_ && set && newerWaiting() && !stop) {
     ++staleDropped_;
-    newest = std::move(newer);
+    set.reset();  // its frames go back to their pools
+    fillNeeds(stop);
+    set = synchronizer_.pop();
   }
-  return newest;
+  // Live timestamps are CLOCK_MONOTONIC, which is steady_clock here.
+  if (!set && live_) set = synchronizer_.popLate(Clock::now().time_since_epoch(), lateAfter_);
+  return set;
 }
 
 void Pipeline::timed(Stage stage, Clock::time_point& since) {

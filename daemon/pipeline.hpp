@@ -109,8 +109,8 @@ class Pipeline {
   };
 
   void fillNeeds(const std::atomic<bool>& stop);
-  // Live: the newest complete set, the older ones counted as stale; replay: the next set.
-  std::optional<capture::FrameSet> nextSet();
+  // The next complete set; with latestWins_, the newest, the older ones counted as stale.
+  std::optional<capture::FrameSet> nextSet(const std::atomic<bool>& stop);
   void process(const capture::FrameSet& set);
   Clock::time_point captureTimeOf(const capture::FrameSet& set) const;
   void handOver(Output& output, const cv::Mat& picture, std::chrono::nanoseconds streamTime,
@@ -133,7 +133,8 @@ class Pipeline {
 
   std::vector<std::unique_ptr<capture::CameraStream>> cameras_;
   capture::Synchronizer synchronizer_;
-  bool live_;  // V4L2 cameras: sets go without a late camera
+  bool live_;        // V4L2 cameras: sets go without a late camera
+  bool latestWins_;  // stale sets are skipped, encoders drop their oldest picture
   capture::Timestamp lateAfter_;
   capture::CameraHealthMonitor health_;
   std::array<const char*, capture::kMaxCameras> faults_{};  // per camera: what is wrong, or null

@@ -55,8 +55,9 @@ std::string statusLine(const PipelineReport& report) {
 std::string statusText(const PipelineReport& report) {
   std::string out = fmt::format("{} frame sets in {:.1f} s: {}\n", report.frameSets,
                                 report.elapsed.count(), statusLine(report));
-  fmt::format_to(std::back_inserter(out), "stale sets skipped: {}; outputs: {} ({} failed)\n",
-                 report.staleDropped, report.outputs, report.failedOutputs);
+  fmt::format_to(std::back_inserter(out),
+                 "stale sets skipped: {}; outputs: {} ({} failed, {} pictures dropped)\n",
+                 report.staleDropped, report.outputs, report.failedOutputs, report.outputDropped);
   if (!report.renderer.empty())
     fmt::format_to(std::back_inserter(out), "render: {}\n", report.renderer);
   for (std::size_t s = 0; s < kStageCount; ++s) {
@@ -153,6 +154,10 @@ std::string prometheusText(const PipelineReport& report) {
   family(out, "sync_skew_seconds", "gauge", "Mean newest-minus-oldest timestamp within a set.");
   fmt::format_to(std::back_inserter(out), "surroundd_sync_skew_seconds {:.6f}\n",
                  seconds(report.sync.meanSpread()));
+  family(out, "output_pictures_dropped_total", "counter",
+         "Pictures outputs dropped because they fell behind (live: the newest wins).");
+  fmt::format_to(std::back_inserter(out), "surroundd_output_pictures_dropped_total {}\n",
+                 report.outputDropped);
   family(out, "outputs_failed_total", "counter", "Outputs dropped after an error.");
   fmt::format_to(std::back_inserter(out), "surroundd_outputs_failed_total {}\n",
                  report.failedOutputs);

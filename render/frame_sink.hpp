@@ -34,6 +34,8 @@ class FrameSink {
   virtual void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) = 0;
   // What was written, for the log ("video /out/demo/mosaic.mp4 (300 frames)").
   virtual std::string describe() const = 0;
+  // Pictures it was given but dropped because it fell behind (see QueuedSink).
+  virtual std::uint64_t dropped() const { return 0; }
 };
 
 // H.264 video (see VideoEncoder): one file, a network stream, or files of `segmentLength` stream

@@ -35,7 +35,7 @@ class QueuedSink final : public FrameSink {
   void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) override;
   std::string describe() const override;
 
-  std::uint64_t dropped() const;
+  std::uint64_t dropped() const override;
 
  private:
   struct Item {

@@ -69,6 +69,7 @@ PipelineReport sampleReport() {
     report.latency.record(milliseconds(30 + i % 7));
   }
   report.outputs = 2;
+  report.outputDropped = 3;
   return report;
 }
 
@@ -76,7 +77,8 @@ TEST(PipelineReport, StatusNamesEveryCameraStageAndLatency) {
   const std::string text = statusText(sampleReport());
   EXPECT_THAT(text, ::testing::HasSubstr("30.0 fps"));
   EXPECT_THAT(text, ::testing::HasSubstr("front ok, right frozen, back out of sync"));
-  EXPECT_THAT(text, ::testing::HasSubstr("stale sets skipped: 4"));
+  EXPECT_THAT(text, ::testing::HasSubstr(
+                        "stale sets skipped: 4; outputs: 2 (0 failed, 3 pictures dropped)"));
   EXPECT_THAT(text, ::testing::ContainsRegex(
                         "stage stitch +p50 +5\\.01 ms +p99 +10\\.00 ms +\\(100 sets, 10\\.0/s\\)"));
   EXPECT_THAT(text, ::testing::HasSubstr("latency capture to output: p50 33.5 ms"));
@@ -115,6 +117,7 @@ TEST(PipelineReport, PrometheusTextFollowsTheExpositionFormat) {
   }
   EXPECT_EQ(values["surroundd_frame_sets_total"], 300);
   EXPECT_EQ(values["surroundd_stale_sets_dropped_total"], 4);
+  EXPECT_EQ(values["surroundd_output_pictures_dropped_total"], 3);
   EXPECT_NEAR(values["surroundd_stage_seconds{stage=\"stitch\",quantile=\"0.5\"}"], 0.00501, 1e-5);
   EXPECT_EQ(values["surroundd_stage_seconds_count{stage=\"stitch\"}"], 100);
   EXPECT_EQ(values["surroundd_stage_seconds_count{stage=\"render\"}"], 0);

@@ -106,6 +106,35 @@ TEST_F(ReplayTest, PipelineLosesOnlyTheSetsOfTheDroppedFrames) {
   EXPECT_TRUE(std::filesystem::exists(dir / "last.png"));
 }
 
+// Seen as live: the cameras decode far faster than the panorama is made, so sets go stale while
+// the pipeline works; they are skipped and counted, and no set is lost without being counted.
+TEST_F(ReplayTest, LatestWinsSkipsStaleSetsAndCountsThem) {
+  const testing::TempDir dir;
+  config_.capture.pacing = capture::Pacing::kAsFastAsPossible;
+  OutputConfig panorama;
+  panorama.kind = OutputKind::kSnapshot;
+  panorama.stream = OutputStream::kPanorama;
+  panorama.path = dir / "last.png";
+  panorama.atSeconds = 1e6;
+  config_.outputs = {panorama};
+  const auto replay = [&](CaptureConfig::LatestWins latestWins) {
+    config_.capture.latestWins = latestWins;
+    Pipeline pipeline(config_);
+    const std::atomic<bool> stop{false};
+    return pipeline.run(stop);
+  };
+  const RunSummary every = replay(CaptureConfig::LatestWins::kAuto);  // files: every set
+  EXPECT_EQ(every.report.staleDropped, 0u);
+  const RunSummary newest = replay(CaptureConfig::LatestWins::kAlways);
+  EXPECT_GT(newest.report.staleDropped, 0u);
+  EXPECT_LT(newest.frameSets, every.frameSets);
+  EXPECT_EQ(newest.frameSets + newest.report.staleDropped, every.frameSets);
+  for (std::size_t c = 0; c < timestamps_.size(); ++c) {
+    EXPECT_EQ(newest.cameras[c].frames, timestamps_[c].size()) << c;  // every frame was read
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir / "last.png"));
+}
+
 TEST_F(ReplayTest, AVideoOfAnotherSizeThanItsCalibrationIsRefused) {
   config_.cameras[1].calibration.intrinsics.imageSize = {640, 360};
   try {
