@@ -229,6 +229,7 @@ Pipeline::~Pipeline() = default;
 void Pipeline::setView(ViewKind view) {
   for (auto& output : outputs_) {
     if (output.view) output.view->setView(view);
+    if (output.http != nullptr && output.view) output.http->setActiveView(toString(view));
   }
 }
 

@@ -90,6 +90,8 @@ async function refreshStatus() {
     const response = await fetch("/status.json", {cache: "no-store"});
     if (!response.ok) throw new Error(`HTTP ${response.status}`);
     showStatus(await response.json());
+    // The view may also be switched from elsewhere (surroundctl view).
+    markView((await (await fetch("/views.json", {cache: "no-store"})).json()).active);
     box.dataset.state = "ok";
     box.dataset.updates = String(++updates);
     byId("connection").textContent = "live";

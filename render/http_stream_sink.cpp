@@ -342,4 +342,9 @@ std::optional<std::string> HttpStreamSink::takeViewRequest() {
   return std::exchange(impl_->requestedView, std::nullopt);
 }
 
+void HttpStreamSink::setActiveView(std::string name) {
+  std::lock_guard lock(impl_->controlMutex);
+  impl_->activeView = std::move(name);
+}
+
 }  // namespace surroundd::render

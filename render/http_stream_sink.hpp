@@ -66,6 +66,8 @@ class HttpStreamSink final : public FrameSink {
   void setStatus(std::string json);
   // The view last asked for by POST /view, once; nullopt if none since the last call.
   std::optional<std::string> takeViewRequest();
+  // The view shown now, when it was switched another way (surroundctl): the page marks it.
+  void setActiveView(std::string name);
 
  private:
   struct Impl;

@@ -16,6 +16,7 @@
 #include "daemon/control_protocol.hpp"
 #include "daemon/rig_yaml.hpp"
 #include "tests/support/child_process.hpp"
+#include "tests/support/http_client.hpp"
 #include "tests/support/notify_socket.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -93,7 +94,8 @@ outputs:
 
 TEST_F(ServiceTest, ControlRequestsRoundTripAndSigtermLeavesPlayableFiles) {
   auto surroundd = start(writeConfig(R"(  - {type: video, stream: surround, path: out/orbit.mp4}
-  - {type: video, stream: mosaic, path: out/mosaic.mkv})"));
+  - {type: video, stream: mosaic, path: out/mosaic.mkv}
+  - {type: http, stream: surround, listen: "127.0.0.1:0"})"));
   waitForSets(*surroundd, 10);
 
   const auto status = request("status");
@@ -128,6 +130,12 @@ TEST_F(ServiceTest, ControlRequestsRoundTripAndSigtermLeavesPlayableFiles) {
       cv::imdecode(std::vector<uchar>(after.body.begin(), after.body.end()), cv::IMREAD_COLOR);
   ASSERT_EQ(top.size(), cv::Size(320, 240));
   EXPECT_GT(cv::norm(orbit, top, cv::NORM_L1) / static_cast<double>(orbit.total() * 3), 10.0);
+  // The live page marks the view it was switched to.
+  std::smatch port;
+  const std::string log = surroundd->output();
+  ASSERT_TRUE(std::regex_search(log, port, std::regex("HTTP stream: http://127.0.0.1:([0-9]+)/")));
+  EXPECT_THAT(testing::httpRequest(std::stoi(port[1]), "GET", "/views.json").body,
+              HasSubstr(R"("active": "top")"));
   EXPECT_THAT(request("view sideways").body, HasSubstr("unknown view 'sideways'"));
 
   // surroundctl itself.

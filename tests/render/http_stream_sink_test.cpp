@@ -174,6 +174,11 @@ TEST(HttpStreamSink, ViewRequestsAreHandedOverOnce) {
   EXPECT_EQ(httpRequest(sink.port(), "POST", "/view").status, 400);
   EXPECT_EQ(httpRequest(sink.port(), "GET", "/view?name=top").status, 405);
   EXPECT_EQ(sink.takeViewRequest(), std::nullopt);
+
+  // Switched another way (surroundctl view): the page is told, and no request is made of it.
+  sink.setActiveView("360");
+  EXPECT_THAT(httpRequest(sink.port(), "GET", "/views.json").body, HasSubstr(R"("active": "360")"));
+  EXPECT_EQ(sink.takeViewRequest(), std::nullopt);
 }
 
 TEST(HttpStreamSink, ServesThePageAndRefusesUnknownPathsAndMethods) {
