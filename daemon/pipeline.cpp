@@ -5,14 +5,8 @@
 
 #include <spdlog/spdlog.h>
 
-#include "capture/file_source.hpp"
-#include "capture/libcamera_source.hpp"
-#include "capture/v4l2_source.hpp"
 #include "daemon/panorama_setup.hpp"
-#include "render/drm_display_sink.hpp"
-#include "render/http_stream_sink.hpp"
-#include "render/queued_sink.hpp"
-#include "render/x11_window_sink.hpp"
+#include "daemon/pipeline_ends.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -23,104 +17,6 @@ constexpr std::chrono::milliseconds kCameraWait{200};
 constexpr std::chrono::milliseconds kLiveCameraWait{2};
 constexpr std::chrono::seconds kProgressInterval{10};
 constexpr std::chrono::seconds kPageStatusInterval{1};
-
-std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& config) {
-  // Each camera's queue, plus one frame waiting in the synchronizer and one being composed.
-  const auto poolFrames = static_cast<std::size_t>(config.capture.queueFrames) + 2;
-  std::vector<std::unique_ptr<capture::CameraStream>> cameras;
-  for (const auto& camera : config.cameras) {
-    const auto& name = camera.calibration.name;
-    std::unique_ptr<capture::FrameSource> source;
-    std::string origin;
-    int maxConsecutiveFaults = 30;  // a replay that keeps failing ends
-    if (camera.libcamera) {
-      source = std::make_unique<capture::LibcameraSource>(name, *camera.libcamera);
-      origin = fmt::format("libcamera {}", camera.libcamera->camera);
-      maxConsecutiveFaults = 0;
-    } else if (camera.device) {
-      auto device = std::make_unique<capture::V4l2Source>(name, *camera.device);
-      origin = fmt::format("{} ({})", camera.device->device.string(),
-                           capture::toString(device->format()));
-      source = std::move(device);
-      maxConsecutiveFaults = 0;  // a live camera is reopened until it is back
-    } else {
-      auto settings = *camera.source;
-      settings.pacing = config.capture.pacing;
-      origin = settings.path.string();
-      source = std::make_unique<capture::FileSource>(name, settings);
-    }
-    const cv::Size calibrated = camera.calibration.intrinsics.imageSize;
-    if (source->frameSize() != calibrated) {
-      throw std::runtime_error(
-          fmt::format("camera '{}': {} has {}x{} frames but the lens is calibrated for {}x{}", name,
-                      origin, source->frameSize().width, source->frameSize().height,
-                      calibrated.width, calibrated.height));
-    }
-    spdlog::info("camera '{}': {} ({}x{}, {:.2f} fps)", name, origin, source->frameSize().width,
-                 source->frameSize().height,
-                 1e9 / static_cast<double>(source->nominalPeriod().count()));
-    cameras.push_back(std::make_unique<capture::CameraStream>(name, std::move(source), poolFrames,
-                                                              maxConsecutiveFaults));
-  }
-  return cameras;
-}
-
-std::vector<std::string> cameraNames(const Config& config) {
-  std::vector<std::string> names;
-  for (const auto& camera : config.cameras) names.push_back(camera.calibration.name);
-  return names;
-}
-
-// Pictures that may wait for an encoder: enough to ride out a slow frame, few enough that a live
-// view stays current.
-constexpr std::size_t kEncoderQueue = 3;
-
-std::unique_ptr<render::HttpStreamSink> openHttp(const OutputConfig& output, ViewKind view) {
-  render::HttpStreamSettings settings;
-  settings.address = output.listenAddress;
-  settings.port = output.listenPort;
-  settings.jpegQuality = output.jpegQuality;
-  if (output.stream == OutputStream::kSurround) {
-    for (const ViewKind kind : render::kViewKinds) settings.views.emplace_back(toString(kind));
-    settings.initialView = toString(view);
-  }
-  auto sink = std::make_unique<render::HttpStreamSink>(std::move(settings));
-  spdlog::info("HTTP stream: http://{}:{}/", output.listenAddress, sink->port());
-  return sink;
-}
-
-std::unique_ptr<render::FrameSink> openSink(const OutputConfig& output, cv::Size videoSize,
-                                            double nominalFps, bool live) {
-  if (output.kind == OutputKind::kWindow) {
-    return std::make_unique<render::X11WindowSink>(
-        render::X11WindowSettings{output.display, output.title, videoSize});
-  }
-  if (output.kind == OutputKind::kDisplay) {
-    return std::make_unique<render::DrmDisplaySink>(
-        render::DrmDisplaySettings{output.device, output.connector});
-  }
-  if (output.path.has_parent_path()) std::filesystem::create_directories(output.path.parent_path());
-  if (output.kind == OutputKind::kSnapshot) {
-    return std::make_unique<render::SnapshotSink>(
-        output.path, std::chrono::duration_cast<std::chrono::nanoseconds>(
-                         std::chrono::duration<double>(output.atSeconds)));
-  }
-  render::VideoEncoderSettings settings;
-  settings.path = output.path;
-  settings.size = videoSize;
-  settings.nominalFps = nominalFps;
-  settings.crf = output.crf;
-  settings.preset = output.preset;
-  settings.pixelFormat = output.pixelFormat;
-  settings.url = output.url;
-  auto video = std::make_unique<render::VideoSink>(
-      std::move(settings), std::chrono::duration_cast<std::chrono::nanoseconds>(
-                               std::chrono::duration<double>(output.segmentS)));
-  // Encoding runs beside the next frame set's stitching; live, the newest picture wins.
-  return std::make_unique<render::QueuedSink>(
-      std::move(video), videoSize, kEncoderQueue,
-      live ? render::QueuedSink::WhenFull::kDropOldest : render::QueuedSink::WhenFull::kWait);
-}
 
 }  // namespace
 

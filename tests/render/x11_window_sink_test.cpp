@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "render/render_error.hpp"
-#include "tests/render/x11_test_server.hpp"
+#include "tests/support/x11_test_server.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace surroundd::render {

@@ -1,4 +1,4 @@
-#include "tests/render/x11_test_server.hpp"
+#include "tests/support/x11_test_server.hpp"
 
 #include <algorithm>
 #include <array>
