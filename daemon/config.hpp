@@ -15,7 +15,7 @@
 #include "capture/file_source.hpp"
 #include "daemon/rig_yaml.hpp"
 #include "processing/panorama_lut.hpp"
-#include "processing/poisson_solver.hpp"
+#include "processing/poisson_correction.hpp"
 #include "processing/surround_mesh.hpp"
 #include "render/car_model.hpp"
 #include "render/egl_context.hpp"
@@ -60,15 +60,12 @@ struct PanoramaConfig {
 };
 
 enum class ColourMethod { kNone, kGain, kPoisson };
+using processing::CorrectionField;
 using processing::PoissonSolverKind;
 
 struct ColourCorrectionConfig {
   ColourMethod method = ColourMethod::kPoisson;
-  double scale = 0.25;  // solve at this fraction of the panorama resolution
-  PoissonSolverKind solver = PoissonSolverKind::kAuto;
-  double tolerance = 1e-4;  // iterative solver: relative residual (1e-4 stays within 0.01 levels of
-                            // the direct solvers; 1e-3 within about 0.07)
-  double temporalSmoothing = 0.0;  // 0 = none; 0.9 = heavy smoothing of the seam data over time
+  processing::ColourCorrectionSettings poisson;  // for method kPoisson
 
   bool operator==(const ColourCorrectionConfig&) const = default;
 };

@@ -105,14 +105,18 @@ void readColour(YamlObject& section, ColourCorrectionConfig& c) {
                             {{"none", ColourMethod::kNone},
                              {"gain", ColourMethod::kGain},
                              {"poisson", ColourMethod::kPoisson}});
-  c.scale = section.number("scale", c.scale, {0.0, 1.0, true, "fraction of the panorama size"});
-  c.solver = section.choice("solver", c.solver,
+  auto& p = c.poisson;
+  p.scale = section.number("scale", p.scale, {0.0, 1.0, true, "fraction of the panorama size"});
+  p.field = section.choice("field", p.field,
+                           {{"multiplicative", CorrectionField::kMultiplicative},
+                            {"additive", CorrectionField::kAdditive}});
+  p.solver = section.choice("solver", p.solver,
                             {{"auto", PoissonSolverKind::kAuto},
                              {"cholmod", PoissonSolverKind::kCholmod},
                              {"iterative", PoissonSolverKind::kIterative},
                              {"rectangle", PoissonSolverKind::kRectangle}});
-  c.tolerance = section.number("tolerance", c.tolerance, {0.0, 0.5, true, "relative residual"});
-  c.temporalSmoothing = section.number("temporal_smoothing", c.temporalSmoothing,
+  p.tolerance = section.number("tolerance", p.tolerance, {0.0, 0.5, true, "relative residual"});
+  p.temporalSmoothing = section.number("temporal_smoothing", p.temporalSmoothing,
                                        {0.0, 0.99, false, "weight of the previous frame"});
   section.finish();
 }
@@ -304,14 +308,14 @@ Config loadConfig(const std::filesystem::path& file) {
   readSection("panorama", [&](YamlObject& s) { readPanorama(s, config.panorama); });
   readSection("colour_correction", [&](YamlObject& s) { readColour(s, config.colour); });
   // The correction field is solved on blocks of 1 / scale pixels, which must tile the panorama.
-  const double blocksPerPixel = 1 / config.colour.scale;
+  const double blocksPerPixel = 1 / config.colour.poisson.scale;
   const auto block = std::lround(blocksPerPixel);
   if (std::abs(blocksPerPixel - static_cast<double>(block)) > 1e-9 ||
       config.panorama.widthPx % block != 0 || config.panorama.heightPx % block != 0) {
     const auto message = fmt::format(
         "colour_correction.scale must be 1/N with N dividing the panorama's {}x{} pixels (e.g. "
         "0.25 or 0.125), got {:g}",
-        config.panorama.widthPx, config.panorama.heightPx, config.colour.scale);
+        config.panorama.widthPx, config.panorama.heightPx, config.colour.poisson.scale);
     if (auto section = root.object("colour_correction")) {
       section->error("scale", message);
     } else {

@@ -83,14 +83,12 @@ void Pipeline::setUpColourCorrection(const Config& config) {
     gains_ = std::make_unique<processing::GainCompensation>(*lut_, pool_);
     spdlog::info("colour correction: global gain compensation");
   } else if (config.colour.method == ColourMethod::kPoisson) {
-    const processing::ColourCorrectionSettings settings{config.colour.scale, config.colour.solver,
-                                                        config.colour.tolerance,
-                                                        config.colour.temporalSmoothing};
+    const processing::ColourCorrectionSettings& settings = config.colour.poisson;
     poisson_ = std::make_unique<processing::PoissonColourCorrection>(rig, panoramaSettings(config),
                                                                      *lut_, settings, pool_);
     for (const auto& note : poisson_->notes()) spdlog::warn("colour correction: {}", note);
     spdlog::info("colour correction: Poisson, {} region(s) at scale {:g}, solver {}",
-                 poisson_->domain().regions.size(), config.colour.scale, poisson_->solverNames());
+                 poisson_->domain().regions.size(), settings.scale, poisson_->solverNames());
   }
 }
 

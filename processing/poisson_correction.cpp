@@ -27,11 +27,19 @@ int firstTapOffset(int r, int block) {
   return static_cast<int>(std::floor((r + 0.5) / block - 0.5)) - 1;
 }
 
+// A seam block black in one camera has no ratio; half a level keeps its logarithm finite.
+constexpr float kDarkestMean = 0.5f;
+
 }  // namespace
+
+std::string_view correctionFieldName(CorrectionField field) {
+  return field == CorrectionField::kMultiplicative ? "multiplicative" : "additive";
+}
 
 struct PoissonColourCorrection::RegionState {
   std::unique_ptr<PoissonSolver> solver;
-  std::vector<float> dirichlet;  // 3 per Dirichlet block: target - source, levels
+  // 3 per Dirichlet block: log(target / source), or target - source in levels (additive).
+  std::vector<float> dirichlet;
   std::vector<float> rhs;
   std::vector<float> solution;  // 3 per unknown; the warm start of the next frame
   int iterations = 0;
@@ -143,6 +151,7 @@ void PoissonColourCorrection::followLostCameras(std::span<const cv::Mat> frames)
 void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames) {
   Configuration& active = *active_;
   const float keep = active.firstFrame ? 0.0f : static_cast<float>(settings_.temporalSmoothing);
+  const bool multiplicative = settings_.field == CorrectionField::kMultiplicative;
   for (std::size_t r = 0; r < active.regions.size(); ++r) {
     const CorrectionRegion& region = active.domain.regions[r];
     RegionState& state = active.regions[r];
@@ -151,20 +160,26 @@ void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames) {
       const DirichletBlock& d = region.dirichlet[k];
       const cv::Mat& target = frames[d.target];
       if (source.empty() || target.empty()) continue;  // hold the last value
-      float sum[3] = {0, 0, 0};
+      float targetSum[3] = {0, 0, 0};
+      float sourceSum[3] = {0, 0, 0};
       for (auto s = d.firstSample; s < d.endSample; ++s) {
         const SeamSample& sample = active.domain.samples[s];
         const std::uint32_t t = bilinear(target.data, target.step, sample.target);
         const std::uint32_t o = bilinear(source.data, source.step, sample.source);
         for (int c = 0; c < 3; ++c) {
-          sum[c] += static_cast<float>(static_cast<int>((t >> (8 * c)) & 0xffU) -
-                                       static_cast<int>((o >> (8 * c)) & 0xffU));
+          targetSum[c] += static_cast<float>((t >> (8 * c)) & 0xffU);
+          sourceSum[c] += static_cast<float>((o >> (8 * c)) & 0xffU);
         }
       }
       const auto count = static_cast<float>(d.endSample - d.firstSample);
       for (int c = 0; c < 3; ++c) {
+        // The ratio of the block's means, not the mean of ratios: noise on dark pixels would
+        // dominate the latter.
+        const float seam = multiplicative ? std::log(std::max(targetSum[c], kDarkestMean * count) /
+                                                     std::max(sourceSum[c], kDarkestMean * count))
+                                          : (targetSum[c] - sourceSum[c]) / count;
         float& value = state.dirichlet[k * 3 + c];
-        value = keep * value + (1 - keep) * sum[c] / count;
+        value = keep * value + (1 - keep) * seam;
       }
     }
   }
@@ -204,6 +219,12 @@ int PoissonColourCorrection::update(std::span<const cv::Mat> frames) {
                   static_cast<std::ptrdiff_t>(active.domain.firstDirichletSlot[r]) * 3);
     iterations += state.iterations;
   }
+  if (settings_.field == CorrectionField::kMultiplicative) {
+    // Log-gains to the levels they add at 255, in place (the slots are refilled every frame).
+    cv::Mat values(1, static_cast<int>(active.slots.size()), CV_32F, active.slots.data());
+    cv::exp(values, values);
+    values.convertTo(values, CV_32F, 255, -255);
+  }
   auto* field = field_.ptr<float>();
   for (std::size_t b = 0; b < active.domain.fillFrom.size(); ++b) {
     const int slot = active.domain.fillFrom[b];
@@ -221,13 +242,20 @@ void PoissonColourCorrection::apply(cv::Mat& panorama) {
       [&](int firstChunk, int lastChunk) {
         for (int chunk = firstChunk; chunk < lastChunk; ++chunk) {
           const int height = lut_.size.height;
-          applyRows(height * chunk / chunks, height * (chunk + 1) / chunks, panorama,
-                    rowBuffers_[static_cast<std::size_t>(chunk)]);
+          const int first = height * chunk / chunks;
+          const int last = height * (chunk + 1) / chunks;
+          auto& buffer = rowBuffers_[static_cast<std::size_t>(chunk)];
+          if (settings_.field == CorrectionField::kMultiplicative) {
+            applyRows<CorrectionField::kMultiplicative>(first, last, panorama, buffer);
+          } else {
+            applyRows<CorrectionField::kAdditive>(first, last, panorama, buffer);
+          }
         }
       },
       chunks);
 }
 
+template <CorrectionField kField>
 void PoissonColourCorrection::applyRows(int first, int last, cv::Mat& panorama,
                                         std::vector<float>& columnBuffer) const {
   const CorrectionDomain& domain = full_->domain;  // its grid and shares are every domain's
@@ -267,7 +295,20 @@ void PoissonColourCorrection::applyRows(int first, int last, cv::Mat& panorama,
       for (int c = 0; c < 3; ++c) {
         const float value =
             wx[0] * tap[c] + wx[1] * tap[3 + c] + wx[2] * tap[6 + c] + wx[3] * tap[9 + c];
-        const float corrected = std::clamp(pixel[c] + weight * value, 0.0f, 255.0f);
+        float corrected = 0;
+        if constexpr (kField == CorrectionField::kAdditive) {
+          corrected = pixel[c] + weight * value;
+        } else {
+          const float gain = 1 + value * (1.0f / 255);
+          if (share[u] == 256) {
+            corrected = pixel[c] * gain;
+          } else {
+            // In the seam band the pixel is w * source + (1 - w) * target, with target = gain *
+            // source where the field is right, so the source's part is pixel / (w + (1 - w) gain).
+            corrected = pixel[c] * gain / (weight + (1 - weight) * gain);
+          }
+        }
+        corrected = std::clamp(corrected, 0.0f, 255.0f);
         // Non-negative, so adding a half and truncating rounds (lround is a libm call per value).
         pixel[c] =
             static_cast<std::uint8_t>(corrected + 0.5f);  // NOLINT(bugprone-incorrect-roundings)

@@ -1,8 +1,14 @@
 #pragma once
 // Poisson local colour correction (DESIGN.md §2.3, the paper's §2.3): per frame, each source
 // camera's region of the panorama gets a smooth correction field that takes its colours to the
-// target cameras' across every seam, solved at a reduced scale and added to the stitched
+// target cameras' across every seam, solved at a reduced scale and applied to the stitched
 // panorama after bicubic upsampling. Target cameras are left as they are.
+//
+// The field is multiplicative by default: it is solved for log(target / source), so the source
+// keeps its own contrast and each pixel is scaled. Cameras differ by gain, white balance and
+// vignetting, all of them factors, so an additive field (the paper's, `kAdditive`) matches the
+// seam's mean but leaves bright and dark pixels next to it off by the gain difference times their
+// distance from that mean.
 //
 // Set up once (domain, systems, solver factorizations, buffers); update() and apply() are the
 // per-frame calls and allocate nothing. A camera missing from a frame set leaves the seams it
@@ -17,6 +23,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -30,11 +37,19 @@ class WorkPool;
 
 namespace surroundd::processing {
 
+enum class CorrectionField { kMultiplicative, kAdditive };
+
+// "multiplicative", "additive": the config's words.
+std::string_view correctionFieldName(CorrectionField field);
+
 struct ColourCorrectionSettings {
   double scale = 0.25;  // the field's resolution against the panorama's (1 / block size)
+  CorrectionField field = CorrectionField::kMultiplicative;
   PoissonSolverKind solver = PoissonSolverKind::kAuto;
-  double tolerance = 1e-4;         // iterative solver: relative residual
+  double tolerance = 5e-5;         // iterative solver: relative residual
   double temporalSmoothing = 0.0;  // weight of the previous frame's seam data, 0..0.99
+
+  bool operator==(const ColourCorrectionSettings&) const = default;
 };
 
 class PoissonColourCorrection {
@@ -65,7 +80,8 @@ class PoissonColourCorrection {
   // Adds the fields to a panorama stitched from the same frames (8-bit BGR of the LUT's size).
   void apply(cv::Mat& panorama);
 
-  // The field at block resolution, CV_32FC3, 8-bit levels (0 outside the regions' reach).
+  // The field at block resolution, CV_32FC3: the levels it adds to a pixel at 255, the most it
+  // changes any pixel (0 outside the regions' reach). Additive: simply the levels it adds.
   const cv::Mat& field() const { return field_; }
 
  private:
@@ -74,6 +90,7 @@ class PoissonColourCorrection {
   Configuration& configurationFor(std::uint32_t presentCameras);
   void followLostCameras(std::span<const cv::Mat> frames);
   void gatherSeams(std::span<const cv::Mat> frames);
+  template <CorrectionField kField>
   void applyRows(int first, int last, cv::Mat& panorama, std::vector<float>& columnBuffer) const;
 
   const PanoramaLut& lut_;

@@ -14,6 +14,10 @@ set(small --size 320x180 --panorama-size 512x256)
 surroundd_fixture(synth_small --rig ${paper} ${small} --seconds 1 --seed 7)
 surroundd_fixture(synth_small_identity --rig ${paper} ${small} --seconds 1 --seed 7
                   --photometrics identity)
+# Gains 0.7 / 1.3 and white balance shifted both ways, at the 720p benchmark's sizes: for the
+# colour step across the seams.
+surroundd_fixture(synth_seams --rig ${paper} --size 1280x720 --panorama-size 1536x768
+                  --seconds 0.2 --seed 5 --photometrics extreme)
 # One camera leaves out every third frame: for replay and synchronizer tests.
 surroundd_fixture(synth_drop --rig ${paper} ${small} --seconds 2 --seed 11 --drop-every right:3)
 surroundd_fixture(synth_fisheye --rig ${fisheye} ${small} --seconds 1 --seed 5)

@@ -117,6 +117,21 @@ TEST_F(ConfigTest, GoodConfigLoads) {
   EXPECT_EQ(config.panorama.widthPx, PanoramaConfig{}.widthPx);  // absent sections keep defaults
 }
 
+TEST_F(ConfigTest, ColourCorrectionSettingsAreRead) {
+  std::string text(kGoodConfig);
+  text += "colour_correction: {field: additive, solver: cholmod, scale: 0.125}\n";
+  const Config config = loadConfig(dir_.write("config.yaml", text));
+  EXPECT_EQ(config.colour.method, ColourMethod::kPoisson);
+  EXPECT_EQ(config.colour.poisson.field, CorrectionField::kAdditive);
+  EXPECT_EQ(config.colour.poisson.solver, PoissonSolverKind::kCholmod);
+  EXPECT_DOUBLE_EQ(config.colour.poisson.scale, 0.125);
+  const auto messages = errorsOf(
+      dir_.write("config.yaml", std::string(kGoodConfig) + "colour_correction: {field: ratio}\n"));
+  ASSERT_EQ(messages.size(), 1u) << ::testing::PrintToString(messages);
+  EXPECT_THAT(messages[0],
+              HasSubstr("colour_correction.field: expected one of 'multiplicative' 'additive'"));
+}
+
 TEST_F(ConfigTest, SurroundOutputsTakeTheirOwnViewOrTheRenderDefault) {
   const Config config = loadConfig(configWith("  height_px: 360\n", R"(  height_px: 360
   view: top

@@ -102,8 +102,7 @@ struct Replay {
     cv::Mat stitched;
     stitcher.stitch(frames, stitched);
     processing::PoissonColourCorrection correction(
-        daemon::rigOf(config), daemon::panoramaSettings(config), lut,
-        {config.colour.scale, config.colour.solver, config.colour.tolerance, 0.0}, pool);
+        daemon::rigOf(config), daemon::panoramaSettings(config), lut, config.colour.poisson, pool);
     correction.update(frames);
     correction.apply(stitched);
     return stitched;

@@ -45,8 +45,9 @@ void measure(const std::filesystem::path& folder, const ColourBenchmarkOptions& 
   stitcher.stitch(frames, raw);
   const synth::Scene scene(truth.seed, truth.seconds);
   const cv::Mat ground = trueGroundMask(scene, truth.frames.front().pose, settings);
-  const auto seamError = [&](const cv::Mat& panorama) {
-    return seamColourError(panorama, frames, truth.rig, settings, lut, ground);
+  // Against the target cameras as the panorama shows them (gain compensation changes them too).
+  const auto seamError = [&](const cv::Mat& panorama, const std::vector<cv::Mat>& targets) {
+    return seamColourError(panorama, targets, truth.rig, settings, lut, ground);
   };
 
   const cv::Size camera = truth.rig.cameras.front().intrinsics.imageSize;
@@ -59,7 +60,7 @@ void measure(const std::filesystem::path& folder, const ColourBenchmarkOptions& 
   fmt::print(
       "  colour step across the seams (true ground): {:.2f} levels uncorrected, {:.2f} with "
       "gain compensation\n",
-      seamError(raw), seamError(gained));
+      seamError(raw, frames), seamError(gained, framesWithGains(frames, gains.gains())));
 
   for (const double scale : {0.25, 0.125}) {
     processing::ColourCorrectionSettings correctionSettings;
@@ -83,16 +84,23 @@ void measure(const std::filesystem::path& folder, const ColourBenchmarkOptions& 
         "    the {}x{} rectangle that fixed-azimuth seams give:\n{}", rectangle.size.width,
         rectangle.size.height,
         formatPoissonTimings(rectangle.size, benchmarkPoissonSolvers(rectangle, solverOptions)));
-    cv::Mat corrected = raw.clone();
-    const auto medians = interleavedMedians(
-        {[&] { correction->update(frames); }, [&] { correction->apply(corrected); }},
-        options.repeats);
-    raw.copyTo(corrected);
-    correction->apply(corrected);
-    fmt::print(
-        "    per frame, {} threads: seam data + solve {:.2f} ms, upsample and apply {:.2f} ms; "
-        "colour step across the seams {:.2f} levels\n",
-        options.threads, medians[0], medians[1], seamError(corrected));
+    for (const auto field :
+         {processing::CorrectionField::kMultiplicative, processing::CorrectionField::kAdditive}) {
+      correctionSettings.field = field;
+      correction = std::make_unique<processing::PoissonColourCorrection>(truth.rig, settings, lut,
+                                                                         correctionSettings, pool);
+      cv::Mat corrected = raw.clone();
+      const auto medians = interleavedMedians(
+          {[&] { correction->update(frames); }, [&] { correction->apply(corrected); }},
+          options.repeats);
+      raw.copyTo(corrected);
+      correction->apply(corrected);
+      fmt::print(
+          "    per frame, {} field, {} threads: seam data + solve {:.2f} ms, upsample and apply "
+          "{:.2f} ms; colour step across the seams {:.2f} levels\n",
+          processing::correctionFieldName(field), options.threads, medians[0], medians[1],
+          seamError(corrected, frames));
+    }
   }
   fmt::print("\n");
 }

@@ -179,6 +179,15 @@ double seamColourError(const cv::Mat& panorama, const std::vector<cv::Mat>& fram
   return tiles > 0 ? sum / tiles : 0;
 }
 
+std::vector<cv::Mat> framesWithGains(const std::vector<cv::Mat>& frames,
+                                     const std::vector<cv::Vec3f>& gains) {
+  std::vector<cv::Mat> scaled(frames.size());
+  for (std::size_t c = 0; c < frames.size(); ++c) {
+    cv::multiply(frames[c], cv::Scalar(gains[c][0], gains[c][1], gains[c][2]), scaled[c]);
+  }
+  return scaled;
+}
+
 double meanAbsoluteError(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
   cv::Mat difference;
   cv::absdiff(a, b, difference);

@@ -51,6 +51,11 @@ double seamColourError(const cv::Mat& panorama, const std::vector<cv::Mat>& fram
                        const processing::PanoramaLut& lut, const cv::Mat& mask, int window = 4,
                        int reach = 12);
 
+// The camera images as a global correction leaves them (per camera and channel gains): what the
+// seams of a gain-compensated panorama are measured against, as its targets change too.
+std::vector<cv::Mat> framesWithGains(const std::vector<cv::Mat>& frames,
+                                     const std::vector<cv::Vec3f>& gains);
+
 // Mean absolute difference over the mask and the channels, 8-bit levels.
 double meanAbsoluteError(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask);
 

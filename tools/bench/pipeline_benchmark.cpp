@@ -87,7 +87,7 @@ daemon::Config configFor(const std::filesystem::path& folder, const RecordingTru
   config.panorama.heightPx = truth.panorama.size.height;
   config.panorama.projection = options.projection;
   config.panorama.cacheDir = scratch / "lut-cache";
-  config.colour.solver = options.solver;
+  config.colour.poisson.solver = options.solver;
   config.render.view = options.view;
   config.render.widthPx = options.outputSize.width;
   config.render.heightPx = options.outputSize.height;

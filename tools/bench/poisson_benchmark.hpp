@@ -10,15 +10,15 @@
 
 #include <opencv2/core.hpp>
 
+#include "processing/poisson_correction.hpp"
 #include "processing/poisson_solver.hpp"
 
 namespace surroundd::bench {
 
 struct PoissonBenchmarkOptions {
   int repeats = 30;  // frames solved per solver; medians reported
-  // The iterative solver's relative residual: 1e-4 stays within 0.01 levels of CHOLMOD (the
-  // config's default, 1e-3, is faster and within about 0.06).
-  double tolerance = 1e-4;
+  // The iterative solver's relative residual: the colour correction's default.
+  double tolerance = processing::ColourCorrectionSettings{}.tolerance;
 };
 
 struct PoissonSolverTiming {
