@@ -38,7 +38,8 @@ Pipeline::Pipeline(const Config& config)
     return std::ranges::any_of(config.outputs, [&](const auto& o) { return o.stream == stream; });
   };
   if (configured(OutputStream::kPanorama) || configured(OutputStream::kSurround)) {
-    lut_ = std::make_unique<processing::PanoramaLut>(obtainPanoramaLut(config, pool_));
+    const processing::Rig rig = rigOf(config, pool_);
+    lut_ = std::make_unique<processing::PanoramaLut>(obtainPanoramaLut(config, rig, pool_));
     stitcher_ = std::make_unique<processing::Stitcher>(*lut_, pool_);
     ownership_ = std::make_unique<processing::PanoramaOwnership>(*lut_);
     panorama_.create(lut_->size, CV_8UC3);
@@ -47,7 +48,7 @@ Pipeline::Pipeline(const Config& config)
     }
     frames_.resize(cameras_.size());
     stitchInputs_.resize(cameras_.size());
-    setUpColourCorrection(config);
+    setUpColourCorrection(config, rig);
   }
   if (configured(OutputStream::kSurround)) setUpSurround(config);
   const double nominalFps = 1e9 / static_cast<double>(cameras_.front()->nominalPeriod().count());
@@ -77,10 +78,11 @@ Pipeline::Pipeline(const Config& config)
   }
 }
 
-void Pipeline::setUpColourCorrection(const Config& config) {
-  const processing::Rig rig = rigOf(config);
+void Pipeline::setUpColourCorrection(const Config& config, const processing::Rig& rig) {
   if (config.colour.method == ColourMethod::kGain) {
-    gains_ = std::make_unique<processing::GainCompensation>(*lut_, pool_);
+    gains_ = std::make_unique<processing::GainCompensation>(
+        *lut_, pool_, config.colour.poisson.minGain, config.colour.poisson.maxGain,
+        cameraNames(config));
     spdlog::info("colour correction: global gain compensation");
   } else if (config.colour.method == ColourMethod::kPoisson) {
     const processing::ColourCorrectionSettings& settings = config.colour.poisson;
@@ -320,6 +322,9 @@ void Pipeline::process(const capture::FrameSet& set) {
       poisson_->apply(panorama_);
     } else if (gains_) {
       gains_->update(frames_);
+      for (const auto& note : gains_->notesOfLastUpdate()) {
+        spdlog::warn("colour correction: {}", note);
+      }
       gains_->apply(panorama_);
     }
     for (std::size_t c = 0; c < set.cameraCount; ++c) {

@@ -16,6 +16,8 @@ namespace {
 constexpr double kMinimumSeenShare = 0.25;
 // How far past a region the field is extended: the bicubic kernel's reach.
 constexpr int kFillReach = 2;
+// A bowl point this low is on its floor (the wall starts at height 0 and rises).
+constexpr double kFloorHeightM = 1e-6;
 
 struct BlockGrid {
   cv::Size size;
@@ -71,7 +73,7 @@ int firstColumn(const BlockGrid& grid, const std::vector<int>& blocks) {
 }  // namespace
 
 CorrectionDomain buildCorrectionDomain(const Rig& rig, const PanoramaSettings& settings,
-                                       const PanoramaLut& lut, double scale,
+                                       const PanoramaLut& lut, double scale, bool groundSeams,
                                        std::span<const bool> present) {
   const int block = static_cast<int>(std::lround(1 / scale));
   if (block < 1 || lut.size.width % block != 0 || lut.size.height % block != 0) {
@@ -108,6 +110,7 @@ CorrectionDomain buildCorrectionDomain(const Rig& rig, const PanoramaSettings& s
   }
 
   const PanoramaProjector projector(rig, settings);
+  const bool floorOnly = groundSeams && settings.projection == PanoramaProjection::kBowl;
   // The pixels of block q that cameras `target` and `source` both see, as sample taps.
   const auto seamSamples = [&](int q, std::uint8_t target, std::uint8_t source) {
     const std::uint32_t first = static_cast<std::uint32_t>(domain.samples.size());
@@ -116,6 +119,7 @@ CorrectionDomain buildCorrectionDomain(const Rig& rig, const PanoramaSettings& s
     for (int v = v0; v < v0 + block; ++v) {
       for (int u = u0; u < u0 + block; ++u) {
         const cv::Point2d pixel(u, v);
+        if (floorOnly && projector.surfacePoint(pixel)[2] > kFloorHeightM) continue;
         const auto t = projector.cameraPixel(target, pixel);
         const auto s = projector.cameraPixel(source, pixel);
         if (!t || !s) continue;
@@ -195,6 +199,31 @@ CorrectionDomain buildCorrectionDomain(const Rig& rig, const PanoramaSettings& s
           "a region of {} blocks of camera '{}' has no seam with a target camera: left uncorrected",
           members.size(), rig.cameras[region.source].name));
       continue;
+    }
+    // The reverse of dirichletOf, and the seams: Dirichlet blocks were made in row-major order of
+    // the region, which runs along a seam (seams are near-vertical in the panorama).
+    std::vector<std::vector<std::uint32_t>> unknownsOf(region.dirichlet.size());
+    for (std::uint32_t i = 0; i + 1 < region.dirichletBegin.size(); ++i) {
+      for (auto k = region.dirichletBegin[i]; k < region.dirichletBegin[i + 1]; ++k) {
+        unknownsOf[region.dirichletOf[k]].push_back(i);
+      }
+    }
+    region.unknownsBegin.push_back(0);
+    for (const auto& unknowns : unknownsOf) {
+      region.unknownsOf.insert(region.unknownsOf.end(), unknowns.begin(), unknowns.end());
+      region.unknownsBegin.push_back(static_cast<std::uint32_t>(region.unknownsOf.size()));
+    }
+    const auto regionIndex = static_cast<std::uint32_t>(domain.regions.size());
+    for (std::uint32_t k = 0; k < region.dirichlet.size(); ++k) {
+      const std::uint8_t target = region.dirichlet[k].target;
+      auto seam = std::ranges::find_if(domain.seams, [&](const CorrectionSeam& s) {
+        return s.region == regionIndex && s.target == target;
+      });
+      if (seam == domain.seams.end()) {
+        domain.seams.push_back({regionIndex, target, {}});
+        seam = domain.seams.end() - 1;
+      }
+      seam->blocks.push_back(k);
     }
     domain.regions.push_back(std::move(region));
   }

@@ -4,10 +4,14 @@
 // The panorama is divided into blocks of `block` x `block` pixels (scale = 1 / block), each owned
 // by the camera that owns its centre pixel. Each connected set of blocks owned by one source
 // camera is a region with its own PoissonSystem. A block across a 4-neighbour border that a
-// target camera owns, and that the source camera sees too, is a Dirichlet block: its value is the
-// mean of (target - source) over the block's pixels that both cameras see, sampled through taps
-// built here. Every other border is Neumann. A region with no Dirichlet block cannot be corrected
-// (nothing to match) and is left out, with a note saying so.
+// target camera owns, and that the source camera sees too, is a Dirichlet block: its value comes
+// from the block's pixels that both cameras see, sampled through taps built here. Only pixels that
+// neither camera's body mask hides take part (the projector leaves those out) and, with
+// `groundSeams` on a bowl, only pixels on its floor: on a real rig the wall part of a seam sees
+// different things from the two cameras (parallax), the ground the same. Every other border is
+// Neumann. A region with no Dirichlet block cannot be corrected (nothing to match) and is left
+// out, with a note saying so. The Dirichlet blocks a region shares with one target camera form a
+// seam, listed along its length for the robust statistics of poisson_correction.hpp.
 //
 // For applying the fields: `share` gives each panorama pixel the weight of source cameras in it
 // (1 inside a source region, the blend weight in the seam bands), and `fillFrom` says which field
@@ -45,12 +49,23 @@ struct CorrectionRegion {
   // Per unknown, its Dirichlet neighbours: dirichletOf[dirichletBegin[i] .. dirichletBegin[i+1]).
   std::vector<std::uint32_t> dirichletBegin;
   std::vector<std::uint32_t> dirichletOf;
+  // Per Dirichlet block, the unknowns next to it: unknownsOf[unknownsBegin[k] .. [k+1]).
+  std::vector<std::uint32_t> unknownsBegin;
+  std::vector<std::uint32_t> unknownsOf;
+};
+
+// The Dirichlet blocks of one region towards one target camera, in order along the seam.
+struct CorrectionSeam {
+  std::uint32_t region = 0;  // index in CorrectionDomain::regions
+  std::uint8_t target = 0;
+  std::vector<std::uint32_t> blocks;  // indices into the region's dirichlet
 };
 
 struct CorrectionDomain {
   int block = 4;
   cv::Size grid;  // blocks; columns wrap around like the panorama's
   std::vector<CorrectionRegion> regions;
+  std::vector<CorrectionSeam> seams;
   std::vector<SeamSample> samples;
   // Field slots: the unknowns of every region, in order, then their Dirichlet blocks.
   std::size_t slots = 0;
@@ -66,7 +81,7 @@ struct CorrectionDomain {
 // the seams with a missing target, which become Neumann borders. Throws std::invalid_argument for
 // a scale that does not divide the panorama into whole blocks of at least 2 pixels.
 CorrectionDomain buildCorrectionDomain(const Rig& rig, const PanoramaSettings& settings,
-                                       const PanoramaLut& lut, double scale,
+                                       const PanoramaLut& lut, double scale, bool groundSeams,
                                        std::span<const bool> present = {});
 
 }  // namespace surroundd::processing

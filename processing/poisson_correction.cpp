@@ -7,7 +7,6 @@
 #include <fmt/format.h>
 
 #include "common/work_pool.hpp"
-#include "processing/bilinear_sample.hpp"
 
 namespace surroundd::processing {
 namespace {
@@ -29,6 +28,21 @@ int firstTapOffset(int r, int block) {
 
 // A seam block black in one camera has no ratio; half a level keeps its logarithm finite.
 constexpr float kDarkestMean = 0.5f;
+// Half-width of the running median along a seam, in blocks: wide enough to outvote an object or a
+// parallax streak a few blocks long, narrow enough to follow vignetting along the seam.
+constexpr int kSeamHalfWindow = 3;
+float medianOf(float* values, std::size_t count) {
+  std::nth_element(values, values + count / 2, values + count);
+  return values[count / 2];
+}
+
+// "Worse" is worse by more than 8-bit rounding and sensor noise move a block's step: on cameras
+// that already agree the seams would otherwise drop in and out with the noise.
+constexpr double kWorseLevels = 0.5;
+constexpr double kWorseShare = 0.05;
+
+// A seam needs this share of its blocks measured to be matched at all; with fewer it keeps gain 1.
+constexpr double kMinimumMeasuredShare = 0.25;
 
 }  // namespace
 
@@ -38,7 +52,12 @@ std::string_view correctionFieldName(CorrectionField field) {
 
 struct PoissonColourCorrection::RegionState {
   std::unique_ptr<PoissonSolver> solver;
-  // 3 per Dirichlet block: log(target / source), or target - source in levels (additive).
+  // Per Dirichlet block: this frame's levels, and 3 values each of log(target / source), or
+  // target - source in levels (additive): as measured, filtered along the seam and bounded, and
+  // smoothed over time. `dirichlet` is what is solved: the smoothed data, 0 on dropped seams.
+  std::vector<SeamBlockLevels> levels;
+  std::vector<std::uint8_t> measuredValid, filteredValid;
+  std::vector<float> measured, filtered, seamValue;
   std::vector<float> dirichlet;
   std::vector<float> rhs;
   std::vector<float> solution;  // 3 per unknown; the warm start of the next frame
@@ -50,6 +69,8 @@ struct PoissonColourCorrection::Configuration {
   std::vector<RegionState> regions;
   std::vector<float> slots;  // 3 values per field slot
   bool firstFrame = true;
+  // Per seam: whether its clamp, its lack of data and its dropping have been said.
+  std::vector<std::uint8_t> saidClamped, saidSparse, saidDropped;
 };
 
 PoissonColourCorrection::PoissonColourCorrection(const Rig& rig, const PanoramaSettings& panorama,
@@ -61,7 +82,9 @@ PoissonColourCorrection::PoissonColourCorrection(const Rig& rig, const PanoramaS
       settings_(settings),
       rig_(rig),
       panorama_(panorama),
-      missingSets_(rig.cameras.size(), 0) {
+      missingSets_(rig.cameras.size(), 0),
+      meter_(static_cast<std::size_t>(std::lround(1 / settings.scale * (1 / settings.scale)))),
+      window_(2 * kSeamHalfWindow + 1) {
   activeCameras_ = (1U << rig.cameras.size()) - 1;
   full_ = &configurationFor(activeCameras_);
   active_ = full_;
@@ -100,17 +123,33 @@ PoissonColourCorrection::Configuration& PoissonColourCorrection::configurationFo
   std::array<bool, 32> present{};
   for (std::size_t c = 0; c < rig_.cameras.size(); ++c) present[c] = (presentCameras >> c) & 1U;
   configuration = std::make_unique<Configuration>();
-  configuration->domain = buildCorrectionDomain(rig_, panorama_, lut_, settings_.scale,
-                                                std::span(present.data(), rig_.cameras.size()));
+  configuration->domain =
+      buildCorrectionDomain(rig_, panorama_, lut_, settings_.scale, settings_.groundSeams,
+                            std::span(present.data(), rig_.cameras.size()));
   for (const auto& region : configuration->domain.regions) {
     RegionState state;
     state.solver = makePoissonSolver(settings_.solver, region.system, settings_.tolerance);
-    state.dirichlet.assign(region.dirichlet.size() * 3, 0.0f);
+    const std::size_t blocks = region.dirichlet.size();
+    state.levels.resize(blocks);
+    state.measuredValid.assign(blocks, 0);
+    state.filteredValid.assign(blocks, 0);
+    state.measured.assign(blocks * 3, 0.0f);
+    state.filtered.assign(blocks * 3, 0.0f);
+    state.seamValue.assign(blocks * 3, 0.0f);
+    state.dirichlet.assign(blocks * 3, 0.0f);
     state.rhs.assign(region.system.unknowns() * 3, 0.0f);
     state.solution.assign(region.system.unknowns() * 3, 0.0f);
     configuration->regions.push_back(std::move(state));
   }
   configuration->slots.assign(configuration->domain.slots * 3, 0.0f);
+  const std::size_t seams = configuration->domain.seams.size();
+  configuration->saidClamped.assign(seams, 0);
+  configuration->saidSparse.assign(seams, 0);
+  configuration->saidDropped.assign(seams, 0);
+  resolve_.resize(std::max(resolve_.size(), configuration->domain.regions.size()));
+  for (const auto& seam : configuration->domain.seams) {
+    stepScratch_.resize(std::max(stepScratch_.size(), 2 * seam.blocks.size()));
+  }
   return *configuration;
 }
 
@@ -148,6 +187,13 @@ void PoissonColourCorrection::followLostCameras(std::span<const cv::Mat> frames)
       active_->domain.regions.size(), solverNames()));
 }
 
+void PoissonColourCorrection::noteOnce(std::vector<std::uint8_t>& said, std::size_t seam,
+                                       std::string note) {
+  if (said[seam] != 0) return;
+  said[seam] = 1;
+  changes_.push_back(std::move(note));
+}
+
 void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames) {
   Configuration& active = *active_;
   const float keep = active.firstFrame ? 0.0f : static_cast<float>(settings_.temporalSmoothing);
@@ -159,41 +205,88 @@ void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames) {
     for (std::size_t k = 0; k < region.dirichlet.size(); ++k) {
       const DirichletBlock& d = region.dirichlet[k];
       const cv::Mat& target = frames[d.target];
-      if (source.empty() || target.empty()) continue;  // hold the last value
-      float targetSum[3] = {0, 0, 0};
-      float sourceSum[3] = {0, 0, 0};
-      for (auto s = d.firstSample; s < d.endSample; ++s) {
-        const SeamSample& sample = active.domain.samples[s];
-        const std::uint32_t t = bilinear(target.data, target.step, sample.target);
-        const std::uint32_t o = bilinear(source.data, source.step, sample.source);
-        for (int c = 0; c < 3; ++c) {
-          targetSum[c] += static_cast<float>((t >> (8 * c)) & 0xffU);
-          sourceSum[c] += static_cast<float>((o >> (8 * c)) & 0xffU);
-        }
-      }
-      const auto count = static_cast<float>(d.endSample - d.firstSample);
+      state.measuredValid[k] = 0;
+      if (source.empty() || target.empty()) continue;
+      const SeamBlockLevels levels = meter_.measure(active.domain, d, target, source);
+      state.levels[k] = levels;
+      state.measuredValid[k] = levels.valid ? 1 : 0;
       for (int c = 0; c < 3; ++c) {
-        // The ratio of the block's means, not the mean of ratios: noise on dark pixels would
-        // dominate the latter.
-        const float seam = multiplicative ? std::log(std::max(targetSum[c], kDarkestMean * count) /
-                                                     std::max(sourceSum[c], kDarkestMean * count))
-                                          : (targetSum[c] - sourceSum[c]) / count;
-        float& value = state.dirichlet[k * 3 + c];
-        value = keep * value + (1 - keep) * seam;
+        state.measured[k * 3 + c] = multiplicative
+                                        ? std::log(std::max(levels.target[c], kDarkestMean) /
+                                                   std::max(levels.source[c], kDarkestMean))
+                                        : levels.target[c] - levels.source[c];
       }
+    }
+  }
+
+  seamReports_.resize(active.domain.seams.size());
+  const auto logMin = static_cast<float>(std::log(settings_.minGain));
+  const auto logMax = static_cast<float>(std::log(settings_.maxGain));
+  for (std::size_t i = 0; i < active.domain.seams.size(); ++i) {
+    const CorrectionSeam& seam = active.domain.seams[i];
+    const CorrectionRegion& region = active.domain.regions[seam.region];
+    RegionState& state = active.regions[seam.region];
+    SeamReport& report = seamReports_[i];
+    report = {region.source, seam.target, static_cast<int>(seam.blocks.size())};
+    // A camera missing from this set: the seam holds its last values.
+    if (frames[region.source].empty() || frames[seam.target].empty()) continue;
+    medianAlongSeam(seam.blocks, state.measured, state.measuredValid, kSeamHalfWindow, window_,
+                    state.filtered, state.filteredValid);
+    cv::Vec3f sourceLevel(0, 0, 0);
+    for (const auto k : seam.blocks) {
+      if (state.measuredValid[k] == 0) continue;
+      ++report.validBlocks;
+      sourceLevel += state.levels[k].source;
+    }
+    if (report.validBlocks > 0) sourceLevel /= static_cast<float>(report.validBlocks);
+    const bool sparse = report.validBlocks < kMinimumMeasuredShare * report.blocks;
+    if (sparse) {
+      noteOnce(active.saidSparse, i,
+               fmt::format("seam {}/{}: {} of {} blocks measurable (too little ground both cameras "
+                           "see unmasked): kept at gain 1",
+                           rig_.cameras[region.source].name, rig_.cameras[seam.target].name,
+                           report.validBlocks, report.blocks));
+    }
+    float furthest = 0;
+    for (const auto k : seam.blocks) {
+      bool clamped = false;
+      for (int c = 0; c < 3; ++c) {
+        float value = sparse || state.filteredValid[k] == 0 ? 0.0f : state.filtered[k * 3 + c];
+        const float low =
+            multiplicative ? logMin : static_cast<float>(settings_.minGain - 1) * sourceLevel[c];
+        const float high =
+            multiplicative ? logMax : static_cast<float>(settings_.maxGain - 1) * sourceLevel[c];
+        if (value < low || value > high) {
+          clamped = true;
+          furthest = std::max(
+              furthest, std::abs(multiplicative ? value : value / std::max(sourceLevel[c], 1.0f)));
+          value = std::clamp(value, low, high);
+        }
+        float& smoothed = state.seamValue[k * 3 + c];
+        smoothed = keep * smoothed + (1 - keep) * value;
+        state.dirichlet[k * 3 + c] = smoothed;
+      }
+      report.clampedBlocks += clamped ? 1 : 0;
+    }
+    if (report.clampedBlocks > 0) {
+      noteOnce(active.saidClamped, i,
+               fmt::format("seam {}/{}: the correction asked for more than gains {:g}..{:g} on {} "
+                           "of {} blocks (up to x{:.2f}): clamped",
+                           rig_.cameras[region.source].name, rig_.cameras[seam.target].name,
+                           settings_.minGain, settings_.maxGain, report.clampedBlocks,
+                           report.blocks, multiplicative ? std::exp(furthest) : 1 + furthest));
     }
   }
   active.firstFrame = false;
 }
 
-int PoissonColourCorrection::update(std::span<const cv::Mat> frames) {
-  followLostCameras(frames);
-  gatherSeams(frames);
+void PoissonColourCorrection::solveRegions(std::span<const std::uint8_t> which) {
   Configuration& active = *active_;
   pool_.parallelFor(
       static_cast<int>(active.regions.size()),
       [&](int first, int last) {
         for (int r = first; r < last; ++r) {
+          if (!which.empty() && which[static_cast<std::size_t>(r)] == 0) continue;
           const CorrectionRegion& region = active.domain.regions[static_cast<std::size_t>(r)];
           RegionState& state = active.regions[static_cast<std::size_t>(r)];
           for (std::size_t i = 0; i < region.system.unknowns(); ++i) {
@@ -203,10 +296,78 @@ int PoissonColourCorrection::update(std::span<const cv::Mat> frames) {
             }
             for (int c = 0; c < 3; ++c) state.rhs[i * 3 + c] = sum[c];
           }
-          state.iterations = state.solver->solve(state.rhs, state.solution).iterations;
+          state.iterations += state.solver->solve(state.rhs, state.solution).iterations;
         }
       },
       static_cast<int>(active.regions.size()));
+}
+
+bool PoissonColourCorrection::dropWorseningSeams() {
+  Configuration& active = *active_;
+  const bool multiplicative = settings_.field == CorrectionField::kMultiplicative;
+  std::fill(resolve_.begin(), resolve_.end(), 0);
+  bool dropped = false;
+  float* uncorrected = stepScratch_.data();
+  float* corrected = uncorrected + stepScratch_.size() / 2;
+  for (std::size_t i = 0; i < active.domain.seams.size(); ++i) {
+    const CorrectionSeam& seam = active.domain.seams[i];
+    const CorrectionRegion& region = active.domain.regions[seam.region];
+    RegionState& state = active.regions[seam.region];
+    SeamReport& report = seamReports_[i];
+    std::size_t measured = 0;
+    for (const auto k : seam.blocks) {
+      const auto first = region.unknownsBegin[k];
+      const auto count = region.unknownsBegin[k + 1] - first;
+      if (state.measuredValid[k] == 0 || count == 0) continue;
+      const SeamBlockLevels& levels = state.levels[k];
+      float before = 0;
+      float after = 0;
+      for (int c = 0; c < 3; ++c) {
+        // What the source's pixels next to the seam get: the field at the unknowns beside it.
+        float field = 0;
+        for (auto u = first; u < first + count; ++u) {
+          field += state.solution[region.unknownsOf[u] * 3 + c];
+        }
+        field /= static_cast<float>(count);
+        const float source =
+            multiplicative ? levels.source[c] * std::exp(field) : levels.source[c] + field;
+        before += std::abs(levels.target[c] - levels.source[c]) / 3;
+        after += std::abs(levels.target[c] - std::clamp(source, 0.0f, 255.0f)) / 3;
+      }
+      uncorrected[measured] = before;
+      corrected[measured] = after;
+      ++measured;
+    }
+    if (measured == 0 || report.validBlocks < kMinimumMeasuredShare * report.blocks) continue;
+    // The typical block, not the mean: an object on a few blocks must not decide for the seam.
+    report.stepUncorrected = medianOf(uncorrected, measured);
+    report.stepCorrected = medianOf(corrected, measured);
+    if (report.stepCorrected <= report.stepUncorrected * (1 + kWorseShare) + kWorseLevels) continue;
+    noteOnce(active.saidDropped, i,
+             fmt::format("seam {}/{}: correcting it would make its step worse ({:.1f} against "
+                         "{:.1f} levels uncorrected): its data is dropped (gain 1 there)",
+                         rig_.cameras[region.source].name, rig_.cameras[seam.target].name,
+                         report.stepCorrected, report.stepUncorrected));
+    report.dropped = true;
+    report.stepCorrected = report.stepUncorrected;
+    dropped = true;
+    resolve_[seam.region] = 1;
+    for (const auto k : seam.blocks) {
+      std::fill_n(state.dirichlet.begin() + static_cast<std::ptrdiff_t>(k) * 3, 3, 0.0f);
+    }
+  }
+  return dropped;
+}
+
+int PoissonColourCorrection::update(std::span<const cv::Mat> frames) {
+  followLostCameras(frames);
+  gatherSeams(frames);
+  Configuration& active = *active_;
+  for (auto& state : active.regions) state.iterations = 0;
+  solveRegions({});
+  if (dropWorseningSeams()) {
+    solveRegions(std::span(resolve_.data(), active.regions.size()));
+  }
 
   int iterations = 0;
   for (std::size_t r = 0; r < active.regions.size(); ++r) {

@@ -10,6 +10,15 @@
 // seam's mean but leaves bright and dark pixels next to it off by the gain difference times their
 // distance from that mean.
 //
+// On real rigs the seam data is made robust (seam_statistics.hpp: trimmed means of usable samples,
+// filtered along each seam, from the ground and never from the vehicle's body), the field is
+// bounded to gains in [minGain, maxGain], and one rule stands above the rest: correction never
+// makes a seam worse than none. After each solve, every seam's step (its typical block's: the
+// target's levels against the source's as the field next to the seam leaves them) is compared
+// with its step uncorrected; a seam that got worse (by more than noise: 5 % and half a level) has
+// its data dropped (gain 1 there) and its region is solved again. Clamps, seams with too little
+// usable data and dropped seams are said once each in notesOfLastUpdate().
+//
 // Set up once (domain, systems, solver factorizations, buffers); update() and apply() are the
 // per-frame calls and allocate nothing. A camera missing from a frame set leaves the seams it
 // shares at their last values; missing for kLostAfterSets sets in a row it counts as lost and the
@@ -30,6 +39,7 @@
 
 #include "processing/correction_domain.hpp"
 #include "processing/poisson_solver.hpp"
+#include "processing/seam_statistics.hpp"
 
 namespace surroundd {
 class WorkPool;
@@ -48,6 +58,9 @@ struct ColourCorrectionSettings {
   PoissonSolverKind solver = PoissonSolverKind::kAuto;
   double tolerance = 5e-5;         // iterative solver: relative residual
   double temporalSmoothing = 0.0;  // weight of the previous frame's seam data, 0..0.99
+  double minGain = 0.5;            // the field's bounds, as gains (additive: the levels these
+  double maxGain = 2.0;            //   gains would add to the seam's source level)
+  bool groundSeams = true;         // seam data from the bowl's floor only
 
   bool operator==(const ColourCorrectionSettings&) const = default;
 };
@@ -63,6 +76,16 @@ class PoissonColourCorrection {
   PoissonColourCorrection& operator=(const PoissonColourCorrection&) = delete;
 
   static constexpr int kLostAfterSets = 5;
+
+  // How each seam of the last update() fared.
+  struct SeamReport {
+    std::uint8_t source = 0, target = 0;
+    int blocks = 0, validBlocks = 0, clampedBlocks = 0;
+    bool dropped = false;  // the correction would have made it worse: gain 1 there
+    // Median over measured blocks of the mean over channels of |target - source| in levels:
+    // without correction, and with the field as it leaves the source next to the seam.
+    double stepUncorrected = 0, stepCorrected = 0;
+  };
 
   // Things left out at set-up (regions without a seam to a target), to be logged once.
   const std::vector<std::string>& notes() const;
@@ -80,6 +103,8 @@ class PoissonColourCorrection {
   // Adds the fields to a panorama stitched from the same frames (8-bit BGR of the LUT's size).
   void apply(cv::Mat& panorama);
 
+  const std::vector<SeamReport>& seams() const { return seamReports_; }
+
   // The field at block resolution, CV_32FC3: the levels it adds to a pixel at 255, the most it
   // changes any pixel (0 outside the regions' reach). Additive: simply the levels it adds.
   const cv::Mat& field() const { return field_; }
@@ -90,6 +115,10 @@ class PoissonColourCorrection {
   Configuration& configurationFor(std::uint32_t presentCameras);
   void followLostCameras(std::span<const cv::Mat> frames);
   void gatherSeams(std::span<const cv::Mat> frames);
+  void solveRegions(std::span<const std::uint8_t> which);
+  // Drops the data of seams the solved field makes worse; true when any was dropped.
+  bool dropWorseningSeams();
+  void noteOnce(std::vector<std::uint8_t>& said, std::size_t seam, std::string note);
   template <CorrectionField kField>
   void applyRows(int first, int last, cv::Mat& panorama, std::vector<float>& columnBuffer) const;
 
@@ -105,6 +134,11 @@ class PoissonColourCorrection {
   std::uint32_t activeCameras_ = 0;
   std::vector<int> missingSets_;  // per camera: frame sets in a row without it
   std::vector<std::string> changes_;
+  std::vector<SeamReport> seamReports_;
+  SeamBlockMeter meter_;
+  std::vector<float> window_;          // running median along a seam
+  std::vector<std::uint8_t> resolve_;  // per region
+  std::vector<float> stepScratch_;     // per block of a seam: its step without and with the field
   cv::Mat field_;
   // Upsampling: bicubic weights for each sub-block phase (Catmull-Rom), each pixel column's first
   // tap (in blocks, -2..width), the rows that have anything to correct, and one row buffer per

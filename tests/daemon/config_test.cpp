@@ -3,6 +3,7 @@
 
 #include "daemon/config.hpp"
 
+#include <fstream>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -137,7 +138,6 @@ TEST_F(ConfigTest, SurroundOutputsTakeTheirOwnViewOrTheRenderDefault) {
   view: top
   split_camera: left
   orbit_period_s: 12
-  car_length_m: 4.2
   platform: surfaceless
 )"));
   const auto file = configWith("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
@@ -152,7 +152,6 @@ TEST_F(ConfigTest, SurroundOutputsTakeTheirOwnViewOrTheRenderDefault) {
   EXPECT_EQ(config.render.view, ViewKind::kTop);
   EXPECT_EQ(config.render.splitCamera, "left");
   EXPECT_DOUBLE_EQ(config.render.views.orbitPeriodS, 12.0);
-  EXPECT_DOUBLE_EQ(config.render.car.lengthM, 4.2);
   EXPECT_EQ(config.render.platform, render::EglPlatform::kSurfaceless);
 }
 
@@ -377,6 +376,59 @@ TEST_F(ConfigTest, RigFileRoundTripsExactly) {
   }
 }
 
+// The vehicle: one block that sizes the car model, the views and the bowl, in the config or in
+// the rig file (the config's wins).
+TEST_F(ConfigTest, TheVehicleSizesTheCarTheViewsAndTheBowl) {
+  const Config car = loadConfig(dir_.write("config.yaml", std::string(kGoodConfig)));
+  EXPECT_EQ(car.vehicle, std::nullopt);
+  EXPECT_DOUBLE_EQ(car.render.car.lengthM, 4.5);
+  const Config robot = loadConfig(dir_.write(
+      "config.yaml",
+      std::string(kGoodConfig) +
+          "vehicle: {length_m: 0.5, width_m: 0.4, height_m: 0.3, ground_clearance_m: 0.05, "
+          "front_overhang_m: 0.1, rear_overhang_m: 0.1, x_m: 0.1, margin_m: 0.05}\n"));
+  ASSERT_TRUE(robot.vehicle.has_value());
+  EXPECT_DOUBLE_EQ(robot.render.car.lengthM, 0.5);
+  EXPECT_DOUBLE_EQ(robot.render.car.centreXM, 0.1);
+  EXPECT_DOUBLE_EQ(robot.render.car.marginM, 0.05);
+  // A small vehicle gets a close look; a car the familiar 8 m.
+  EXPECT_LT(robot.render.views.topRangeM, 2.0);
+  EXPECT_NEAR(car.render.views.topRangeM, 8.0, 0.1);
+  EXPECT_LT(robot.render.views.orbitRadiusM, car.render.views.orbitRadiusM / 3);
+  // The bowl's floor reaches the top view's corners, so that the ground it shows stays flat.
+  for (const Config* config : {&car, &robot}) {
+    EXPECT_NEAR(config->mesh.bowlFloorRadiusM, topViewReachM(config->render), 1e-9);
+    EXPECT_GT(config->mesh.bowlRadiusM, config->mesh.bowlFloorRadiusM);
+    EXPECT_TRUE(config->warnings.empty()) << ::testing::PrintToString(config->warnings);
+  }
+  // A floor set smaller than that is allowed, with a warning.
+  const Config small = loadConfig(
+      dir_.write("config.yaml",
+                 std::string(kGoodConfig) + "mesh: {bowl_floor_radius_m: 5, bowl_radius_m: 10}\n"));
+  ASSERT_EQ(small.warnings.size(), 1u);
+  EXPECT_THAT(small.warnings[0], HasSubstr("mesh.bowl_floor_radius_m 5 is less than"));
+}
+
+TEST_F(ConfigTest, VehicleAndBodyMaskMistakesAreNamed) {
+  expectOneError(
+      "capture:", "vehicle: {length_m: 4, footprint: [[1, 1], [-1, 1], [0, -1]]}\ncapture:",
+      {"vehicle.footprint", "either length_m and width_m or footprint"});
+  expectOneError("capture:", "vehicle: {footprint: [[1, 1], [-1, 1]]}\ncapture:",
+                 {"vehicle.footprint", "at least 3 [x, y] pairs", "2 items"});
+  expectOneError("capture:", "vehicle: {height_m: 1, ground_clearance_m: 1.2}\ncapture:",
+                 {"vehicle.ground_clearance_m", "less than height_m"});
+  expectOneError("capture:", "vehicle: {length_m: 1, front_overhang_m: 0.6}\ncapture:",
+                 {"vehicle.front_overhang_m", "no wheelbase"});
+  expectOneError("      source: {file: left.mkv}",
+                 "      source: {file: left.mkv}\n      body_mask: {mode: add}",
+                 {"body_mask", "expected 'file'"});
+  expectOneError("      source: {file: left.mkv}",
+                 "      source: {file: left.mkv}\n      body_mask: {file: nowhere.png}",
+                 {"body_mask.file", "nowhere.png"});
+  expectOneError("  height_px: 360\noutputs", "  height_px: 360\n  car_length_m: 4\noutputs",
+                 {"render.car_length_m", "vehicle.length_m"});
+}
+
 // The reference config shows every key at its default: loading it must give the code's defaults.
 TEST(ReferenceConfig, DocumentsTheDefaults) {
   const testing::TempDir dir;
@@ -394,8 +446,24 @@ TEST(ReferenceConfig, DocumentsTheDefaults) {
   EXPECT_EQ(config.pipeline, PipelineConfig{});
   EXPECT_EQ(config.panorama, PanoramaConfig{});
   EXPECT_EQ(config.colour, ColourCorrectionConfig{});
-  EXPECT_EQ(config.mesh, MeshConfig{});
-  EXPECT_EQ(config.render, RenderConfig{});
+  // Sizes that follow the vehicle are commented out there: a config without those sections.
+  std::ifstream file(dir / "config/surroundd.reference.yaml");
+  const std::string text{std::istreambuf_iterator<char>(file), {}};
+  const auto section = [&](std::string_view key) {
+    const auto first = text.find(std::string("\n") + std::string(key) + ":");
+    const auto next = text.find("\n\n", first + 1);
+    return std::pair{first + 1, next};
+  };
+  std::string bare = text;
+  for (const auto* key : {"render", "mesh"}) {
+    const auto [first, next] = section(key);
+    bare.erase(bare.find(text.substr(first, next - first)), next - first);
+  }
+  const Config defaults = loadConfig(dir.write("config/bare.yaml", bare));
+  EXPECT_EQ(config.mesh, defaults.mesh);
+  EXPECT_EQ(config.render, defaults.render);
+  EXPECT_EQ(config.vehicle, std::nullopt);
+  EXPECT_TRUE(config.warnings.empty()) << ::testing::PrintToString(config.warnings);
   EXPECT_EQ(config.control, ControlConfig{});
   ASSERT_EQ(config.outputs.size(), 2u);
   OutputConfig video;

@@ -2,7 +2,7 @@
 // milliseconds, with ratios against a baseline measured in the same run.
 //
 //   surround-bench stitch [--threads N] [--repeats N] [--json] RECORDING...
-//   surround-bench colour [--threads N] [--repeats N] RECORDING...
+//   surround-bench colour [--threads N] [--repeats N] [--pictures DIR] RECORDING|CONFIG...
 //   surround-bench pipeline [--threads N] [--repeats N] [--json] [--solver S] [--projection P]
 //                           [--view V] [--size WxH] RECORDING...
 //
@@ -11,6 +11,7 @@
 #include <charconv>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <optional>
 #include <string_view>
 
@@ -18,17 +19,21 @@
 
 #include "tools/bench/colour_benchmark.hpp"
 #include "tools/bench/pipeline_benchmark.hpp"
+#include "tools/bench/rig_colour_report.hpp"
 #include "tools/bench/stitch_benchmark.hpp"
 
 namespace {
 
 constexpr std::string_view kUsage =
     R"(usage: surround-bench stitch [--threads N] [--repeats N] [--json] RECORDING...
-       surround-bench colour [--threads N] [--repeats N] RECORDING...
+       surround-bench colour [--threads N] [--repeats N] [--pictures DIR] RECORDING|CONFIG...
        surround-bench pipeline [--threads N] [--repeats N] [--json] [--solver S]
                                [--projection P] [--view V] [--size WxH] RECORDING...
   stitch        LUT build, stitch against cv::remap, accuracy against the ground truth
-  colour        Poisson colour correction: solvers, per-frame cost, seam colour error
+  colour        Poisson colour correction: solvers, per-frame cost, seam colour error; for a
+                CONFIG (a surroundd .yaml: any rig, the shared real ones, your own car): per
+                seam the ground misalignment and the colour step on near and far ground with
+                no correction, gains and Poisson, and the mean level
   pipeline      the whole daemon pipeline (the paper's tables 1 and 2): frames per second,
                 milliseconds per stage, CPU and peak memory, against a decode-only replay
   RECORDING     a surround-synth recording folder (with ground truth); scripts/bench.sh makes
@@ -40,6 +45,7 @@ constexpr std::string_view kUsage =
   --projection P  pipeline: bowl | sphere (default bowl)
   --view V      pipeline: top | 360 | orbit | split (default orbit)
   --size WxH    pipeline: output size (default 1280x720)
+  --pictures DIR  colour, CONFIG: also write the panoramas (none, gain, Poisson) and body masks
 )";
 
 int usageError(std::string_view message) {
@@ -86,6 +92,7 @@ int main(int argc, char** argv) {
   bench::StitchBenchmarkOptions options;
   bench::PipelineBenchmarkOptions pipeline;
   std::optional<int> repeats;
+  std::filesystem::path pictures;
   for (int i = 2; i < argc; ++i) {
     const std::string_view arg = argv[i];
     const bool hasValue = i + 1 < argc;
@@ -122,6 +129,10 @@ int main(int argc, char** argv) {
       if (!view) return usageError("--view needs top, 360, orbit or split");
       pipeline.view = *view;
       ++i;
+    } else if (command == "colour" && arg == "--pictures") {
+      if (!hasValue) return usageError("--pictures needs a folder");
+      pictures = value;
+      ++i;
     } else if (command == "pipeline" && arg == "--size") {
       if (!parseSize(value, pipeline.outputSize)) {
         return usageError("--size needs an even WIDTHxHEIGHT such as 1280x720");
@@ -137,7 +148,15 @@ int main(int argc, char** argv) {
   if (repeats) options.repeats = *repeats;
   try {
     if (command == "colour") {
-      return bench::runColourBenchmark({options.recordings, options.threads, options.repeats});
+      bench::ColourBenchmarkOptions colour{{}, options.threads, options.repeats};
+      for (const auto& input : options.recordings) {
+        if (std::filesystem::is_regular_file(input)) {
+          bench::reportRigColour(input, options.threads, pictures);
+        } else {
+          colour.recordings.push_back(input);
+        }
+      }
+      return colour.recordings.empty() ? 0 : bench::runColourBenchmark(colour);
     }
     if (command == "pipeline") {
       pipeline.recordings = options.recordings;

@@ -1,0 +1,193 @@
+// Colour correction made for real rigs (issue 15), on the generator's recordings: an object on a
+// seam does not pull the field; gains beyond the configured range are clamped and said; a seam
+// that correction would make worse keeps gain 1 (here: a sudden exposure change under heavy
+// temporal smoothing); gain compensation keeps the rig's brightness.
+
+#include <gtest/gtest.h>
+
+#include "common/work_pool.hpp"
+#include "processing/gain_compensation.hpp"
+#include "processing/poisson_correction.hpp"
+#include "processing/stitcher.hpp"
+#include "tests/processing/panorama_test_support.hpp"
+#include "tests/support/test_support.hpp"
+#include "tools/bench/seam_measures.hpp"
+
+namespace surroundd::processing {
+namespace {
+
+class RobustColourTest : public ::testing::Test {
+ protected:
+  explicit RobustColourTest(const char* fixture = "synth_small")
+      : truth_(bench::loadRecordingTruth(std::filesystem::path(SURROUNDD_FIXTURE_DIR) / fixture)),
+        settings_(testing::settingsFor(truth_)),
+        lut_(buildPanoramaLut(truth_.rig, settings_, pool_)) {
+    for (const auto& video : truth_.videos) {
+      frames_.push_back(surroundd::testing::decodeAll(video, false, 1).images.at(0));
+    }
+  }
+
+  std::string name(std::size_t camera) const { return truth_.rig.cameras[camera].name; }
+  // A new picture (assigning a MatExpr to a copied header would write into the original).
+  static cv::Mat scaled(const cv::Mat& image, double gain) {
+    cv::Mat out;
+    image.convertTo(out, -1, gain);
+    return out;
+  }
+
+  WorkPool pool_{2};
+  bench::RecordingTruth truth_;
+  PanoramaSettings settings_;
+  PanoramaLut lut_;
+  std::vector<cv::Mat> frames_;
+};
+
+// A bright object standing on two neighbouring blocks of every seam, seen by the target camera
+// only (parallax): the running median along the seam (7 blocks) outvotes it.
+TEST_F(RobustColourTest, AnObjectOnASeamDoesNotPullTheField) {
+  ColourCorrectionSettings settings;
+  PoissonColourCorrection clean(truth_.rig, settings_, lut_, settings, pool_);
+  clean.update(frames_);
+  const cv::Mat cleanField = clean.field().clone();
+
+  std::vector<cv::Mat> objects;
+  for (const auto& frame : frames_) objects.push_back(frame.clone());
+  const CorrectionDomain& domain = clean.domain();
+  int painted = 0;
+  for (const auto& seam : domain.seams) {
+    const CorrectionRegion& region = domain.regions[seam.region];
+    for (std::size_t k = seam.blocks.size() / 2; k < seam.blocks.size() / 2 + 2; ++k) {
+      const DirichletBlock& block = region.dirichlet[seam.blocks[k]];
+      for (auto s = block.firstSample; s < block.endSample; ++s) {
+        const LutTap& tap = domain.samples[s].target;
+        cv::Mat& image = objects[tap.camera];
+        const int x = static_cast<int>(tap.offset % static_cast<std::uint32_t>(image.cols));
+        const int y = static_cast<int>(tap.offset / static_cast<std::uint32_t>(image.cols));
+        cv::rectangle(image, {x, y, 2, 2}, cv::Scalar(40, 200, 230), cv::FILLED);
+      }
+      ++painted;
+    }
+  }
+  ASSERT_GE(painted, 6);
+  PoissonColourCorrection robust(truth_.rig, settings_, lut_, settings, pool_);
+  robust.update(objects);
+  cv::Mat difference;
+  cv::absdiff(robust.field(), cleanField, difference);
+  // The field in levels at 255; a plain block mean would move it by tens of levels there.
+  EXPECT_LT(cv::mean(difference.reshape(1))[0], 0.5);
+  double worst = 0;
+  cv::minMaxLoc(difference.reshape(1), nullptr, &worst);
+  EXPECT_LT(worst, 6.0);
+}
+
+TEST_F(RobustColourTest, GainsBeyondTheRangeAreClampedAndSaid) {
+  std::vector<cv::Mat> dark = frames_;
+  dark[0] = scaled(frames_[0], 0.3);  // the front camera: the targets are over 3 times brighter
+  ColourCorrectionSettings settings;
+  PoissonColourCorrection poisson(truth_.rig, settings_, lut_, settings, pool_);
+  poisson.update(dark);
+  double lowest = 0, highest = 0;
+  cv::minMaxLoc(poisson.field().reshape(1), &lowest, &highest);
+  EXPECT_LE(highest, 255 * (settings.maxGain - 1) + 1);   // levels added at 255
+  EXPECT_GT(highest, 255 * (settings.maxGain - 1) - 10);  // and the bound is reached
+  EXPECT_GE(lowest, 255 * (settings.minGain - 1) - 1);
+  const auto& notes = poisson.notesOfLastUpdate();
+  const auto said = std::ranges::count_if(notes, [&](const std::string& note) {
+    return note.starts_with("seam " + name(0) + "/") && note.find("clamped") != std::string::npos;
+  });
+  EXPECT_EQ(said, 2) << ::testing::PrintToString(notes);  // front/left and front/right
+  int clampedSeams = 0;
+  for (const auto& seam : poisson.seams()) clampedSeams += seam.clampedBlocks > 0 ? 1 : 0;
+  EXPECT_EQ(clampedSeams, 2);
+  // Said once: the next frame clamps as much and says nothing new.
+  poisson.update(dark);
+  EXPECT_TRUE(poisson.notesOfLastUpdate().empty());
+}
+
+// Heavy smoothing learns the seam data of a brighter target camera; its exposure then drops back
+// at once. The smoothed field would now leave the seam far worse than no correction: that seam's
+// data is dropped, said once, and the step measured across it is no worse than uncorrected.
+TEST_F(RobustColourTest, ASeamThatCorrectionWouldMakeWorseKeepsGainOne) {
+  std::vector<cv::Mat> bright = frames_;
+  bright[1] = scaled(frames_[1], 1.7);  // the right camera
+  ColourCorrectionSettings settings;
+  settings.temporalSmoothing = 0.95;
+  PoissonColourCorrection poisson(truth_.rig, settings_, lut_, settings, pool_);
+  for (int k = 0; k < 3; ++k) poisson.update(bright);
+  for (const auto& seam : poisson.seams()) {
+    EXPECT_FALSE(seam.dropped);
+    EXPECT_LE(seam.stepCorrected, seam.stepUncorrected);
+  }
+  poisson.update(frames_);
+  int dropped = 0;
+  for (const auto& seam : poisson.seams()) {
+    if (seam.validBlocks == 0) continue;
+    EXPECT_LE(seam.stepCorrected, seam.stepUncorrected + 1e-9);
+    if (seam.dropped) {
+      ++dropped;
+      EXPECT_EQ(seam.target, 1u);
+    }
+  }
+  EXPECT_EQ(dropped, 2);  // front/right and back/right
+  const auto& notes = poisson.notesOfLastUpdate();
+  EXPECT_EQ(std::ranges::count_if(notes,
+                                  [](const std::string& note) {
+                                    return note.find("would make its step worse") !=
+                                           std::string::npos;
+                                  }),
+            2)
+      << ::testing::PrintToString(notes);
+
+  // Measured independently on the panorama, next to the seams on the near ground.
+  Stitcher stitcher(lut_, pool_);
+  cv::Mat raw;
+  stitcher.stitch(frames_, raw);
+  cv::Mat corrected = raw.clone();
+  poisson.apply(corrected);
+  for (const auto& seam : bench::seamLines(truth_.rig, settings_)) {
+    if (seam.left != 1 && seam.right != 1) continue;
+    const auto before = bench::seamColourStep(raw, lut_, settings_, seam).nearLevels;
+    const auto after = bench::seamColourStep(corrected, lut_, settings_, seam).nearLevels;
+    ASSERT_TRUE(before && after) << seam.name;
+    // The other seam's field still reaches across the region a little.
+    EXPECT_LE(*after, *before * 1.1 + 0.5) << seam.name;
+  }
+}
+
+TEST_F(RobustColourTest, GainCompensationKeepsTheRigsBrightness) {
+  // One camera far off, as a wrong exposure or a body in the overlaps makes it: least squares
+  // alone would dim the whole rig towards it.
+  std::vector<cv::Mat> frames = frames_;
+  frames[2] = scaled(frames_[2], 0.2);
+  std::vector<std::string> names;
+  for (const auto& camera : truth_.rig.cameras) names.push_back(camera.name);
+  GainCompensation gains(lut_, pool_, 0.5, 2.0, names);
+  gains.update(frames_);
+  const std::vector<cv::Vec3f> usual = gains.gains();
+  gains.update(frames);
+  // The others keep about the gains they have with the back camera as it came.
+  for (const std::size_t camera : {0U, 1U, 3U}) {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(gains.gains()[camera][c] / usual[camera][c], 1.0, 0.15)
+          << name(camera) << " channel " << c;
+    }
+  }
+  // The back camera wanted about 5: clamped to the bound, and said naming it.
+  for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(gains.gains()[2][c], 2.0f);
+  const auto& notes = gains.notesOfLastUpdate();
+  EXPECT_TRUE(std::ranges::any_of(notes, [&](const std::string& note) {
+    return note.starts_with("camera '" + name(2) + "': gain ");
+  })) << ::testing::PrintToString(notes);
+
+  // The cameras as they came: the panorama keeps its mean level.
+  Stitcher stitcher(lut_, pool_);
+  cv::Mat raw;
+  stitcher.stitch(frames_, raw);
+  gains.update(frames_);
+  cv::Mat gained = raw.clone();
+  gains.apply(gained);
+  EXPECT_NEAR(bench::meanLevel(gained, lut_) / bench::meanLevel(raw, lut_), 1.0, 0.1);
+}
+
+}  // namespace
+}  // namespace surroundd::processing

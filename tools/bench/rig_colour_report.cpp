@@ -1,0 +1,123 @@
+#include "tools/bench/rig_colour_report.hpp"
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "capture/file_source.hpp"
+#include "common/work_pool.hpp"
+#include "daemon/config.hpp"
+#include "daemon/panorama_setup.hpp"
+#include "processing/gain_compensation.hpp"
+#include "processing/poisson_correction.hpp"
+#include "processing/stitcher.hpp"
+#include "tools/bench/seam_measures.hpp"
+
+namespace surroundd::bench {
+namespace {
+
+std::vector<cv::Mat> firstFrames(const daemon::Config& config) {
+  std::vector<cv::Mat> frames;
+  for (const auto& camera : config.cameras) {
+    if (!camera.source) {
+      throw std::runtime_error(fmt::format("{}: camera '{}' is live; the report needs files",
+                                           config.file.string(), camera.calibration.name));
+    }
+    capture::FileSource source(camera.calibration.name, *camera.source);
+    capture::Frame frame;
+    frame.image.create(source.frameSize(), CV_8UC3);
+    if (source.read(frame) != capture::ReadStatus::kFrame) {
+      throw std::runtime_error(
+          fmt::format("cannot read a frame of {}", camera.source->path.string()));
+    }
+    frames.push_back(frame.image);
+  }
+  return frames;
+}
+
+std::string levels(const std::optional<double>& value) {
+  return value ? fmt::format("{:5.1f}", *value) : std::string("  n/a");
+}
+
+}  // namespace
+
+void reportRigColour(const std::filesystem::path& configFile, int threads,
+                     const std::filesystem::path& pictures) {
+  const daemon::Config config = daemon::loadConfig(configFile);
+  WorkPool pool(threads);
+  const processing::Rig rig = daemon::rigOf(config, pool);
+  const processing::PanoramaSettings settings = daemon::panoramaSettings(config);
+  const processing::PanoramaLut lut = processing::buildPanoramaLut(rig, settings, pool);
+  const std::vector<cv::Mat> frames = firstFrames(config);
+  processing::Stitcher stitcher(lut, pool);
+  cv::Mat raw;
+  stitcher.stitch(frames, raw);
+
+  const auto& colour = config.colour.poisson;
+  cv::Mat gained = raw.clone();
+  processing::GainCompensation gains(lut, pool, colour.minGain, colour.maxGain);
+  gains.update(frames);
+  gains.apply(gained);
+  cv::Mat poisson = raw.clone();
+  processing::PoissonColourCorrection correction(rig, settings, lut, colour, pool);
+  correction.update(frames);
+  correction.apply(poisson);
+
+  int masked = 0;
+  for (const auto& camera : rig.cameras) masked += camera.bodyMask.empty() ? 0 : 1;
+  fmt::print(
+      "{}: {} cameras, panorama {}x{}, {} with a body mask, Poisson {} field at scale {:g}\n",
+      configFile.filename().string(), rig.cameras.size(), lut.size.width, lut.size.height, masked,
+      processing::correctionFieldName(colour.field), colour.scale);
+  fmt::print("  {:<14} {:>16}   {:^23}   {:^23}\n", "seam", "misalignment",
+             "step near: none gain PLCC", "step far: none gain PLCC");
+  for (const auto& seam : seamLines(rig, settings)) {
+    const auto alignment = seamAlignment(rig, frames, settings, seam);
+    const auto none = seamColourStep(raw, lut, settings, seam);
+    const auto gain = seamColourStep(gained, lut, settings, seam);
+    const auto plcc = seamColourStep(poisson, lut, settings, seam);
+    fmt::print("  {:<14} {:>16}   {}  {}  {}     {}  {}  {}\n", seam.name,
+               alignment
+                   ? fmt::format("{:.1f} cm ({:.2f})", alignment->shiftCm, alignment->response)
+                   : std::string("n/a"),
+               levels(none.nearLevels), levels(gain.nearLevels), levels(plcc.nearLevels),
+               levels(none.farLevels), levels(gain.farLevels), levels(plcc.farLevels));
+  }
+  const double before = meanLevel(raw, lut);
+  fmt::print("  mean level: none {:.1f}, gain {:.1f} ({:+.1f} %), Poisson {:.1f} ({:+.1f} %)\n",
+             before, meanLevel(gained, lut), 100 * (meanLevel(gained, lut) / before - 1),
+             meanLevel(poisson, lut), 100 * (meanLevel(poisson, lut) / before - 1));
+  std::string gainText;
+  for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+    const cv::Vec3f g = gains.gains()[c];
+    gainText += fmt::format("{}{} {:.2f}/{:.2f}/{:.2f}", gainText.empty() ? "" : ", ",
+                            rig.cameras[c].name, g[0], g[1], g[2]);
+  }
+  fmt::print("  gains (B/G/R): {}\n", gainText);
+  double lowest = 1, highest = 1;
+  cv::minMaxLoc(correction.field().reshape(1), &lowest, &highest);
+  fmt::print("  Poisson field: x{:.2f} .. x{:.2f} at 255\n", 1 + lowest / 255, 1 + highest / 255);
+  for (const auto& seam : correction.seams()) {
+    fmt::print("    seam {}/{}: {} of {} blocks measured, {} clamped, step {:.1f} -> {:.1f}{}\n",
+               rig.cameras[seam.source].name, rig.cameras[seam.target].name, seam.validBlocks,
+               seam.blocks, seam.clampedBlocks, seam.stepUncorrected, seam.stepCorrected,
+               seam.dropped ? " (dropped: it would have got worse)" : "");
+  }
+  for (const auto& note : correction.notes()) fmt::print("    note: {}\n", note);
+  for (const auto& note : correction.notesOfLastUpdate()) fmt::print("    note: {}\n", note);
+  if (!pictures.empty()) {
+    std::filesystem::create_directories(pictures);
+    const std::string stem = configFile.stem().string();
+    cv::imwrite((pictures / (stem + "-none.png")).string(), raw);
+    cv::imwrite((pictures / (stem + "-gain.png")).string(), gained);
+    cv::imwrite((pictures / (stem + "-poisson.png")).string(), poisson);
+    for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+      if (rig.cameras[c].bodyMask.empty()) continue;
+      cv::imwrite((pictures / (stem + "-mask-" + rig.cameras[c].name + ".png")).string(),
+                  rig.cameras[c].bodyMask);
+    }
+    fmt::print("  pictures in {}\n", pictures.string());
+  }
+  fmt::print("\n");
+}
+
+}  // namespace surroundd::bench
