@@ -174,6 +174,8 @@ processing::Pose readMount(YamlObject& mount) {
   return pose;
 }
 
+}  // namespace
+
 // Default colour role: cameras looking mostly along the vehicle (front, back) are sources, the
 // sideways ones targets — the paper's arrangement.
 processing::ColourRole defaultRole(const processing::Pose& pose) {
@@ -181,8 +183,6 @@ processing::ColourRole defaultRole(const processing::Pose& pose) {
   return std::abs(axis[0]) >= std::abs(axis[1]) ? processing::ColourRole::kSource
                                                 : processing::ColourRole::kTarget;
 }
-
-}  // namespace
 
 std::vector<RigCamera> readRigCameras(YamlObject& rig) {
   std::vector<RigCamera> cameras;

@@ -38,6 +38,10 @@ struct RigCamera {
   bool live() const { return device.has_value() || libcamera.has_value(); }
 };
 
+// The role a camera gets when its entry names none: cameras looking mostly along the vehicle
+// (front, back) are colour sources, the sideways ones targets.
+processing::ColourRole defaultRole(const processing::Pose& pose);
+
 // Reads and validates the `cameras` list of `rig`; errors go to the object's Diagnostics.
 std::vector<RigCamera> readRigCameras(YamlObject& rig);
 
