@@ -103,28 +103,32 @@ void parseOptions(std::span<const std::string_view> arguments, const Handlers& v
 IntrinsicsOptions parseIntrinsics(std::span<const std::string_view> arguments) {
   IntrinsicsOptions o;
   bool model = false;
-  parseOptions(
-      arguments,
-      {{"--images", [&](auto v) { o.images = std::string(v); }},
-       {"--board", [&](auto v) { o.board = parseBoard("--board", v); }},
-       {"--model",
-        [&](auto v) {
-          if (v != "pinhole" && v != "fisheye") {
-            throw UsageError(fmt::format("--model: expected 'pinhole' or 'fisheye', got '{}'", v));
-          }
-          o.model =
-              v == "pinhole" ? processing::LensModel::kPinhole : processing::LensModel::kFisheye;
-          model = true;
-        }},
-       {"--out", [&](auto v) { o.out = std::string(v); }},
-       {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
-       {"--field-of-view-deg",
-        [&](auto v) {
-          o.fieldOfViewDeg = parseDouble("--field-of-view-deg", v, 1, 360, "degrees from 1 to 360");
-        }},
-       {"--update-rig", [&](auto v) { o.updateRig = std::string(v); }},
-       {"--camera", [&](auto v) { o.camera = std::string(v); }}},
-      {});
+  parseOptions(arguments,
+               {{"--images", [&](auto v) { o.images = std::string(v); }},
+                {"--board", [&](auto v) { o.board = parseBoard("--board", v); }},
+                {"--model",
+                 [&](auto v) {
+                   if (v != "pinhole" && v != "fisheye") {
+                     throw UsageError(fmt::format(
+                         "--model: expected 'pinhole' or 'fisheye', got '{}'{}", v,
+                         v == "ocam" ? " (an OCamCalib lens is calibrated with OCamCalib, and its "
+                                       "polynomials written into the rig as lens.model ocam)"
+                                     : ""));
+                   }
+                   o.model = v == "pinhole" ? processing::LensModel::kPinhole
+                                            : processing::LensModel::kFisheye;
+                   model = true;
+                 }},
+                {"--out", [&](auto v) { o.out = std::string(v); }},
+                {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
+                {"--field-of-view-deg",
+                 [&](auto v) {
+                   o.fieldOfViewDeg =
+                       parseDouble("--field-of-view-deg", v, 1, 360, "degrees from 1 to 360");
+                 }},
+                {"--update-rig", [&](auto v) { o.updateRig = std::string(v); }},
+                {"--camera", [&](auto v) { o.camera = std::string(v); }}},
+               {});
   if (o.images.empty()) throw UsageError("--images: missing (the folder of checkerboard images)");
   if (o.board.area() == 0) throw UsageError("--board: missing (inner corners, e.g. 9x6)");
   if (!model) throw UsageError("--model: missing (pinhole or fisheye)");
