@@ -103,32 +103,35 @@ void parseOptions(std::span<const std::string_view> arguments, const Handlers& v
 IntrinsicsOptions parseIntrinsics(std::span<const std::string_view> arguments) {
   IntrinsicsOptions o;
   bool model = false;
-  parseOptions(arguments,
-               {{"--images", [&](auto v) { o.images = std::string(v); }},
-                {"--board", [&](auto v) { o.board = parseBoard("--board", v); }},
-                {"--model",
-                 [&](auto v) {
-                   if (v != "pinhole" && v != "fisheye") {
-                     throw UsageError(fmt::format(
-                         "--model: expected 'pinhole' or 'fisheye', got '{}'{}", v,
-                         v == "ocam" ? " (an OCamCalib lens is calibrated with OCamCalib, and its "
-                                       "polynomials written into the rig as lens.model ocam)"
-                                     : ""));
-                   }
-                   o.model = v == "pinhole" ? processing::LensModel::kPinhole
-                                            : processing::LensModel::kFisheye;
-                   model = true;
-                 }},
-                {"--out", [&](auto v) { o.out = std::string(v); }},
-                {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
-                {"--field-of-view-deg",
-                 [&](auto v) {
-                   o.fieldOfViewDeg =
-                       parseDouble("--field-of-view-deg", v, 1, 360, "degrees from 1 to 360");
-                 }},
-                {"--update-rig", [&](auto v) { o.updateRig = std::string(v); }},
-                {"--camera", [&](auto v) { o.camera = std::string(v); }}},
-               {});
+  // The rig takes OCamCalib lenses, but this tool does not solve them: say where one comes from.
+  const auto wrongModel = [](std::string_view v) {
+    return UsageError(fmt::format("--model: expected 'pinhole' or 'fisheye', got '{}'{}", v,
+                                  v == "ocam" ? " (calibrate an OCamCalib lens with OCamCalib and "
+                                                "write its polynomials into the rig's lens block)"
+                                              : ""));
+  };
+  parseOptions(
+      arguments,
+      {{"--images", [&](auto v) { o.images = std::string(v); }},
+       {"--board", [&](auto v) { o.board = parseBoard("--board", v); }},
+       {"--model",
+        [&](auto v) {
+          if (v != "pinhole" && v != "fisheye") {
+            throw wrongModel(v);
+          }
+          o.model =
+              v == "pinhole" ? processing::LensModel::kPinhole : processing::LensModel::kFisheye;
+          model = true;
+        }},
+       {"--out", [&](auto v) { o.out = std::string(v); }},
+       {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
+       {"--field-of-view-deg",
+        [&](auto v) {
+          o.fieldOfViewDeg = parseDouble("--field-of-view-deg", v, 1, 360, "degrees from 1 to 360");
+        }},
+       {"--update-rig", [&](auto v) { o.updateRig = std::string(v); }},
+       {"--camera", [&](auto v) { o.camera = std::string(v); }}},
+      {});
   if (o.images.empty()) throw UsageError("--images: missing (the folder of checkerboard images)");
   if (o.board.area() == 0) throw UsageError("--board: missing (inner corners, e.g. 9x6)");
   if (!model) throw UsageError("--model: missing (pinhole or fisheye)");
