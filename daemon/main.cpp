@@ -16,6 +16,7 @@
 
 #include "daemon/config.hpp"
 #include "daemon/logging.hpp"
+#include "daemon/rig_yaml.hpp"
 #include "daemon/service.hpp"
 
 namespace {
@@ -119,6 +120,12 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (arguments->checkOnly) {
+    // Not errors: the daemon runs with them, and says so at start-up too.
+    for (const auto& camera : config.cameras) {
+      if (const auto warning = daemon::lensFieldCutWarning(camera.calibration)) {
+        fmt::print(stderr, "surroundd: warning: {}\n", *warning);
+      }
+    }
     fmt::print("surroundd: {}: good ({} cameras, {} outputs)\n", arguments->configFile,
                config.cameras.size(), config.outputs.size());
     return 0;

@@ -6,6 +6,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "daemon/rig_yaml.hpp"
 #include "processing/panorama_lut_cache.hpp"
 
 namespace surroundd::daemon {
@@ -61,6 +62,10 @@ std::filesystem::path lutCacheDir(const Config& config) {
 }
 
 processing::PanoramaLut obtainPanoramaLut(const Config& config, WorkPool& pool) {
+  // Once per camera at start-up, whether the LUT comes from the cache or not.
+  for (const auto& camera : config.cameras) {
+    if (const auto warning = lensFieldCutWarning(camera.calibration)) spdlog::warn("{}", *warning);
+  }
   const processing::Rig rig = rigOf(config);
   const processing::PanoramaSettings settings = panoramaSettings(config);
   const std::string key = processing::panoramaLutKey(rig, settings);

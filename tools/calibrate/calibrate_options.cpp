@@ -72,6 +72,13 @@ cv::Size parseBoard(std::string_view option, std::string_view text) {
 IntrinsicsOptions parseIntrinsics(std::span<const std::string_view> arguments) {
   IntrinsicsOptions o;
   bool model = false;
+  // The rig takes OCamCalib lenses, but this tool does not solve them: say where one comes from.
+  const auto wrongModel = [](std::string_view v) {
+    return UsageError(fmt::format("--model: expected 'pinhole' or 'fisheye', got '{}'{}", v,
+                                  v == "ocam" ? " (calibrate an OCamCalib lens with OCamCalib and "
+                                                "write its polynomials into the rig's lens block)"
+                                              : ""));
+  };
   parseOptions(
       arguments,
       {{"--images", [&](auto v) { o.images = std::string(v); }},
@@ -79,7 +86,7 @@ IntrinsicsOptions parseIntrinsics(std::span<const std::string_view> arguments) {
        {"--model",
         [&](auto v) {
           if (v != "pinhole" && v != "fisheye") {
-            throw UsageError(fmt::format("--model: expected 'pinhole' or 'fisheye', got '{}'", v));
+            throw wrongModel(v);
           }
           o.model =
               v == "pinhole" ? processing::LensModel::kPinhole : processing::LensModel::kFisheye;
