@@ -373,6 +373,15 @@ TEST(Import, OcamCalibResultsMadeFromTheFisheyeRig) {
   for (const auto& option : kTopDown.options()) arguments.push_back(option);
   const auto imported = runImport(arguments);
   expectPoses(imported, truth, "calib_results.txt + 4x4");
+  // The rig file keeps the ocam lens exactly.
+  std::ostringstream log;
+  calibrate::runImport(
+      parseImport(std::vector<std::string_view>(arguments.begin(), arguments.end())), log);
+  const auto reread = daemon::loadRigFile(dir / "rig.yaml");
+  ASSERT_EQ(reread.size(), imported.size());
+  for (std::size_t i = 0; i < reread.size(); ++i) {
+    EXPECT_EQ(reread[i].calibration.intrinsics, imported[i].calibration.intrinsics);
+  }
   double worst = 0;
   for (std::size_t i = 0; i < truth.size(); ++i) {
     const processing::CameraModel want(truth[i].intrinsics);

@@ -79,28 +79,28 @@ IntrinsicsOptions parseIntrinsics(std::span<const std::string_view> arguments) {
                                                 "write its polynomials into the rig's lens block)"
                                               : ""));
   };
-  parseOptions(
-      arguments,
-      {{"--images", [&](auto v) { o.images = std::string(v); }},
-       {"--board", [&](auto v) { o.board = parseBoard("--board", v); }},
-       {"--model",
-        [&](auto v) {
-          if (v != "pinhole" && v != "fisheye") {
-            throw wrongModel(v);
-          }
-          o.model =
-              v == "pinhole" ? processing::LensModel::kPinhole : processing::LensModel::kFisheye;
-          model = true;
-        }},
-       {"--out", [&](auto v) { o.out = std::string(v); }},
-       {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
-       {"--field-of-view-deg",
-        [&](auto v) {
-          o.fieldOfViewDeg = parseDouble("--field-of-view-deg", v, 1, 360, "degrees from 1 to 360");
-        }},
-       {"--update-rig", [&](auto v) { o.updateRig = std::string(v); }},
-       {"--camera", [&](auto v) { o.camera = std::string(v); }}},
-      {});
+  parseOptions(arguments,
+               {{"--images", [&](auto v) { o.images = std::string(v); }},
+                {"--board", [&](auto v) { o.board = parseBoard("--board", v); }},
+                {"--model",
+                 [&](auto v) {
+                   if (v != "pinhole" && v != "fisheye") {
+                     throw wrongModel(v);
+                   }
+                   o.model = v == "pinhole" ? processing::LensModel::kPinhole
+                                            : processing::LensModel::kFisheye;
+                   model = true;
+                 }},
+                {"--out", [&](auto v) { o.out = std::string(v); }},
+                {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
+                {"--field-of-view-deg",
+                 [&](auto v) {
+                   o.fieldOfViewDeg =
+                       parseDouble("--field-of-view-deg", v, 1, 360, "degrees from 1 to 360");
+                 }},
+                {"--update-rig", [&](auto v) { o.updateRig = std::string(v); }},
+                {"--camera", [&](auto v) { o.camera = std::string(v); }}},
+               {});
   if (o.images.empty()) throw UsageError("--images: missing (the folder of checkerboard images)");
   if (o.board.area() == 0) throw UsageError("--board: missing (inner corners, e.g. 9x6)");
   if (!model) throw UsageError("--model: missing (pinhole or fisheye)");

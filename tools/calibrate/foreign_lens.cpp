@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
 
 #include "tools/calibrate/calibrate_options.hpp"
 
@@ -13,6 +14,14 @@ namespace surroundd::calibrate {
 namespace {
 
 using processing::LensModel;
+
+// A picture's pixels at or below this level are outside the lens's image circle (as
+// surround-calibrate intrinsics takes it).
+constexpr int kLitLevel = 16;
+// Real pictures are rarely black outside the image circle (JPEG's dark level, stray light: the
+// pjlab samples are lit to their corners), and a polynomial fitted inside the circle means nothing
+// beyond it: the default field stops at the widest automotive fisheye lenses'.
+constexpr double kWidestDefaultFieldDeg = 200;
 
 std::optional<LensModel> modelFromName(std::string name) {
   std::ranges::transform(name, name.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -106,9 +115,39 @@ double fieldToImageCorner(const processing::Intrinsics& lens) {
   return 360;
 }
 
+double litFieldDeg(const processing::Intrinsics& lens, const cv::Mat& picture) {
+  // Unprojected with the widest field the image allows, then cut back to what is lit. The
+  // farthest lit pixel of a row from the centre is its first or last one, and the off-axis angle
+  // grows with that distance, so the rows' ends decide.
+  processing::Intrinsics wide = lens;
+  wide.maxFieldAngleRad = fieldToImageCorner(lens) * std::numbers::pi / 360;
+  const processing::CameraModel model(wide);
+  cv::Mat gray;
+  if (picture.channels() == 1) {
+    gray = picture;
+  } else {
+    cv::cvtColor(picture, gray, picture.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+  }
+  double widest = 0;
+  for (int y = 0; y < gray.rows; ++y) {
+    const auto* row = gray.ptr<std::uint8_t>(y);
+    int first = 0, last = gray.cols - 1;
+    while (first < gray.cols && row[first] <= kLitLevel) ++first;
+    while (last > first && row[last] <= kLitLevel) --last;
+    for (const int x : {first, last}) {
+      if (x >= gray.cols || row[x] <= kLitLevel) continue;
+      if (const auto ray = model.unproject(cv::Point2d(x, y))) {
+        widest = std::max(widest, std::acos(std::clamp((*ray)[2], -1.0, 1.0)));
+      }
+    }
+  }
+  return widest > 0 ? 2 * widest * 180 / std::numbers::pi : fieldToImageCorner(lens);
+}
+
 processing::Intrinsics importedLens(const std::string& camera, const ForeignCalibration& found,
-                                    const ImportOptions& options,
-                                    std::optional<cv::Size> pictureSize) {
+                                    const ImportOptions& options, const cv::Mat& picture) {
+  const std::optional<cv::Size> pictureSize =
+      picture.empty() ? std::nullopt : std::optional(picture.size());
   processing::Intrinsics lens;
   if (found.lens) {
     lens = found.lens->value;
@@ -169,9 +208,12 @@ processing::Intrinsics importedLens(const std::string& camera, const ForeignCali
         camera, filesOf(found)));
   }
   if (lens.model != LensModel::kPinhole) {
-    lens.maxFieldAngleRad =
-        (options.fieldOfViewDeg ? *options.fieldOfViewDeg : fieldToImageCorner(lens)) *
-        std::numbers::pi / 360;
+    const double degrees =
+        options.fieldOfViewDeg
+            ? *options.fieldOfViewDeg
+            : std::min(kWidestDefaultFieldDeg,
+                       picture.empty() ? fieldToImageCorner(lens) : litFieldDeg(lens, picture));
+    lens.maxFieldAngleRad = degrees * std::numbers::pi / 360;
   } else if (options.fieldOfViewDeg) {
     throw UsageError(fmt::format(
         "--field-of-view-deg: only a fisheye or ocam lens takes it, and camera '{}' is a pinhole",

@@ -155,12 +155,12 @@ ImportedRig importRig(const ImportOptions& options) {
     c.name = lower(input.sourceName);
     const auto picture =
         options.images ? findPicture(*options.images, input.sourceName) : std::nullopt;
-    std::optional<cv::Size> pictureSize;
+    cv::Mat image;
     if (picture) {
-      const cv::Mat image = cv::imread(picture->string(), cv::IMREAD_UNCHANGED);
-      if (image.empty())
+      image = cv::imread(picture->string(), cv::IMREAD_COLOR);
+      if (image.empty()) {
         throw UsageError(fmt::format("{}: cannot read the picture", picture->string()));
-      pictureSize = image.size();
+      }
       // Relative to the rig file, so that the rig and the pictures can move together.
       const auto folder = std::filesystem::absolute(options.out).parent_path();
       camera.source = capture::FileSourceSettings{};
@@ -172,12 +172,11 @@ ImportedRig importRig(const ImportOptions& options) {
       throw UsageError(fmt::format("--images: no picture named '{}' (.png, .jpg, ...) in {}",
                                    input.sourceName, options.images->string()));
     }
-    c.intrinsics = importedLens(c.name, input.calibration, options, pictureSize);
-    if (pictureSize && *pictureSize != c.intrinsics.imageSize) {
+    c.intrinsics = importedLens(c.name, input.calibration, options, image);
+    if (!image.empty() && image.size() != c.intrinsics.imageSize) {
       throw UsageError(fmt::format("{} is {}x{}, but the calibration of camera '{}' is for {}x{}",
-                                   picture->string(), pictureSize->width, pictureSize->height,
-                                   c.name, c.intrinsics.imageSize.width,
-                                   c.intrinsics.imageSize.height));
+                                   picture->string(), image.cols, image.rows, c.name,
+                                   c.intrinsics.imageSize.width, c.intrinsics.imageSize.height));
     }
     c.pose = poseOf(c.name, input.calibration, c.intrinsics, options, frame);
     cameras.push_back(std::move(camera));

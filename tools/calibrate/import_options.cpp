@@ -75,8 +75,10 @@ Lens:
                              are ambiguous and need --lens). ocam with --pjlab: cam_K holds
                              [[c, d, xc], [e, 1, yc]] and cam_dist OCamCalib's invpol
   --image-size WxH           when the files do not say (default: the camera's picture in --images)
-  --field-of-view-deg D      fisheye, ocam: the lens's full field (default: as far as the image
-                             reaches, up to where the polynomial stops increasing)
+  --field-of-view-deg D      fisheye, ocam: the lens's full field (default: as far as the
+                             camera's picture in --images is lit, else as far as the image's
+                             corners; at most 200, and never past where the polynomial stops
+                             increasing)
 
 Output:
   --out RIG                  the rig file (written beside and renamed); its header comment names
