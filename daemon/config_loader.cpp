@@ -382,6 +382,11 @@ Config loadConfig(const std::filesystem::path& file) {
   config.mesh.bowlRadiusM = bowlRimRadius(topReach);
   config.mesh.bowlHeightM = bowlRimHeight(topReach, config.mesh.bowlRadiusM);
   readSection("mesh", [&](YamlObject& s) { readMesh(s, config.mesh); });
+  for (const auto& camera : config.cameras) {
+    if (auto warning = lensFieldCutWarning(camera.calibration)) {
+      config.warnings.push_back(std::move(*warning));
+    }
+  }
   if (config.mesh.model == MeshModel::kBowl && config.mesh.bowlFloorRadiusM + 1e-9 < topReach) {
     config.warnings.push_back(fmt::format(
         "mesh.bowl_floor_radius_m {:g} is less than the {:g} m the top view shows from the "

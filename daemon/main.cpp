@@ -16,6 +16,7 @@
 
 #include "daemon/config.hpp"
 #include "daemon/logging.hpp"
+#include "daemon/rig_yaml.hpp"
 #include "daemon/service.hpp"
 
 namespace {

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
+#include "daemon/rig_yaml.hpp"
 #include "processing/panorama_lut_cache.hpp"
 
 namespace surroundd::daemon {

@@ -109,15 +109,55 @@ capture::LibcameraSettings readLibcamera(YamlObject& source) {
   return settings;
 }
 
+// OCamCalib's own parameters (lens.model ocam); cx_px, cy_px are its distortion centre.
+void readOcam(YamlObject& lens, processing::Intrinsics& in) {
+  auto& ocam = in.ocam;
+  if (const auto affine = lens.numbers("affine", {3})) {
+    ocam.c = (*affine)[0], ocam.d = (*affine)[1], ocam.e = (*affine)[2];
+    // Singular, or a mirror image: neither is a lens, and unproject() divides by it.
+    if (!(ocam.c - ocam.d * ocam.e > 1e-3)) {
+      lens.error("affine",
+                 fmt::format("expected [c, d, e] of an invertible matrix [c d; e 1] that keeps the "
+                             "image's orientation (c - d e > 0, near 1), got c - d e = {:.6g}",
+                             ocam.c - ocam.d * ocam.e));
+    }
+  }
+  if (const auto p = lens.numbers("world_to_image", 2, 32)) {
+    ocam.worldToImage = *p;
+  } else if (!lens.has("world_to_image")) {
+    lens.errorHere("missing key 'world_to_image' (OCamCalib's inverse polynomial p0, p1, ...)");
+  }
+  if (const auto a = lens.numbers("image_to_world", 2, 32)) {
+    ocam.imageToWorld = *a;
+    if (!(a->front() < 0)) {
+      lens.error("image_to_world",
+                 fmt::format("expected OCamCalib's a0 < 0 first (z in front of the lens is "
+                             "negative in its frame), got {:.6g}",
+                             a->front()));
+    }
+  }
+}
+
 processing::Intrinsics readLens(YamlObject& lens) {
   processing::Intrinsics in;
   in.model = lens.choice("model", LensModel::kPinhole,
-                         {{"pinhole", LensModel::kPinhole}, {"fisheye", LensModel::kFisheye}});
+                         {{"pinhole", LensModel::kPinhole},
+                          {"fisheye", LensModel::kFisheye},
+                          {"ocam", LensModel::kOcam}});
   const int width = lens.requiredInteger("width_px", 16, 16384).value_or(0);
   const int height = lens.requiredInteger("height_px", 16, 16384).value_or(0);
   in.imageSize = cv::Size(width, height);
-  in.fx = lens.requiredNumber("fx_px", {0.0, 1e6, true, "pixels"}).value_or(1.0);
-  in.fy = lens.requiredNumber("fy_px", {0.0, 1e6, true, "pixels"}).value_or(1.0);
+  const bool ocam = in.model == LensModel::kOcam;
+  if (ocam) {
+    for (const auto key : {"fx_px", "fy_px", "distortion"}) {
+      if (lens.has(key)) {
+        lens.error(key, "an ocam lens does not take this key (world_to_image is its projection)");
+      }
+    }
+  } else {
+    in.fx = lens.requiredNumber("fx_px", {0.0, 1e6, true, "pixels"}).value_or(1.0);
+    in.fy = lens.requiredNumber("fy_px", {0.0, 1e6, true, "pixels"}).value_or(1.0);
+  }
   in.cx = lens.requiredNumber("cx_px",
                               {0.0, std::max(width, 1) * 1.0, false, "pixels, inside the image"})
               .value_or(0.0);
@@ -125,16 +165,23 @@ processing::Intrinsics readLens(YamlObject& lens) {
                               {0.0, std::max(height, 1) * 1.0, false, "pixels, inside the image"})
               .value_or(0.0);
   const bool fisheye = in.model == LensModel::kFisheye;
-  const auto distortion =
-      fisheye ? lens.numbers("distortion", {4}) : lens.numbers("distortion", {4, 5});
-  if (distortion) std::copy(distortion->begin(), distortion->end(), in.distortion.begin());
-  if (fisheye) {
+  if (ocam) {
+    readOcam(lens, in);
+  } else {
+    const auto distortion =
+        fisheye ? lens.numbers("distortion", {4}) : lens.numbers("distortion", {4, 5});
+    if (distortion) std::copy(distortion->begin(), distortion->end(), in.distortion.begin());
+    for (const auto key : {"affine", "world_to_image", "image_to_world"}) {
+      if (lens.has(key)) lens.error(key, "only an ocam lens takes this key");
+    }
+  }
+  if (fisheye || ocam) {
     in.maxFieldAngleRad =
         lens.number("field_of_view_deg", 180.0, {0.0, 360.0, true, "degrees, full field"}) *
         kDegToRad / 2;
   } else if (lens.has("field_of_view_deg")) {
     lens.error("field_of_view_deg",
-               "only a fisheye lens takes this key (a pinhole sees less than 180 degrees)");
+               "only a fisheye or ocam lens takes this key (a pinhole sees less than 180 degrees)");
   }
   lens.finish();
   return in;
@@ -174,6 +221,8 @@ processing::Pose readMount(YamlObject& mount) {
   return pose;
 }
 
+}  // namespace
+
 // Default colour role: cameras looking mostly along the vehicle (front, back) are sources, the
 // sideways ones targets — the paper's arrangement.
 processing::ColourRole defaultRole(const processing::Pose& pose) {
@@ -181,8 +230,6 @@ processing::ColourRole defaultRole(const processing::Pose& pose) {
   return std::abs(axis[0]) >= std::abs(axis[1]) ? processing::ColourRole::kSource
                                                 : processing::ColourRole::kTarget;
 }
-
-}  // namespace
 
 std::vector<RigCamera> readRigCameras(YamlObject& rig) {
   std::vector<RigCamera> cameras;
@@ -233,6 +280,24 @@ std::vector<RigCamera> readRigCameras(YamlObject& rig) {
   return cameras;
 }
 
+std::optional<std::string> lensFieldCutWarning(const processing::CameraCalibration& camera) {
+  const auto cut = processing::CameraModel(camera.intrinsics).fieldCut();
+  // A turn beyond the picture's corners (common for pinhole calibrations) loses nothing.
+  if (!cut || !cut->inImage) return std::nullopt;
+  constexpr double kRadToDeg = 180 / std::numbers::pi;
+  const auto model = camera.intrinsics.model;
+  return fmt::format(
+      "camera '{}': the lens's {} polynomial stops increasing {:.1f} degrees off axis, so its "
+      "field is cut there ({}); the picture beyond that circle is not used",
+      camera.name, model == LensModel::kOcam ? "world_to_image" : "distortion",
+      cut->atRad * kRadToDeg,
+      model == LensModel::kPinhole
+          ? fmt::format("a pinhole lens is otherwise taken up to {:.1f} degrees",
+                        cut->askedRad * kRadToDeg)
+          : fmt::format("field_of_view_deg asks for {:.1f} degrees",
+                        2 * cut->askedRad * kRadToDeg));
+}
+
 RigFile loadRig(const std::filesystem::path& file) {
   Diagnostics diag;
   YamlObject root(parseYamlFile(file), "", file, diag);
@@ -252,8 +317,6 @@ namespace {
 
 void emitCamera(YAML::Emitter& out, const RigCamera& camera, const std::filesystem::path& folder) {
   const auto& c = camera.calibration;
-  const auto& in = c.intrinsics;
-  const bool fisheye = in.model == LensModel::kFisheye;
   out << YAML::BeginMap;
   out << YAML::Key << "name" << YAML::Value << c.name;
   out << YAML::Key << "role" << YAML::Value
@@ -295,20 +358,7 @@ void emitCamera(YAML::Emitter& out, const RigCamera& camera, const std::filesyst
     out << YAML::EndMap;
   }
   out << YAML::Key << "lens" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "model" << YAML::Value << (fisheye ? "fisheye" : "pinhole");
-  out << YAML::Key << "width_px" << YAML::Value << in.imageSize.width;
-  out << YAML::Key << "height_px" << YAML::Value << in.imageSize.height;
-  out << YAML::Key << "fx_px" << YAML::Value << in.fx;
-  out << YAML::Key << "fy_px" << YAML::Value << in.fy;
-  out << YAML::Key << "cx_px" << YAML::Value << in.cx;
-  out << YAML::Key << "cy_px" << YAML::Value << in.cy;
-  out << YAML::Key << "distortion" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (std::size_t i = 0; i < (fisheye ? 4U : 5U); ++i) out << in.distortion[i];
-  out << YAML::EndSeq;
-  if (fisheye) {
-    out << YAML::Key << "field_of_view_deg" << YAML::Value
-        << in.maxFieldAngleRad * 2 * 180.0 / std::numbers::pi;
-  }
+  emitLensFields(out, c.intrinsics);
   out << YAML::EndMap;
   if (camera.bodyMask) {
     const auto& mask = *camera.bodyMask;
@@ -340,6 +390,36 @@ void emitCamera(YAML::Emitter& out, const RigCamera& camera, const std::filesyst
 }
 
 }  // namespace
+
+void emitLensFields(YAML::Emitter& out, const processing::Intrinsics& lens) {
+  const bool fisheye = lens.model == LensModel::kFisheye;
+  const bool ocam = lens.model == LensModel::kOcam;
+  out << YAML::Key << "model" << YAML::Value << std::string(processing::lensModelName(lens.model));
+  out << YAML::Key << "width_px" << YAML::Value << lens.imageSize.width;
+  out << YAML::Key << "height_px" << YAML::Value << lens.imageSize.height;
+  if (!ocam) {
+    out << YAML::Key << "fx_px" << YAML::Value << lens.fx;
+    out << YAML::Key << "fy_px" << YAML::Value << lens.fy;
+  }
+  out << YAML::Key << "cx_px" << YAML::Value << lens.cx;
+  out << YAML::Key << "cy_px" << YAML::Value << lens.cy;
+  if (ocam) {
+    const auto& o = lens.ocam;
+    out << YAML::Key << "affine" << YAML::Value << YAML::Flow << std::vector<double>{o.c, o.d, o.e};
+    out << YAML::Key << "world_to_image" << YAML::Value << YAML::Flow << o.worldToImage;
+    if (!o.imageToWorld.empty()) {
+      out << YAML::Key << "image_to_world" << YAML::Value << YAML::Flow << o.imageToWorld;
+    }
+  } else {
+    out << YAML::Key << "distortion" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (std::size_t i = 0; i < (fisheye ? 4U : 5U); ++i) out << lens.distortion[i];
+    out << YAML::EndSeq;
+  }
+  if (fisheye || ocam) {
+    out << YAML::Key << "field_of_view_deg" << YAML::Value
+        << lens.maxFieldAngleRad * 2 * 180.0 / std::numbers::pi;
+  }
+}
 
 void writeRigFile(const std::filesystem::path& file, std::span<const RigCamera> cameras,
                   std::string_view headerComment, const VehicleConfig* vehicle) {

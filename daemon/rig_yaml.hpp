@@ -9,6 +9,12 @@
 //       source: {libcamera: "/base/soc/i2c0mux/i2c@1/imx219@10"}  # an id, or part of one
 //       lens: {model: pinhole, width_px: 1280, height_px: 720, fx_px: .., fy_px: .., cx_px: ..,
 //              cy_px: .., distortion: [k1, k2, p1, p2, k3]}
+//       lens: {model: fisheye, ..., distortion: [k1, k2, k3, k4], field_of_view_deg: 190}
+//       lens: {model: ocam, width_px: 1280, height_px: 960, cx_px: xc, cy_px: yc,  # OCamCalib
+//              affine: [c, d, e], world_to_image: [p0, p1, ...],
+//              image_to_world: [a0, a1, ...], field_of_view_deg: 200}
+//             # affine defaults to [1, 0, 0], image_to_world is optional; no fx_px, fy_px,
+//             # distortion
 //       mount: {x_m: .., y_m: .., z_m: .., yaw_deg: .., pitch_deg: .., roll_deg: ..}
 //       body_mask: {file: front-body.png, mode: add}  # optional, see vehicle_yaml.hpp
 //   vehicle: {length_m: .., width_m: .., height_m: ..}  # optional, see vehicle_yaml.hpp
@@ -19,6 +25,7 @@
 #include <filesystem>
 #include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -47,6 +54,10 @@ struct RigFile {
   std::optional<VehicleConfig> vehicle;
 };
 
+// The role a camera gets when its entry names none: cameras looking mostly along the vehicle
+// (front, back) are colour sources, the sideways ones targets.
+processing::ColourRole defaultRole(const processing::Pose& pose);
+
 // Reads and validates the `cameras` list of `rig`; errors go to the object's Diagnostics.
 std::vector<RigCamera> readRigCameras(YamlObject& rig);
 
@@ -54,6 +65,15 @@ std::vector<RigCamera> readRigCameras(YamlObject& rig);
 RigFile loadRig(const std::filesystem::path& file);
 // Its cameras only.
 std::vector<RigCamera> loadRigFile(const std::filesystem::path& file);
+
+// A warning for a camera whose lens's polynomial stops increasing inside the field it asks for
+// while the picture reaches past that angle: the camera model cuts the field there
+// (processing::CameraModel::fieldCut), which nobody would notice in the panorama. nullopt when not.
+std::optional<std::string> lensFieldCutWarning(const processing::CameraCalibration& camera);
+
+// The keys of one `lens:` map (model, size, intrinsics), into a map the caller has begun. Doubles
+// round-trip exactly at the emitter's precision 17.
+void emitLensFields(YAML::Emitter& out, const processing::Intrinsics& lens);
 
 // Writes a rig file that loadRigFile reads back to the same calibration (doubles round-trip
 // exactly). Source paths are written relative to the file's folder when they lie inside it.

@@ -222,12 +222,25 @@ std::string YamlObject::string(std::string_view key, std::string fallback) {
 
 std::optional<std::vector<double>> YamlObject::numbers(std::string_view key,
                                                        std::initializer_list<std::size_t> sizes) {
-  if (!has(key)) return std::nullopt;
   std::string counts;
   for (const auto size : sizes) counts += (counts.empty() ? "" : " or ") + std::to_string(size);
-  const std::string expected = fmt::format("a list of {} numbers", counts);
+  return numberList(key, fmt::format("a list of {} numbers", counts), [&](std::size_t size) {
+    return std::find(sizes.begin(), sizes.end(), size) != sizes.end();
+  });
+}
+
+std::optional<std::vector<double>> YamlObject::numbers(std::string_view key, std::size_t minSize,
+                                                       std::size_t maxSize) {
+  return numberList(key, fmt::format("a list of {} to {} numbers", minSize, maxSize),
+                    [&](std::size_t size) { return size >= minSize && size <= maxSize; });
+}
+
+std::optional<std::vector<double>> YamlObject::numberList(
+    std::string_view key, const std::string& expected,
+    const std::function<bool(std::size_t)>& sizeFits) {
+  if (!has(key)) return std::nullopt;
   YAML::Node list = at(key);
-  if (!list.IsSequence() || std::find(sizes.begin(), sizes.end(), list.size()) == sizes.end()) {
+  if (!list.IsSequence() || !sizeFits(list.size())) {
     error(key,
           fmt::format("expected {}, got {}", expected,
                       list.IsSequence() ? fmt::format("{} items", list.size()) : describe(list)));

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <filesystem>
+#include <functional>
 #include <initializer_list>
 #include <optional>
 #include <set>
@@ -72,6 +73,9 @@ class YamlObject {
   // A list of numbers whose length is one of `sizes`.
   std::optional<std::vector<double>> numbers(std::string_view key,
                                              std::initializer_list<std::size_t> sizes);
+  // A list of minSize to maxSize numbers.
+  std::optional<std::vector<double>> numbers(std::string_view key, std::size_t minSize,
+                                             std::size_t maxSize);
   // A list of [x, y] pairs, at least `minCount` of them (a polygon).
   std::optional<std::vector<std::array<double, 2>>> points(std::string_view key,
                                                            std::size_t minCount);
@@ -112,6 +116,8 @@ class YamlObject {
   std::optional<YAML::Node> scalar(std::string_view key, std::string_view expected);
   std::string childPath(std::string_view key) const;
   YAML::Mark markOf(std::string_view key) const;
+  std::optional<std::vector<double>> numberList(std::string_view key, const std::string& expected,
+                                                const std::function<bool(std::size_t)>& sizeFits);
   std::optional<std::string> choiceText(std::string_view key,
                                         const std::vector<std::string_view>& names);
 

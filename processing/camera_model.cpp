@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace surroundd::processing {
 namespace {
@@ -26,9 +27,22 @@ Radial fisheyeRadial(const std::array<double, 5>& d, double theta) {
   return {theta * poly, poly + polyDerivative};
 }
 
-// Largest radius (pinhole: normalized image radius; fisheye: field angle) up to `limit` over which
-// the radial mapping keeps increasing: beyond it two rays would share a pixel, so the lens is
-// treated as ending there.
+// OCamCalib's rho(theta) as a function of the off-axis angle: theta, the elevation below the sensor
+// plane, is the off-axis angle less 90 degrees (atan(-1 / r) = atan2(-z, |xy|) for z > 0, and the
+// same formula carries on past 90 degrees without a jump).
+Radial ocamRadial(const std::vector<double>& p, double offAxis) {
+  const double theta = offAxis - std::numbers::pi / 2;
+  Radial f{0, 0};
+  for (auto it = p.rbegin(); it != p.rend(); ++it) {  // Horner, with the derivative alongside
+    f.derivative = f.derivative * theta + f.value;
+    f.value = f.value * theta + *it;
+  }
+  return f;
+}
+
+// Largest radius (pinhole: normalized image radius; fisheye, ocam: field angle) up to `limit` over
+// which the radial mapping keeps increasing: beyond it two rays would share a pixel, so the lens
+// is treated as ending there.
 template <typename RadialFn>
 double monotonicLimit(RadialFn radial, double limit) {
   constexpr int kSteps = 4000;
@@ -39,6 +53,28 @@ double monotonicLimit(RadialFn radial, double limit) {
   return limit;
 }
 
+// The off-axis angle in [0, limit] where an increasing radial mapping reaches `target`: Newton,
+// with a bisection step whenever Newton would leave the bracket, so a polynomial that is nearly
+// flat somewhere (OCamCalib fits often are near their edge) still converges.
+template <typename RadialFn>
+double invertRadial(RadialFn radial, double target, double guess, double limit) {
+  double low = 0;
+  double high = limit;
+  double x = std::clamp(guess, low, high);
+  for (int i = 0; i < 100; ++i) {
+    const Radial f = radial(x);
+    const double error = f.value - target;
+    if (error == 0) break;
+    (error < 0 ? low : high) = x;
+    double next = x - error / f.derivative;
+    if (!(next > low && next < high)) next = (low + high) / 2;
+    const bool converged = std::abs(next - x) < 1e-15;
+    x = next;
+    if (converged) break;
+  }
+  return x;
+}
+
 // Pinhole rays are accepted up to this normalized radius (about 84 degrees off axis).
 constexpr double kPinholeMaxRadius = 10.0;
 
@@ -46,17 +82,82 @@ constexpr double kPinholeMaxRadius = 10.0;
 
 CameraModel::CameraModel(const Intrinsics& intrinsics) : intrinsics_(intrinsics) {
   const auto& d = intrinsics_.distortion;
-  if (intrinsics_.model == LensModel::kPinhole) {
-    maxRadius_ = monotonicLimit([&](double r) { return pinholeRadial(d, r); }, kPinholeMaxRadius);
-  } else {
-    intrinsics_.maxFieldAngleRad =
-        monotonicLimit([&](double t) { return fisheyeRadial(d, t); }, intrinsics_.maxFieldAngleRad);
-    maxRadius_ = fisheyeRadial(d, intrinsics_.maxFieldAngleRad).value;
+  const auto& ocam = intrinsics_.ocam;
+  double askedRad = 0;
+  double fieldRad = 0;
+  double edgeRadius = 0;  // distorted radius at the edge of the field, as sensorRadius() gives it
+  switch (intrinsics_.model) {
+    case LensModel::kPinhole:
+      askedRad = std::atan(kPinholeMaxRadius);
+      maxRadius_ = monotonicLimit([&](double r) { return pinholeRadial(d, r); }, kPinholeMaxRadius);
+      fieldRad = std::atan(maxRadius_);
+      edgeRadius = pinholeRadial(d, maxRadius_).value;
+      break;
+    case LensModel::kFisheye:
+      // No ray is further than 180 degrees off axis, whatever the field asks for.
+      askedRad = std::min(intrinsics_.maxFieldAngleRad, std::numbers::pi);
+      fieldRad = monotonicLimit([&](double t) { return fisheyeRadial(d, t); }, askedRad);
+      maxRadius_ = edgeRadius = fisheyeRadial(d, fieldRad).value;
+      intrinsics_.maxFieldAngleRad = fieldRad;
+      break;
+    case LensModel::kOcam:
+      askedRad = std::min(intrinsics_.maxFieldAngleRad, std::numbers::pi);
+      fieldRad =
+          monotonicLimit([&](double a) { return ocamRadial(ocam.worldToImage, a); }, askedRad);
+      maxRadius_ = edgeRadius = ocamRadial(ocam.worldToImage, fieldRad).value;
+      axisRho_ = ocamRadial(ocam.worldToImage, 0).value;
+      intrinsics_.maxFieldAngleRad = fieldRad;
+      break;
   }
+  if (fieldRad < askedRad) {
+    const cv::Size size = intrinsics_.imageSize;
+    bool inImage = false;
+    for (const cv::Point2d corner :
+         {cv::Point2d(-0.5, -0.5), cv::Point2d(size.width - 0.5, -0.5),
+          cv::Point2d(-0.5, size.height - 0.5), cv::Point2d(size.width - 0.5, size.height - 0.5)}) {
+      inImage = inImage || sensorRadius(corner) > edgeRadius;
+    }
+    fieldCut_ = FieldCut{fieldRad, askedRad, inImage};
+  }
+}
+
+cv::Point2d CameraModel::sensorPoint(const cv::Point2d& pixel) const {
+  const auto& in = intrinsics_;
+  if (in.model != LensModel::kOcam) return {(pixel.x - in.cx) / in.fx, (pixel.y - in.cy) / in.fy};
+  // [u - xc; v - yc] = [c d; e 1] [x; y], inverted.
+  const auto& a = in.ocam;
+  const double det = a.c - a.d * a.e;
+  const double du = pixel.x - in.cx;
+  const double dv = pixel.y - in.cy;
+  return {(du - a.d * dv) / det, (a.c * dv - a.e * du) / det};
+}
+
+double CameraModel::sensorRadius(const cv::Point2d& pixel) const {
+  const cv::Point2d m = sensorPoint(pixel);
+  return std::hypot(m.x, m.y);
+}
+
+cv::Vec2d CameraModel::axisFocalPx() const {
+  const auto& in = intrinsics_;
+  if (in.model != LensModel::kOcam) return {in.fx, in.fy};
+  const double slope = ocamRadial(in.ocam.worldToImage, 0).derivative;  // pixels per radian
+  return {slope * std::hypot(in.ocam.c, in.ocam.e), slope * std::hypot(in.ocam.d, 1.0)};
 }
 
 std::optional<cv::Point2d> CameraModel::project(const cv::Vec3d& p) const {
   const auto& in = intrinsics_;
+  if (in.model == LensModel::kOcam) {
+    const double planar = std::hypot(p[0], p[1]);
+    const double offAxis = std::atan2(planar, p[2]);
+    if (offAxis > in.maxFieldAngleRad) return std::nullopt;
+    // On the axis the direction of rho is undefined (and rho itself all but 0).
+    if (planar == 0) return cv::Point2d(in.cx, in.cy);
+    const double rho = ocamRadial(in.ocam.worldToImage, offAxis).value;
+    const double x = p[0] / planar * rho;
+    const double y = p[1] / planar * rho;
+    const auto& a = in.ocam;
+    return cv::Point2d(a.c * x + a.d * y + in.cx, a.e * x + y + in.cy);
+  }
   const auto& d = in.distortion;
   double xd = 0;
   double yd = 0;
@@ -84,9 +185,11 @@ std::optional<cv::Point2d> CameraModel::project(const cv::Vec3d& p) const {
 
 std::optional<cv::Vec3d> CameraModel::unproject(const cv::Point2d& pixel) const {
   const auto& in = intrinsics_;
+  if (in.model == LensModel::kOcam) return unprojectOcam(pixel);
   const auto& d = in.distortion;
-  const double xd = (pixel.x - in.cx) / in.fx;
-  const double yd = (pixel.y - in.cy) / in.fy;
+  const cv::Point2d sensor = sensorPoint(pixel);
+  const double xd = sensor.x;
+  const double yd = sensor.y;
   if (in.model == LensModel::kFisheye) {
     const double thetaD = std::hypot(xd, yd);
     // The edge of the field itself belongs to the lens; allow for rounding in project().
@@ -129,6 +232,32 @@ std::optional<cv::Vec3d> CameraModel::unproject(const cv::Point2d& pixel) const 
   const auto back = project(cv::Vec3d(x, y, 1));
   if (!back || std::hypot(back->x - pixel.x, back->y - pixel.y) > 1e-6) return std::nullopt;
   return cv::normalize(cv::Vec3d(x, y, 1));
+}
+
+std::optional<cv::Vec3d> CameraModel::unprojectOcam(const cv::Point2d& pixel) const {
+  const auto& a = intrinsics_.ocam;
+  if (a.c - a.d * a.e == 0) return std::nullopt;
+  const cv::Point2d m = sensorPoint(pixel);
+  const double rho = std::hypot(m.x, m.y);
+  // The edge of the field itself belongs to the lens; allow for rounding in project().
+  if (rho > maxRadius_ * (1 + 1e-12)) return std::nullopt;
+  if (!a.imageToWorld.empty()) {
+    double z = 0;
+    for (auto it = a.imageToWorld.rbegin(); it != a.imageToWorld.rend(); ++it) z = z * rho + *it;
+    // OCamCalib's sensor frame has z towards the back of the lens: its (x, y, z) is OpenCV's
+    // (x, y, -z), as project() takes theta = atan2(-z, |xy|).
+    const cv::Vec3d ray(m.x, m.y, -z);
+    if (cv::norm(ray) == 0) return std::nullopt;
+    return cv::normalize(ray);
+  }
+  // A fitted rho(theta) misses 0 on the axis by a hundredth of a pixel or so: pixels that close to
+  // the centre take the axis.
+  if (rho <= std::max(axisRho_, 0.0)) return cv::Vec3d(0, 0, 1);
+  const double field = intrinsics_.maxFieldAngleRad;
+  const double offAxis = invertRadial([&](double t) { return ocamRadial(a.worldToImage, t); }, rho,
+                                      field * rho / maxRadius_, field);
+  const double s = std::sin(offAxis) / rho;
+  return cv::Vec3d(m.x * s, m.y * s, std::cos(offAxis));
 }
 
 bool CameraModel::inImage(const cv::Point2d& pixel) const {

@@ -50,7 +50,8 @@ CameraFromVehicle initialPose(const Intrinsics& intrinsics, const std::vector<cv
   }
   // Threshold in normalized units; generous, since RANSAC only has to throw out gross mismatches:
   // off the virtual axis a pixel spans less than 1 / f of normalized distance.
-  const double threshold = 4 * settings.inlierThresholdPx / std::min(intrinsics.fx, intrinsics.fy);
+  const cv::Vec2d focal = CameraModel(intrinsics).axisFocalPx();  // ocam has no fx, fy
+  const double threshold = 4 * settings.inlierThresholdPx / std::min(focal[0], focal[1]);
   cv::Vec3d rvec, tvec;
   std::vector<int> inliers;
   const bool solved = cv::solvePnPRansac(

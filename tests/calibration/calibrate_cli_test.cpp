@@ -215,9 +215,15 @@ TEST(CalibrateCli, UsageErrorsNameTheOption) {
   const TempDir dir;
   expectFailure(
       calibrate(dir, {}), 2,
-      "surround-calibrate: missing the subcommand: intrinsics or extrinsics (see --help)");
+      "surround-calibrate: missing the subcommand: intrinsics, extrinsics or import (see --help)");
   expectFailure(calibrate(dir, {"calibrate"}), 2,
-                "unknown subcommand 'calibrate': expected intrinsics or extrinsics");
+                "unknown subcommand 'calibrate': expected intrinsics, extrinsics or import");
+  expectFailure(calibrate(dir, {"import", "--pjlab", dir.path().string(), "--axes",
+                                "right,forward,down", "--out", "rig.yaml"}),
+                2,
+                "surround-calibrate import: --axes: 'right,forward,down' is a left-handed "
+                "(mirrored) frame; a calibration's frame is right-handed, so one of the "
+                "directions is wrong");
   auto arguments = intrinsicsOn(dir, dir.path());
   arguments[4] = "8x6";
   expectFailure(calibrate(dir, arguments), 2,

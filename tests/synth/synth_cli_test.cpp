@@ -2,12 +2,16 @@
 // ones; a second run with the same arguments is a cache hit; bad input exits non-zero with a
 // message naming the problem.
 
+#include <numbers>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "processing/camera_model.hpp"
 #include "tests/support/child_process.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/synth/synth_test_support.hpp"
+#include "tools/synth/recording_plan.hpp"
 
 namespace surroundd::synth {
 namespace {
@@ -31,6 +35,33 @@ SynthRun synth(const surroundd::testing::TempDir& dir, std::vector<std::string> 
 std::vector<std::string> smallRun(const std::filesystem::path& out, int seed) {
   return {"--rig",     kPaper, "--out",  out.string(),         "--size",          "128x72",
           "--seconds", "0.3",  "--seed", std::to_string(seed), "--panorama-size", "256x128"};
+}
+
+// An OCamCalib lens at another size (columns and rows scaled differently) sees each ray at the
+// scaled pixel, and unprojects it (through its image-to-world polynomial) to the same ray.
+TEST(ScaleIntrinsics, AnOcamLensSeesTheSameRaysAtAnotherSize) {
+  processing::Intrinsics in;
+  in.model = processing::LensModel::kOcam;
+  in.imageSize = {1280, 960};
+  in.cx = 648.6, in.cy = 481.4;
+  in.ocam = {1.002,
+             0.0015,
+             -0.0008,
+             {627.9, 466.0, -2.9, 24.2, 72.7, -33.4, -23.5, 114.2},
+             {-318.5, 0, 0.0007, -2e-7}};
+  in.maxFieldAngleRad = 100 * std::numbers::pi / 180;
+  const processing::CameraModel model(in);
+  const processing::CameraModel scaled(scaleIntrinsics(in, {640, 360}));
+  for (double degrees = 0; degrees <= 100; degrees += 10) {
+    const double a = degrees * std::numbers::pi / 180;
+    const cv::Vec3d ray(std::sin(a) * 0.6, std::sin(a) * -0.8, std::cos(a));
+    const auto pixel = model.project(ray);
+    const auto scaledPixel = scaled.project(ray);
+    ASSERT_TRUE(pixel && scaledPixel) << degrees;
+    EXPECT_NEAR(scaledPixel->x, (pixel->x + 0.5) * 0.5 - 0.5, 1e-9) << degrees;
+    EXPECT_NEAR(scaledPixel->y, (pixel->y + 0.5) * 0.375 - 0.5, 1e-9) << degrees;
+    EXPECT_LT(cv::norm(*scaled.unproject(*scaledPixel) - *model.unproject(*pixel)), 1e-12);
+  }
 }
 
 // Every file of a recording but the manifest (which records how long the run took).

@@ -2,8 +2,6 @@
 
 #include <charconv>
 #include <cmath>
-#include <functional>
-#include <map>
 
 #include <fmt/format.h>
 
@@ -50,17 +48,6 @@ and the change from the rig's current mount; writes the camera's mount: block.
   --update-rig               also write the mount into the rig file (rewritten; comments are lost)
 )";
 
-double parseDouble(std::string_view option, std::string_view text, double min, double max,
-                   std::string_view expected) {
-  double value = 0;
-  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (error != std::errc() || end != text.data() + text.size() || !std::isfinite(value) ||
-      value < min || value > max) {
-    throw UsageError(fmt::format("{}: expected {}, got '{}'", option, expected, text));
-  }
-  return value;
-}
-
 cv::Size parseBoard(std::string_view option, std::string_view text) {
   const auto fail = [&] {
     return UsageError(fmt::format(
@@ -82,49 +69,38 @@ cv::Size parseBoard(std::string_view option, std::string_view text) {
   return {cols, rows};
 }
 
-// Options that take a value: the handler gets it. Flags: the handler gets "".
-using Handlers = std::map<std::string_view, std::function<void(std::string_view)>>;
-
-void parseOptions(std::span<const std::string_view> arguments, const Handlers& valued,
-                  const Handlers& flags) {
-  for (std::size_t i = 0; i < arguments.size(); ++i) {
-    const std::string_view option = arguments[i];
-    if (const auto flag = flags.find(option); flag != flags.end()) {
-      flag->second("");
-    } else if (const auto handler = valued.find(option); handler != valued.end()) {
-      if (i + 1 >= arguments.size()) throw UsageError(fmt::format("{}: missing its value", option));
-      handler->second(arguments[++i]);
-    } else {
-      throw UsageError(fmt::format("unknown option '{}' (see --help)", option));
-    }
-  }
-}
-
 IntrinsicsOptions parseIntrinsics(std::span<const std::string_view> arguments) {
   IntrinsicsOptions o;
   bool model = false;
-  parseOptions(
-      arguments,
-      {{"--images", [&](auto v) { o.images = std::string(v); }},
-       {"--board", [&](auto v) { o.board = parseBoard("--board", v); }},
-       {"--model",
-        [&](auto v) {
-          if (v != "pinhole" && v != "fisheye") {
-            throw UsageError(fmt::format("--model: expected 'pinhole' or 'fisheye', got '{}'", v));
-          }
-          o.model =
-              v == "pinhole" ? processing::LensModel::kPinhole : processing::LensModel::kFisheye;
-          model = true;
-        }},
-       {"--out", [&](auto v) { o.out = std::string(v); }},
-       {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
-       {"--field-of-view-deg",
-        [&](auto v) {
-          o.fieldOfViewDeg = parseDouble("--field-of-view-deg", v, 1, 360, "degrees from 1 to 360");
-        }},
-       {"--update-rig", [&](auto v) { o.updateRig = std::string(v); }},
-       {"--camera", [&](auto v) { o.camera = std::string(v); }}},
-      {});
+  // The rig takes OCamCalib lenses, but this tool does not solve them: say where one comes from.
+  const auto wrongModel = [](std::string_view v) {
+    return UsageError(fmt::format("--model: expected 'pinhole' or 'fisheye', got '{}'{}", v,
+                                  v == "ocam" ? " (calibrate an OCamCalib lens with OCamCalib and "
+                                                "write its polynomials into the rig's lens block)"
+                                              : ""));
+  };
+  parseOptions(arguments,
+               {{"--images", [&](auto v) { o.images = std::string(v); }},
+                {"--board", [&](auto v) { o.board = parseBoard("--board", v); }},
+                {"--model",
+                 [&](auto v) {
+                   if (v != "pinhole" && v != "fisheye") {
+                     throw wrongModel(v);
+                   }
+                   o.model = v == "pinhole" ? processing::LensModel::kPinhole
+                                            : processing::LensModel::kFisheye;
+                   model = true;
+                 }},
+                {"--out", [&](auto v) { o.out = std::string(v); }},
+                {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
+                {"--field-of-view-deg",
+                 [&](auto v) {
+                   o.fieldOfViewDeg =
+                       parseDouble("--field-of-view-deg", v, 1, 360, "degrees from 1 to 360");
+                 }},
+                {"--update-rig", [&](auto v) { o.updateRig = std::string(v); }},
+                {"--camera", [&](auto v) { o.camera = std::string(v); }}},
+               {});
   if (o.images.empty()) throw UsageError("--images: missing (the folder of checkerboard images)");
   if (o.board.area() == 0) throw UsageError("--board: missing (inner corners, e.g. 9x6)");
   if (!model) throw UsageError("--model: missing (pinhole or fisheye)");
@@ -170,9 +146,35 @@ bool asksForHelp(std::span<const std::string_view> arguments) {
 
 }  // namespace
 
+double parseDouble(std::string_view option, std::string_view text, double min, double max,
+                   std::string_view expected) {
+  double value = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (error != std::errc() || end != text.data() + text.size() || !std::isfinite(value) ||
+      value < min || value > max) {
+    throw UsageError(fmt::format("{}: expected {}, got '{}'", option, expected, text));
+  }
+  return value;
+}
+
+void parseOptions(std::span<const std::string_view> arguments, const Handlers& valued,
+                  const Handlers& flags) {
+  for (std::size_t i = 0; i < arguments.size(); ++i) {
+    const std::string_view option = arguments[i];
+    if (const auto flag = flags.find(option); flag != flags.end()) {
+      flag->second("");
+    } else if (const auto handler = valued.find(option); handler != valued.end()) {
+      if (i + 1 >= arguments.size()) throw UsageError(fmt::format("{}: missing its value", option));
+      handler->second(arguments[++i]);
+    } else {
+      throw UsageError(fmt::format("unknown option '{}' (see --help)", option));
+    }
+  }
+}
+
 Command parseArguments(std::span<const std::string_view> arguments) {
   if (arguments.empty()) {
-    throw UsageError("missing the subcommand: intrinsics or extrinsics (see --help)");
+    throw UsageError("missing the subcommand: intrinsics, extrinsics or import (see --help)");
   }
   const std::string_view subcommand = arguments.front();
   const auto rest = arguments.subspan(1);
@@ -187,16 +189,21 @@ Command parseArguments(std::span<const std::string_view> arguments) {
     if (asksForHelp(rest)) return HelpRequest{std::string(kExtrinsicsUsage)};
     return parseExtrinsics(rest);
   }
-  throw UsageError(fmt::format(
-      "unknown subcommand '{}': expected intrinsics or extrinsics (see --help)", subcommand));
+  if (subcommand == "import") {
+    if (asksForHelp(rest)) return HelpRequest{std::string(kImportUsage)};
+    return parseImport(rest);
+  }
+  throw UsageError(
+      fmt::format("unknown subcommand '{}': expected intrinsics, extrinsics or import (see --help)",
+                  subcommand));
 }
 
 std::string usage() {
   return fmt::format(
-      "surround-calibrate: camera calibration for surroundd.\n\n{}\n{}\n"
+      "surround-calibrate: camera calibration for surroundd.\n\n{}\n{}\n{}\n"
       "exit status: 0 done, 1 calibration failed (too little in the images), 2 bad arguments or "
       "input files\n",
-      kIntrinsicsUsage, kExtrinsicsUsage);
+      kIntrinsicsUsage, kExtrinsicsUsage, kImportUsage);
 }
 
 }  // namespace surroundd::calibrate

@@ -4,6 +4,8 @@
 // exits 2).
 
 #include <filesystem>
+#include <functional>
+#include <map>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -14,6 +16,7 @@
 #include <opencv2/core.hpp>
 
 #include "processing/camera_model.hpp"
+#include "tools/calibrate/import_options.hpp"
 
 namespace surroundd::calibrate {
 
@@ -50,10 +53,19 @@ struct HelpRequest {
   std::string text;
 };
 
-using Command = std::variant<IntrinsicsOptions, ExtrinsicsOptions, HelpRequest>;
+using Command = std::variant<IntrinsicsOptions, ExtrinsicsOptions, ImportOptions, HelpRequest>;
 
 // `arguments` excludes the program name. Throws UsageError.
 Command parseArguments(std::span<const std::string_view> arguments);
 std::string usage();
+
+// Shared by the subcommands' parsers. Options that take a value: the handler gets it; flags: the
+// handler gets "". Unknown options and a missing value throw UsageError.
+using Handlers = std::map<std::string_view, std::function<void(std::string_view)>>;
+void parseOptions(std::span<const std::string_view> arguments, const Handlers& valued,
+                  const Handlers& flags);
+// A number in [min, max]; UsageError naming the option and `expected` otherwise.
+double parseDouble(std::string_view option, std::string_view text, double min, double max,
+                   std::string_view expected);
 
 }  // namespace surroundd::calibrate

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <fstream>
-#include <numbers>
 #include <utility>
 
 #include <fmt/format.h>
@@ -60,22 +59,9 @@ void updateRig(const std::filesystem::path& rig, const std::string& camera, Chan
 
 void writeLensBlock(const std::filesystem::path& file, const processing::Intrinsics& lens,
                     std::string_view comment) {
-  const bool fisheye = lens.model == processing::LensModel::kFisheye;
+  // The rig reader's own writer, so that every lens model comes out as the rig schema reads it.
   writeAtomically(
-      file, block("lens", comment, [&](YAML::Emitter& out) {
-        out << YAML::Key << "model" << YAML::Value << (fisheye ? "fisheye" : "pinhole");
-        emitFields<int>(out,
-                        {{"width_px", lens.imageSize.width}, {"height_px", lens.imageSize.height}});
-        emitFields<double>(
-            out, {{"fx_px", lens.fx}, {"fy_px", lens.fy}, {"cx_px", lens.cx}, {"cy_px", lens.cy}});
-        out << YAML::Key << "distortion" << YAML::Value << YAML::Flow
-            << std::vector<double>(lens.distortion.begin(),
-                                   lens.distortion.begin() + (fisheye ? 4 : 5));
-        if (fisheye) {
-          out << YAML::Key << "field_of_view_deg" << YAML::Value
-              << lens.maxFieldAngleRad * 2 * 180 / std::numbers::pi;
-        }
-      }));
+      file, block("lens", comment, [&](YAML::Emitter& out) { daemon::emitLensFields(out, lens); }));
 }
 
 void writeMountBlock(const std::filesystem::path& file, const processing::Pose& pose,

@@ -1,5 +1,5 @@
-// surround-calibrate: camera intrinsics from checkerboard images, extrinsics from ground markers
-// (see --help).
+// surround-calibrate: camera intrinsics from checkerboard images, extrinsics from ground markers,
+// and other tools' calibrations imported into a rig file (see --help).
 
 #include <iostream>
 #include <string_view>
@@ -9,21 +9,25 @@
 #include "processing/calibration_error.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 #include "tools/calibrate/extrinsics_command.hpp"
+#include "tools/calibrate/import_command.hpp"
 #include "tools/calibrate/intrinsics_command.hpp"
 
 int main(int argc, char** argv) {
   using namespace surroundd::calibrate;
   const std::vector<std::string_view> arguments(argv + 1, argv + argc);
   std::string_view subcommand = arguments.empty() ? "" : arguments.front();
-  const std::string prefix = subcommand == "intrinsics" || subcommand == "extrinsics"
-                                 ? "surround-calibrate " + std::string(subcommand) + ": "
-                                 : std::string("surround-calibrate: ");
+  const std::string prefix =
+      subcommand == "intrinsics" || subcommand == "extrinsics" || subcommand == "import"
+          ? "surround-calibrate " + std::string(subcommand) + ": "
+          : std::string("surround-calibrate: ");
   try {
     const Command command = parseArguments(arguments);
     if (const auto* help = std::get_if<HelpRequest>(&command)) {
       std::cout << help->text;
     } else if (const auto* intrinsics = std::get_if<IntrinsicsOptions>(&command)) {
       runIntrinsics(*intrinsics, std::cout);
+    } else if (const auto* import = std::get_if<ImportOptions>(&command)) {
+      runImport(*import, std::cout);
     } else {
       runExtrinsics(std::get<ExtrinsicsOptions>(command), std::cout);
     }

@@ -137,7 +137,7 @@ std::vector<processing::Pose> boardPosesCoveringField(const processing::Intrinsi
                                                       int count, std::uint64_t seed) {
   const processing::CameraModel model(intrinsics);
   const cv::Size size = intrinsics.imageSize;
-  const bool fisheye = intrinsics.model == processing::LensModel::kFisheye;
+  const bool fisheye = intrinsics.model != processing::LensModel::kPinhole;  // a wide lens
   const double maxCornerAngle = (fisheye ? 80 : 89) * kDegToRad;
   const int cols = std::max(1, static_cast<int>(std::lround(std::sqrt(
                                    count * static_cast<double>(size.width) / size.height))));
@@ -172,7 +172,7 @@ std::vector<processing::Pose> boardPosesCoveringField(const processing::Intrinsi
       const cv::Matx33d rotation =
           rotationAbout(tiltAxis, tilt) * rotationAbout(*ray, roll) * facing;
       const double fraction = rng.uniform(0.3, 0.55);  // of the image width
-      const double distance = printWidthM * intrinsics.fx / (fraction * size.width);
+      const double distance = printWidthM * model.axisFocalPx()[0] / (fraction * size.width);
       const cv::Vec3d position = distance * *ray - rotation * patternCentre;
       std::vector<cv::Vec3d> points;
       points.reserve(checkPoints.size());

@@ -47,6 +47,18 @@ processing::Intrinsics scaleIntrinsics(const processing::Intrinsics& in, cv::Siz
   out.fy = in.fy * sy;
   out.cx = (in.cx + 0.5) * sx - 0.5;
   out.cy = (in.cy + 0.5) * sy - 0.5;
+  if (in.model == processing::LensModel::kOcam) {
+    // The sensor plane scales with the rows (the affine matrix keeps its 1 there), the columns'
+    // extra through c and d; image_to_world's rays keep their directions: z(rho) scales with rho.
+    out.ocam.c = in.ocam.c * sx / sy;
+    out.ocam.d = in.ocam.d * sx / sy;
+    for (auto& p : out.ocam.worldToImage) p *= sy;
+    double scale = sy;  // sy^(1 - i)
+    for (auto& a : out.ocam.imageToWorld) {
+      a *= scale;
+      scale /= sy;
+    }
+  }
   return out;
 }
 

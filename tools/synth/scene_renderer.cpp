@@ -23,7 +23,7 @@ constexpr int kChunk = CameraRays::kTileSize;
 CameraRays::CameraRays(const processing::CameraCalibration& camera)
     : size_(camera.intrinsics.imageSize),
       position_(camera.pose.position),
-      fisheye_(camera.intrinsics.model == processing::LensModel::kFisheye),
+      fisheye_(camera.intrinsics.model != processing::LensModel::kPinhole),
       pixels_(static_cast<std::size_t>(size_.area())),
       offAxis_(size_, CV_32F) {
   const processing::CameraModel model(camera.intrinsics);
@@ -52,7 +52,7 @@ CameraRays::CameraRays(const processing::CameraCalibration& camera)
     return p.pixelAngle < 0 ? nullptr : &p;
   };
   const float height = static_cast<float>(camera.pose.position[2]);
-  const float fallbackAngle = static_cast<float>(1.0 / camera.intrinsics.fx);
+  const float fallbackAngle = static_cast<float>(1.0 / model.axisFocalPx()[0]);
   for (int y = 0; y < size_.height; ++y) {
     for (int x = 0; x < size_.width; ++x) {
       Pixel& p = pixels_[static_cast<std::size_t>(y * size_.width + x)];

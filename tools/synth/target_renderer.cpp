@@ -84,7 +84,7 @@ PlacedTarget placeBoard(const processing::Checkerboard& board,
 TargetRenderer::TargetRenderer(const processing::Intrinsics& intrinsics, int supersampling)
     : size_(intrinsics.imageSize),
       samples_(supersampling),
-      fisheye_(intrinsics.model == processing::LensModel::kFisheye),
+      fisheye_(intrinsics.model != processing::LensModel::kPinhole),
       rays_(static_cast<std::size_t>(size_.area() * supersampling * supersampling)),
       offAxisAngle_(size_, CV_32F) {
   const processing::CameraModel model(intrinsics);

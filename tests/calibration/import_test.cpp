@@ -1,0 +1,627 @@
+// surround-calibrate import: foreign calibration files written from the project's rig presets in a
+// foreign frame (other axes, unit, ground height and origin) are imported back to the presets
+// (position within 1 cm, rotation within 0.2 degrees, lenses exact or, for an OCamCalib lens
+// fitted to a fisheye, projections within 0.5 px); the three shared pjlab samples give sensible
+// rigs; bad input is refused naming the file and key.
+
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <numbers>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "daemon/rig_yaml.hpp"
+#include "processing/camera_model.hpp"
+#include "tests/support/temp_dir.hpp"
+#include "tools/calibrate/calibrate_options.hpp"
+#include "tools/calibrate/import_command.hpp"
+#include "tools/calibrate/ocam_results.hpp"
+
+namespace surroundd::calibrate {
+namespace {
+
+using processing::CameraCalibration;
+using surroundd::testing::TempDir;
+using ::testing::HasSubstr;
+
+constexpr double kRadToDeg = 180 / std::numbers::pi;
+
+std::vector<CameraCalibration> preset(const std::string& name) {
+  std::vector<CameraCalibration> cameras;
+  for (const auto& camera :
+       daemon::loadRigFile(std::string(SURROUNDD_SOURCE_DIR) + "/config/rigs/" + name)) {
+    cameras.push_back(camera.calibration);
+  }
+  return cameras;
+}
+
+// A frame as another tool might use: axes, unit, where the ground is on its vertical axis, and
+// the vehicle-frame ground point under its origin.
+struct ForeignFrame {
+  std::string axesText;
+  cv::Matx33d axes;  // columns: source x, y, z in the vehicle frame
+  double unitM;
+  double groundZ;
+  cv::Vec3d originOnGround;
+
+  cv::Vec3d toSource(const cv::Vec3d& vehicle) const {
+    cv::Vec3d source = axes.t() * (vehicle - originOnGround) * (1 / unitM);
+    for (int k = 0; k < 3; ++k) {
+      if (std::abs(axes(2, k)) > 0.5) source[k] += groundZ;
+    }
+    return source;
+  }
+  // P_camera = rotation * P_source + translation.
+  std::pair<cv::Matx33d, cv::Vec3d> cameraFromSource(const processing::Pose& pose) const {
+    const cv::Matx33d rotation = pose.rotation.t() * axes;
+    return {rotation, -(rotation * toSource(pose.position))};
+  }
+  std::vector<std::string> options() const {
+    return {"--axes",     axesText,
+            "--unit-m",   fmt::format("{}", unitM),
+            "--ground-z", fmt::format("{:.17g}", groundZ),
+            "--offset-m", fmt::format("{:.17g},{:.17g},0", originOnGround[0], originOnGround[1])};
+  }
+};
+
+// A top-down frame (x right, y towards the rear, z down) in decimetres, its origin 5 m above the
+// ground at vehicle (0.7, -0.4): the pjlab samples' kind of frame, off-centre.
+const ForeignFrame kTopDown{
+    "right,back,down", {0, -1, 0, -1, 0, 0, 0, 0, -1}, 0.1, 50, {0.7, -0.4, 0}};
+
+std::vector<daemon::RigCamera> runImport(std::vector<std::string> arguments) {
+  const std::vector<std::string_view> views(arguments.begin(), arguments.end());
+  return importRig(parseImport(views)).cameras;
+}
+
+std::string fileName(const CameraCalibration& camera) {
+  auto name = camera.name;
+  name[0] = static_cast<char>(std::toupper(name[0]));
+  return name;
+}
+
+// Poses within 1 cm and 0.2 degrees; prints the worst for the record.
+void expectPoses(const std::vector<daemon::RigCamera>& imported,
+                 const std::vector<CameraCalibration>& truth, const std::string& what) {
+  ASSERT_EQ(imported.size(), truth.size()) << what;
+  double worstM = 0, worstDeg = 0;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    const auto& got = imported[i].calibration;
+    const auto& want = truth[i];
+    EXPECT_EQ(got.name, want.name) << what << ": the rig order is front, right, back, left";
+    cv::Vec3d turn;
+    cv::Rodrigues(got.pose.rotation * want.pose.rotation.t(), turn);
+    const double metres = cv::norm(got.pose.position - want.pose.position);
+    const double degrees = cv::norm(turn) * kRadToDeg;
+    EXPECT_LT(metres, 0.01) << what << " " << want.name;
+    EXPECT_LT(degrees, 0.2) << what << " " << want.name;
+    EXPECT_EQ(got.role, want.role) << what << " " << want.name;
+    worstM = std::max(worstM, metres);
+    worstDeg = std::max(worstDeg, degrees);
+  }
+  std::cout << fmt::format("[ measured ] {}: worst position {:.2e} m, rotation {:.2e} deg\n", what,
+                           worstM, worstDeg);
+}
+
+void expectSameLens(const processing::Intrinsics& got, const processing::Intrinsics& want,
+                    const std::string& what) {
+  EXPECT_EQ(got.model, want.model) << what;
+  EXPECT_EQ(got.imageSize, want.imageSize) << what;
+  EXPECT_DOUBLE_EQ(got.fx, want.fx) << what;
+  EXPECT_DOUBLE_EQ(got.fy, want.fy) << what;
+  EXPECT_DOUBLE_EQ(got.cx, want.cx) << what;
+  EXPECT_DOUBLE_EQ(got.cy, want.cy) << what;
+  for (std::size_t i = 0; i < 5; ++i) EXPECT_DOUBLE_EQ(got.distortion[i], want.distortion[i]);
+}
+
+cv::Mat cameraMatrix(const processing::Intrinsics& lens) {
+  return (cv::Mat_<double>(3, 3) << lens.fx, 0, lens.cx, 0, lens.fy, lens.cy, 0, 0, 1);
+}
+
+TEST(Import, OpenCvYamlWithRvecTvecGivesThePaperRig) {
+  const TempDir dir;
+  const auto truth = preset("paper.yaml");
+  std::vector<std::string> arguments{"--out", (dir / "rig.yaml").string()};
+  for (const auto& camera : truth) {
+    const auto file = dir / (camera.name + ".yml");
+    cv::FileStorage storage(file.string(), cv::FileStorage::WRITE);
+    const auto& lens = camera.intrinsics;
+    storage << "image_width" << lens.imageSize.width << "image_height" << lens.imageSize.height;
+    storage << "camera_matrix" << cameraMatrix(lens);
+    storage << "distortion_coefficients"
+            << cv::Mat(std::vector<double>(lens.distortion.begin(), lens.distortion.end()))
+                   .reshape(1, 1);
+    const auto [rotation, translation] = kTopDown.cameraFromSource(camera.pose);
+    cv::Mat rvec;
+    cv::Rodrigues(cv::Mat(rotation), rvec);
+    storage << "rvec" << rvec << "tvec" << cv::Mat(translation);
+    storage.release();
+    arguments.push_back("--camera");
+    arguments.push_back(camera.name + "=" + file.string());
+  }
+  for (const auto& option : kTopDown.options()) arguments.push_back(option);
+  const auto imported = runImport(arguments);
+  expectPoses(imported, truth, "OpenCV YAML rvec/tvec");
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    expectSameLens(imported[i].calibration.intrinsics, truth[i].intrinsics, truth[i].name);
+  }
+}
+
+TEST(Import, OpenCvJsonFisheyeWithMatricesInTheOtherDirection) {
+  // The lens in one file, the pose in another, as the camera's pose in the source frame
+  // (--pose-direction to-source): a 4x4 for two cameras, R and t for the other two.
+  const TempDir dir;
+  const auto truth = preset("fisheye.yaml");
+  std::vector<std::string> arguments{"--out",     (dir / "rig.yaml").string(), "--pose-direction",
+                                     "to-source", "--field-of-view-deg",       "190"};
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    const auto& camera = truth[i];
+    const auto lensFile = dir / (camera.name + "_lens.json");
+    const auto poseFile = dir / (camera.name + "_pose.json");
+    cv::FileStorage lens(lensFile.string(), cv::FileStorage::WRITE);
+    lens << "distortion_model"
+         << "equidistant";
+    lens << "K" << cameraMatrix(camera.intrinsics);
+    lens << "D"
+         << cv::Mat(std::vector<double>(camera.intrinsics.distortion.begin(),
+                                        camera.intrinsics.distortion.begin() + 4))
+                .reshape(1, 1);
+    lens << "image_size"
+         << std::vector<int>{camera.intrinsics.imageSize.width, camera.intrinsics.imageSize.height};
+    lens.release();
+    const auto [rotation, translation] = kTopDown.cameraFromSource(camera.pose);
+    const cv::Matx33d sourceFromCamera = rotation.t();
+    const cv::Vec3d centre = -(rotation.t() * translation);
+    cv::FileStorage pose(poseFile.string(), cv::FileStorage::WRITE);
+    if (i % 2 == 0) {
+      cv::Matx44d t = cv::Matx44d::eye();
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) t(r, c) = sourceFromCamera(r, c);
+        t(r, 3) = centre[r];
+      }
+      pose << "extrinsic" << cv::Mat(t);
+    } else {
+      pose << "R" << cv::Mat(sourceFromCamera) << "t" << cv::Mat(centre);
+    }
+    pose.release();
+    arguments.push_back("--camera");
+    arguments.push_back(camera.name + "=" + lensFile.string() + "," + poseFile.string());
+  }
+  for (const auto& option : kTopDown.options()) arguments.push_back(option);
+  const auto imported = runImport(arguments);
+  expectPoses(imported, truth, "OpenCV JSON 4x4 and R/t, to-source");
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    expectSameLens(imported[i].calibration.intrinsics, truth[i].intrinsics, truth[i].name);
+    EXPECT_NEAR(imported[i].calibration.intrinsics.maxFieldAngleRad,
+                truth[i].intrinsics.maxFieldAngleRad, 1e-12);
+  }
+}
+
+TEST(Import, GroundHomographyIsDecomposedWithTheCameraMatrix) {
+  // H maps a ground canvas (5 cm pixels, the source origin at canvas pixel (400, 600)) to the
+  // image: H = K [r1 r2 r3 g + t] S^-1.
+  const TempDir dir;
+  const auto truth = preset("paper.yaml");
+  const double scale = 0.5;  // decimetres per canvas pixel
+  const cv::Matx33d groundToCanvas(1 / scale, 0, 400, 0, 1 / scale, 600, 0, 0, 1);
+  std::vector<std::string> arguments{"--out", (dir / "rig.yaml").string(), "--canvas-scale",
+                                     "0.5",   "--canvas-origin",           "400,600"};
+  for (const auto& camera : truth) {
+    const auto [r, t] = kTopDown.cameraFromSource(camera.pose);
+    const cv::Vec3d third = t + kTopDown.groundZ * cv::Vec3d(r(0, 2), r(1, 2), r(2, 2));
+    const cv::Matx33d plane(r(0, 0), r(0, 1), third[0], r(1, 0), r(1, 1), third[1], r(2, 0),
+                            r(2, 1), third[2]);
+    cv::Matx33d h = cv::Matx33d(cameraMatrix(camera.intrinsics)) * plane * groundToCanvas.inv();
+    h *= -3.0 / h(2, 2);  // any scale, of either sign
+    const auto file = dir / (camera.name + ".yaml");
+    cv::FileStorage storage(file.string(), cv::FileStorage::WRITE);
+    storage << "camera_matrix" << cameraMatrix(camera.intrinsics) << "dist_coeffs"
+            << cv::Mat::zeros(1, 5, CV_64F) << "homography" << cv::Mat(h);
+    storage << "image_width" << camera.intrinsics.imageSize.width << "image_height"
+            << camera.intrinsics.imageSize.height;
+    storage.release();
+    arguments.push_back("--camera");
+    arguments.push_back(camera.name + "=" + file.string());
+  }
+  for (const auto& option : kTopDown.options()) arguments.push_back(option);
+  expectPoses(runImport(arguments), truth, "ground homography");
+}
+
+// A least-squares polynomial through (x, y) samples, coefficients from the constant up; fitted in
+// x / max|x| so that the powers stay comparable (rho reaches hundreds of pixels).
+std::vector<double> fitPolynomial(const std::vector<double>& x, const std::vector<double>& y,
+                                  int degree) {
+  double scale = 0;
+  for (const double v : x) scale = std::max(scale, std::abs(v));
+  cv::Mat a(static_cast<int>(x.size()), degree + 1, CV_64F), b(y, true), p;
+  for (int i = 0; i < a.rows; ++i) {
+    for (int j = 0; j <= degree; ++j) a.at<double>(i, j) = std::pow(x[i] / scale, j);
+  }
+  cv::solve(a, b, p, cv::DECOMP_SVD);
+  std::vector<double> coefficients(p);
+  for (int j = 0; j <= degree; ++j) coefficients[j] /= std::pow(scale, j);
+  return coefficients;
+}
+
+// OCamCalib's lens for a fisheye lens with fx = fy: rho(theta) = f theta_d(theta + pi/2) over the
+// field, and z(rho) = -rho cot(off-axis angle), fitted. Native (the file's) terms.
+OcamNative ocamFromFisheye(const processing::Intrinsics& fisheye, double c, double d, double e) {
+  std::vector<double> elevations, rhos, zs;
+  const auto& k = fisheye.distortion;
+  for (double offAxis = 1e-3; offAxis < fisheye.maxFieldAngleRad; offAxis += 0.005) {
+    const double t2 = offAxis * offAxis;
+    const double rho =
+        fisheye.fx * offAxis * (1 + t2 * (k[0] + t2 * (k[1] + t2 * (k[2] + t2 * k[3]))));
+    elevations.push_back(offAxis - std::numbers::pi / 2);
+    rhos.push_back(rho);
+    zs.push_back(-rho * std::cos(offAxis) / std::sin(offAxis));
+  }
+  OcamNative native;
+  native.invpol = fitPolynomial(elevations, rhos, 12);
+  native.pol = fitPolynomial(rhos, zs, 6);
+  native.c = c, native.d = d, native.e = e;
+  native.xcRow = fisheye.cy;
+  native.ycColumn = fisheye.cx;
+  native.imageSize = fisheye.imageSize;
+  return native;
+}
+
+std::filesystem::path writeCalibResults(const std::filesystem::path& file, const OcamNative& n) {
+  std::ofstream out(file);
+  out << "#polynomial coefficients for the DIRECT mapping function (ocam_model.ss in MATLAB). "
+         "These are used by cam2world\n\n"
+      << n.pol.size() << " " << fmt::format("{:.17g}", fmt::join(n.pol, " ")) << " \n\n"
+      << "#polynomial coefficients for the inverse mapping function (ocam_model.invpol in "
+         "MATLAB). These are used by world2cam\n\n"
+      << n.invpol.size() << " " << fmt::format("{:.17g}", fmt::join(n.invpol, " ")) << " \n\n"
+      << "#center: \"row\" and \"column\" coordinates (x, y) of the center of the image in "
+         "pixels.\n\n"
+      << fmt::format("{:.17g} {:.17g}\n\n", n.xcRow, n.ycColumn)
+      << "#affine parameters \"c\", \"d\", \"e\"\n\n"
+      << fmt::format("{:.17g} {:.17g} {:.17g}\n\n", n.c, n.d, n.e)
+      << "#image size: \"height\" and \"width\"\n\n"
+      << n.imageSize.height << " " << n.imageSize.width << "\n\n";
+  return file;
+}
+
+// OCamCalib's world2cam (ocam_functions.cpp) in its own axes: x down the rows, y along the
+// columns, z = -forward; returns (column, row).
+cv::Point2d nativeWorldToCam(const OcamNative& n, const cv::Vec3d& opencv) {
+  const double x = opencv[1], y = opencv[0], z = -opencv[2];
+  const double norm = std::hypot(x, y);
+  const double theta = std::atan(z / norm);
+  double rho = 0, power = 1;
+  for (const double p : n.invpol) rho += p * power, power *= theta;
+  const double px = x / norm * rho, py = y / norm * rho;
+  return {px * n.e + py + n.ycColumn, px * n.c + py * n.d + n.xcRow};
+}
+
+// Directions over the field up to `maxOffAxis`, in OpenCV camera axes.
+std::vector<cv::Vec3d> fieldDirections(double maxOffAxis) {
+  std::vector<cv::Vec3d> directions;
+  for (double offAxis = 0.02; offAxis < maxOffAxis; offAxis += 0.05) {
+    for (double azimuth = 0; azimuth < 2 * std::numbers::pi; azimuth += 0.3) {
+      directions.push_back({std::sin(offAxis) * std::cos(azimuth),
+                            std::sin(offAxis) * std::sin(azimuth), std::cos(offAxis)});
+    }
+  }
+  return directions;
+}
+
+TEST(Import, OcamCalibResultsFollowOCamCalibsAxesAndAffineMatrix) {
+  // A lens with a real affine matrix: the import must project exactly as OCamCalib's world2cam,
+  // with its row/column centre and (row, column) affine matrix turned into image order.
+  const TempDir dir;
+  const auto fisheye = preset("fisheye.yaml").front();
+  const auto native = ocamFromFisheye(fisheye.intrinsics, 1.02, 0.01, -0.015);
+  const auto file = writeCalibResults(dir / "calib_results.txt", native);
+  auto lens = readOcamResults(file);
+  EXPECT_EQ(lens.model, processing::LensModel::kOcam);
+  lens.maxFieldAngleRad = 95 / kRadToDeg;  // the field is the importer's to set, not the file's
+  EXPECT_EQ(lens.imageSize, fisheye.intrinsics.imageSize);
+  const processing::CameraModel model(lens);
+  double worst = 0, worstRay = 0;
+  for (const auto& direction : fieldDirections(std::numbers::pi / 2)) {
+    const auto pixel = model.project(direction);
+    ASSERT_TRUE(pixel.has_value());
+    worst = std::max(worst, cv::norm(*pixel - nativeWorldToCam(native, direction)));
+    const auto ray = model.unproject(*pixel);
+    ASSERT_TRUE(ray.has_value());
+    worstRay = std::max(worstRay, std::acos(std::min(1.0, ray->dot(direction))) * kRadToDeg);
+  }
+  std::cout << fmt::format(
+      "[ measured ] OCamCalib world2cam vs import: {:.2e} px; "
+      "round trip through pol {:.3f} deg\n",
+      worst, worstRay);
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_LT(worstRay, 0.1);  // pol is a separate fit of the inverse
+  const auto back = toOcamNative(lens);
+  EXPECT_NEAR(back.c, native.c, 1e-12);
+  EXPECT_NEAR(back.d, native.d, 1e-12);
+  EXPECT_NEAR(back.e, native.e, 1e-12);
+}
+
+TEST(Import, OcamCalibResultsMadeFromTheFisheyeRig) {
+  // calib_results.txt fitted to each fisheye camera (the fit is approximate, so projections are
+  // compared over the field), the pose as a 4x4 in an OpenCV YAML file.
+  const TempDir dir;
+  const auto truth = preset("fisheye.yaml");
+  std::vector<std::string> arguments{"--out", (dir / "rig.yaml").string(), "--field-of-view-deg",
+                                     "190"};
+  for (const auto& camera : truth) {
+    const auto results = writeCalibResults(dir / (camera.name + "_calib_results.txt"),
+                                           ocamFromFisheye(camera.intrinsics, 1, 0, 0));
+    const auto poseFile = dir / (camera.name + "_pose.yml");
+    const auto [rotation, translation] = kTopDown.cameraFromSource(camera.pose);
+    cv::Matx44d t = cv::Matx44d::eye();
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) t(r, c) = rotation(r, c);
+      t(r, 3) = translation[r];
+    }
+    cv::FileStorage storage(poseFile.string(), cv::FileStorage::WRITE);
+    storage << "T" << cv::Mat(t);
+    storage.release();
+    arguments.push_back("--camera");
+    arguments.push_back(camera.name + "=" + results.string() + "," + poseFile.string());
+  }
+  for (const auto& option : kTopDown.options()) arguments.push_back(option);
+  const auto imported = runImport(arguments);
+  expectPoses(imported, truth, "calib_results.txt + 4x4");
+  // The rig file keeps the ocam lens exactly.
+  std::ostringstream log;
+  calibrate::runImport(
+      parseImport(std::vector<std::string_view>(arguments.begin(), arguments.end())), log);
+  const auto reread = daemon::loadRigFile(dir / "rig.yaml");
+  ASSERT_EQ(reread.size(), imported.size());
+  for (std::size_t i = 0; i < reread.size(); ++i) {
+    EXPECT_EQ(reread[i].calibration.intrinsics, imported[i].calibration.intrinsics);
+  }
+  double worst = 0;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    const processing::CameraModel want(truth[i].intrinsics);
+    const processing::CameraModel got(imported[i].calibration.intrinsics);
+    for (const auto& direction : fieldDirections(95 / kRadToDeg)) {
+      const auto a = want.project(direction), b = got.project(direction);
+      ASSERT_TRUE(a && b) << truth[i].name;
+      worst = std::max(worst, cv::norm(*a - *b));
+    }
+  }
+  std::cout << fmt::format(
+      "[ measured ] OCam fitted to the fisheye rig: {:.2e} px worst over "
+      "190 degrees\n",
+      worst);
+  EXPECT_LT(worst, 0.5);
+}
+
+// The pjlab JSON layout as the samples write it: nested maps, {rows, cols, type, continuous,
+// data} matrices with nested rows.
+std::string pjlabMatrix(const cv::Mat& m) {
+  std::vector<std::string> rows;
+  for (int r = 0; r < m.rows; ++r) {
+    std::vector<std::string> row;
+    for (int c = 0; c < m.cols; ++c) row.push_back(fmt::format("{:.17g}", m.at<double>(r, c)));
+    rows.push_back(fmt::format("[{}]", fmt::join(row, ", ")));
+  }
+  return fmt::format(R"({{"rows": {}, "cols": {}, "type": 6, "continuous": true, "data": [{}]}})",
+                     m.rows, m.cols, fmt::join(rows, ", "));
+}
+
+TEST(Import, PjlabJsonLayoutWithAGroundPerCamera) {
+  // The carla sample's layout and frame (x right, y towards the rear, z down, metres, the
+  // origin above the vehicle centre) with each camera's ground at its own height, as in
+  // pjlab-ocam-real; the pictures become the cameras' sources.
+  const TempDir dir;
+  const auto truth = preset("paper.yaml");
+  std::filesystem::create_directories(dir / "intrinsic");
+  std::filesystem::create_directories(dir / "extrinsic");
+  std::filesystem::create_directories(dir / "imgs");
+  const std::map<std::string, double> ground{
+      {"front", 5.1}, {"right", 5.3}, {"back", 4.9}, {"left", 6.0}};
+  std::string grounds;
+  for (const auto& camera : truth) {
+    const auto& lens = camera.intrinsics;
+    ForeignFrame frame{"right,back,down", kTopDown.axes, 1, ground.at(camera.name), {}};
+    const auto [rotation, translation] = frame.cameraFromSource(camera.pose);
+    cv::Mat t = cv::Mat::eye(4, 4, CV_64F);
+    cv::Mat(rotation).copyTo(t(cv::Rect(0, 0, 3, 3)));
+    cv::Mat(translation).copyTo(t(cv::Rect(3, 0, 1, 3)));
+    const auto name = fileName(camera);
+    std::ofstream(dir / "intrinsic" / (name + ".json")) << fmt::format(
+        R"({{"{}_camera-intrinsic": {{"sensor_name": "{}_camera", "param": {{"img_dist_w": {},
+        "img_dist_h": {}, "cam_K": {}, "cam_dist": {}}}}}}})",
+        camera.name, camera.name, lens.imageSize.width, lens.imageSize.height,
+        pjlabMatrix(cameraMatrix(lens)), pjlabMatrix(cv::Mat::zeros(1, 4, CV_64F)));
+    std::ofstream(dir / "extrinsic" / (name + ".json")) << fmt::format(
+        R"({{"bev-to-{}_camera-extrinsic": {{"param": {{"time_lag": 0, "sensor_calib": {}}}}}}})",
+        camera.name, pjlabMatrix(t));
+    cv::imwrite((dir / "imgs" / (name + ".png")).string(), cv::Mat::zeros(lens.imageSize, CV_8UC3));
+    grounds +=
+        fmt::format("{}{}={}", grounds.empty() ? "" : ",", camera.name, ground.at(camera.name));
+  }
+  const auto rigFile = dir / "rigs" / "imported.yaml";
+  const std::vector<std::string> arguments{
+      "--pjlab",  dir.path().string(),     "--axes", "right,back,down", "--ground-z", grounds,
+      "--images", (dir / "imgs").string(), "--out",  rigFile.string()};
+  const auto imported = runImport(arguments);
+  expectPoses(imported, truth, "pjlab JSON");
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    expectSameLens(imported[i].calibration.intrinsics, truth[i].intrinsics, truth[i].name);
+  }
+
+  // The file: written, its header saying where from, read back to the same rig, pictures found.
+  std::ostringstream log;
+  calibrate::runImport(
+      parseImport(std::vector<std::string_view>(arguments.begin(), arguments.end())), log);
+  std::ifstream stream(rigFile);
+  const std::string text((std::istreambuf_iterator<char>(stream)), {});
+  EXPECT_THAT(text, HasSubstr("# Imported by surround-calibrate import from:"));
+  EXPECT_THAT(text, HasSubstr("axes (x, y, z) = right,back,down"));
+  EXPECT_THAT(text, HasSubstr("file: ../imgs/Front.png"));
+  const auto reread = daemon::loadRigFile(rigFile);
+  ASSERT_EQ(reread.size(), 4U);
+  for (std::size_t i = 0; i < reread.size(); ++i) {
+    EXPECT_EQ(reread[i].calibration.intrinsics, imported[i].calibration.intrinsics);
+    EXPECT_LT(cv::norm(reread[i].calibration.pose.position - truth[i].pose.position), 0.01);
+    ASSERT_TRUE(reread[i].source.has_value());
+    EXPECT_EQ(reread[i].source->path.filename(), fileName(truth[i]) + ".png");
+    EXPECT_TRUE(std::filesystem::exists(reread[i].source->path));
+  }
+  EXPECT_FALSE(std::filesystem::exists(rigFile.string() + ".part"));
+}
+
+TEST(Import, PjlabYamlOfTheFisheyeSampleWithTheOriginAtTheCamerasCentre) {
+  // The frame of pjlab-fisheye-real: x right, y forward, z up, decimetres, the ground at z = 1,
+  // its origin anywhere; --origin-centre finds the fisheye rig's centre (the cameras' bounding
+  // box is centred on the vehicle).
+  const TempDir dir;
+  const auto truth = preset("fisheye.yaml");
+  const ForeignFrame frame{"right,forward,up", {0, 1, 0, -1, 0, 0, 0, 0, 1}, 0.1, 1, {0.9, 1.3, 0}};
+  std::string yaml =
+      fmt::format("image_size: [{}, {}]\ncameras:\n", truth[0].intrinsics.imageSize.width,
+                  truth[0].intrinsics.imageSize.height);
+  for (const auto& camera : truth) {
+    const auto& lens = camera.intrinsics;
+    const auto [r, t] = frame.cameraFromSource(camera.pose);
+    yaml += fmt::format(
+        "  {}:\n    K: [{:.17g}, {:.17g}, {:.17g}, {:.17g}]\n    D: [{:.17g}]\n    T_cam_from_G:\n",
+        camera.name, lens.fx, lens.fy, lens.cx, lens.cy,
+        fmt::join(lens.distortion.begin(), lens.distortion.begin() + 4, ", "));
+    for (int row = 0; row < 3; ++row) {
+      yaml += fmt::format("      - [{:.17g}, {:.17g}, {:.17g}, {:.17g}]\n", r(row, 0), r(row, 1),
+                          r(row, 2), t[row]);
+    }
+    yaml += "      - [0, 0, 0, 1]\n";
+  }
+  const auto file = dir.write("calibration.yaml", yaml);
+  const auto imported =
+      runImport({"--pjlab-yaml", file.string(), "--lens", "fisheye", "--axes", "right,forward,up",
+                 "--unit-m", "0.1", "--ground-z", "1", "--origin-centre", "--field-of-view-deg",
+                 "190", "--out", (dir / "rig.yaml").string()});
+  expectPoses(imported, truth, "pjlab YAML, origin at the centre");
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    expectSameLens(imported[i].calibration.intrinsics, truth[i].intrinsics, truth[i].name);
+  }
+}
+
+std::string importError(const std::vector<std::string>& arguments) {
+  try {
+    runImport(arguments);
+  } catch (const UsageError& error) {
+    return error.what();
+  }
+  return "(no error)";
+}
+
+TEST(Import, BadInputIsRefusedNamingTheFileAndKey) {
+  const TempDir dir;
+  const auto noMatrix = dir.write("front.yml", "%YAML:1.0\ndist_coeffs: [0, 0, 0, 0, 0]\n");
+  EXPECT_THAT(importError({"--camera", "front=" + noMatrix.string(), "--out", "x.yaml"}),
+              AllOf(HasSubstr(noMatrix.string()), HasSubstr("camera_matrix")));
+  const auto shortMatrix =
+      dir.write("short.yml", "%YAML:1.0\nK: [1, 0, 2, 0, 1, 2, 0]\nD: [0, 0, 0, 0]\n");
+  EXPECT_THAT(importError({"--camera", "front=" + shortMatrix.string(), "--out", "x.yaml"}),
+              AllOf(HasSubstr(shortMatrix.string() + ": K"), HasSubstr("7 numbers")));
+  const auto ambiguous =
+      dir.write("ambiguous.yml",
+                "%YAML:1.0\nK: [300, 0, 320, 0, 300, 240, 0, 0, 1]\nD: [0.1, 0.01, 0, 0]\n"
+                "image_width: 640\nimage_height: 480\nrvec: [0, 0, 0]\ntvec: [0, 0, 1]\n");
+  EXPECT_THAT(importError({"--camera", "front=" + ambiguous.string(), "--out", "x.yaml"}),
+              AllOf(HasSubstr(ambiguous.string() + ": D"), HasSubstr("--lens")));
+  const auto noPose = dir.write("nopose.yml",
+                                "%YAML:1.0\nK: [300, 0, 320, 0, 300, 240, 0, 0, 1]\n"
+                                "D: [0, 0, 0, 0, 0]\nimage_width: 640\nimage_height: 480\n");
+  EXPECT_THAT(importError({"--camera", "front=" + noPose.string(), "--out", "x.yaml"}),
+              AllOf(HasSubstr(noPose.string()), HasSubstr("no pose")));
+  const auto results =
+      dir.write("calib_results.txt", "#pol\n\n3 -200 0\n\n2 1 2\n\n1 2\n\n1 0 0\n\n10 10\n");
+  EXPECT_THAT(importError({"--camera", "front=" + results.string(), "--out", "x.yaml"}),
+              AllOf(HasSubstr(results.string() + ":3: pol"), HasSubstr("count")));
+  EXPECT_THAT(importError({"--camera", "front=" + noPose.string(), "--axes", "right,forward,down",
+                           "--out", "x.yaml"}),
+              HasSubstr("left-handed"));
+  EXPECT_THAT(importError({"--pjlab", dir.path().string(), "--out", "x.yaml"}),
+              HasSubstr("no folder 'intrinsic'"));
+}
+
+// The shared samples, imported as config/rigs/imported/README.md says.
+std::filesystem::path sharedData() {
+  return std::filesystem::path(SURROUNDD_SOURCE_DIR) / ".." / "shared" / "data";
+}
+
+cv::Vec3d opticalAxis(const CameraCalibration& camera) {
+  return camera.pose.rotation * cv::Vec3d(0, 0, 1);
+}
+
+// Sensible: four cameras in rig order, heights in range, front ahead of back, left at +y, each
+// looking outward (its optical axis within 30 degrees of its side, seen from above).
+void expectSensibleRig(const std::vector<daemon::RigCamera>& rig, double minHeight,
+                       double maxHeight, const std::string& what) {
+  ASSERT_EQ(rig.size(), 4U) << what;
+  const std::array<std::pair<const char*, cv::Vec2d>, 4> sides{
+      {{"front", {1, 0}}, {"right", {0, -1}}, {"back", {-1, 0}}, {"left", {0, 1}}}};
+  for (std::size_t i = 0; i < 4; ++i) {
+    const auto& camera = rig[i].calibration;
+    const auto& [name, side] = sides[i];
+    EXPECT_EQ(camera.name, name) << what;
+    EXPECT_GE(camera.pose.position[2], minHeight) << what << " " << name;
+    EXPECT_LE(camera.pose.position[2], maxHeight) << what << " " << name;
+    const cv::Vec3d axis = opticalAxis(camera);
+    const cv::Vec2d flat = cv::normalize(cv::Vec2d(axis[0], axis[1]));
+    EXPECT_GT(flat.dot(side), std::cos(30 / kRadToDeg))
+        << what << " " << name << " looks along " << axis;
+    EXPECT_LT(axis[2], 0.01) << what << " " << name << " looks level or down";
+    std::cout << fmt::format(
+        "[ measured ] {} {}: ({:+.3f}, {:+.3f}, {:.3f}) m, axis ({:+.2f}, "
+        "{:+.2f}, {:+.2f})\n",
+        what, name, camera.pose.position[0], camera.pose.position[1], camera.pose.position[2],
+        axis[0], axis[1], axis[2]);
+  }
+  EXPECT_GT(rig[0].calibration.pose.position[0], rig[2].calibration.pose.position[0]) << what;
+  EXPECT_GT(rig[3].calibration.pose.position[1], 0) << what;
+  EXPECT_LT(rig[1].calibration.pose.position[1], 0) << what;
+}
+
+TEST(Import, TheSharedPjlabSamplesGiveSensibleRigs) {
+  const auto data = sharedData();
+  if (!std::filesystem::is_directory(data)) GTEST_SKIP() << "../shared/data is absent";
+  const TempDir dir;
+  const auto sample = [&](const char* name) { return (data / name).string(); };
+
+  const auto carla = runImport(
+      {"--pjlab", sample("pjlab-carla-pinhole"), "--axes", "right,back,down", "--ground-z", "5.1",
+       "--images", sample("pjlab-carla-pinhole/imgs"), "--out", (dir / "carla.yaml").string()});
+  expectSensibleRig(carla, 0.99, 1.01, "pjlab-carla-pinhole");
+  // The README's centres: front 2.5 m ahead, back 2 m behind, sides 1 m out, all 1.0 m up.
+  const std::array<cv::Vec3d, 4> centres{{{2.5, 0, 1}, {0, -1, 1}, {-2, 0, 1}, {0, 1, 1}}};
+  for (std::size_t i = 0; i < 4 && i < carla.size(); ++i) {
+    EXPECT_LT(cv::norm(carla[i].calibration.pose.position - centres[i]), 0.01)
+        << carla[i].calibration.name;
+  }
+
+  const auto fisheye = runImport(
+      {"--pjlab-yaml", sample("pjlab-fisheye-real/calibration.yaml"), "--lens", "fisheye", "--axes",
+       "right,forward,up", "--unit-m", "0.1", "--ground-z", "1", "--origin-centre", "--images",
+       sample("pjlab-fisheye-real/imgs"), "--out", (dir / "fisheye.yaml").string()});
+  // The calibration's header: about 17 units (1.7 m) up; the back camera sits higher.
+  expectSensibleRig(fisheye, 1.5, 2.0, "pjlab-fisheye-real");
+
+  const auto ocam = runImport(
+      {"--pjlab", sample("pjlab-ocam-real"), "--lens", "ocam", "--axes", "right,back,down",
+       "--ground-z", "front=6.07826,left=6.25217,back=6.31014,right=6.28116", "--origin-centre",
+       "--images", sample("pjlab-ocam-real/imgs"), "--out", (dir / "ocam.yaml").string()});
+  // The README: camera heights of 1.22-1.35 m follow from the ground heights.
+  expectSensibleRig(ocam, 1.21, 1.36, "pjlab-ocam-real");
+  for (const auto& camera : ocam) {
+    EXPECT_EQ(camera.calibration.intrinsics.model, processing::LensModel::kOcam);
+    EXPECT_EQ(camera.calibration.intrinsics.ocam.worldToImage.size(), 11U);
+  }
+}
+
+}  // namespace
+}  // namespace surroundd::calibrate

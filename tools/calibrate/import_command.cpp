@@ -1,0 +1,216 @@
+#include "tools/calibrate/import_command.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "tools/calibrate/calibrate_options.hpp"
+#include "tools/calibrate/foreign_lens.hpp"
+#include "tools/calibrate/ground_homography.hpp"
+#include "tools/calibrate/ocam_results.hpp"
+#include "tools/calibrate/pjlab_layout.hpp"
+
+namespace surroundd::calibrate {
+namespace {
+
+constexpr std::array<std::string_view, 4> kRigOrder{"front", "right", "back", "left"};
+
+std::string lower(std::string text) {
+  std::ranges::transform(text, text.begin(), [](unsigned char c) { return std::tolower(c); });
+  return text;
+}
+
+std::vector<NamedCalibration> readInputs(const ImportOptions& options) {
+  std::vector<NamedCalibration> cameras;
+  if (options.pjlabYaml) return readPjlabYaml(*options.pjlabYaml, options.poseDirection);
+  const auto files = options.pjlabDir
+                         ? pjlabCameraFiles(*options.pjlabDir)
+                         : std::vector<std::pair<std::string, std::vector<std::filesystem::path>>>(
+                               options.cameraFiles.begin(), options.cameraFiles.end());
+  for (const auto& [name, paths] : files) {
+    NamedCalibration camera{name, {}};
+    for (const auto& path : paths) {
+      if (path.extension() == ".txt") {
+        if (!camera.calibration.lens) {
+          camera.calibration.lens =
+              Found<processing::Intrinsics>{readOcamResults(path), path.string()};
+        }
+        camera.calibration.files.push_back(path);
+      } else {
+        readOpenCvCalibration(path, options.poseDirection, camera.calibration);
+      }
+    }
+    cameras.push_back(std::move(camera));
+  }
+  return cameras;
+}
+
+// The still picture of a camera in the --images folder: a picture file whose name (without its
+// extension, any case) is the camera's.
+std::optional<std::filesystem::path> findPicture(const std::filesystem::path& folder,
+                                                 const std::string& sourceName) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(folder, ec)) {
+    throw UsageError(fmt::format("--images: {} is not a folder", folder.string()));
+  }
+  std::vector<std::filesystem::path> matches;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    const auto extension = lower(entry.path().extension().string());
+    const bool picture = extension == ".png" || extension == ".jpg" || extension == ".jpeg" ||
+                         extension == ".bmp" || extension == ".tif" || extension == ".tiff";
+    if (picture && lower(entry.path().stem().string()) == lower(sourceName)) {
+      matches.push_back(entry.path());
+    }
+  }
+  if (matches.size() > 1) {
+    throw UsageError(fmt::format("--images: {} has more than one picture for camera '{}'",
+                                 folder.string(), sourceName));
+  }
+  if (matches.empty()) return std::nullopt;
+  return matches.front();
+}
+
+processing::Pose poseOf(const std::string& camera, const ForeignCalibration& found,
+                        const processing::Intrinsics& lens, const ImportOptions& options,
+                        const SourceFrame& frame) {
+  if (found.pose) return vehiclePose(frame, camera, found.pose->value);
+  if (!found.homography) {
+    std::string files;
+    for (const auto& file : found.files) files += (files.empty() ? "" : ", ") + file.string();
+    throw UsageError(
+        fmt::format("camera '{}': no pose in {} (keys rvec + tvec, R + t, a 4x4 T / sensor_calib / "
+                    "T_cam_from_G / extrinsic / transform, or a homography H)",
+                    camera, files));
+  }
+  const auto& origin = found.homography->origin;
+  if (!options.canvasScale) {
+    throw UsageError(fmt::format(
+        "{}: a ground homography needs --canvas-scale (source units per canvas pixel) and "
+        "--canvas-origin",
+        origin));
+  }
+  if (lens.model == processing::LensModel::kOcam) {
+    throw UsageError(
+        fmt::format("{}: an ocam lens has no camera matrix to decompose H with", origin));
+  }
+  if (frame.verticalAxis() != 2) {
+    throw UsageError(fmt::format(
+        "{}: a ground canvas lies in the source's x-y plane, so its z axis must be up or down "
+        "(--axes {})",
+        origin, options.axesText));
+  }
+  const cv::Matx33d k(lens.fx, 0, lens.cx, 0, lens.fy, lens.cy, 0, 0, 1);
+  const GroundCanvas canvas{*options.canvasScale, options.canvasOrigin, frame.groundFor(camera),
+                            frame.verticalSign()};
+  return vehiclePose(frame, camera,
+                     poseFromGroundHomography(found.homography->value, k, canvas, origin));
+}
+
+std::string headerComment(const ImportOptions& options,
+                          const std::vector<NamedCalibration>& inputs) {
+  std::string files;
+  for (const auto& input : inputs) {
+    for (const auto& file : input.calibration.files) {
+      if (files.find(file.string()) == std::string::npos) files += "\n  " + file.string();
+    }
+  }
+  std::string ground = fmt::format("{}", options.groundZ);
+  for (const auto& [camera, z] : options.groundZByCamera)
+    ground += fmt::format(", {} {}", camera, z);
+  return fmt::format(
+      "Imported by surround-calibrate import from:{}\n"
+      "Source frame: axes (x, y, z) = {}, unit {} m, ground at {} source units on the vertical "
+      "axis; poses map {}; origin: {}{}.\n"
+      "Written in the vehicle frame: origin on the ground under the vehicle centre, x forward, "
+      "y left, z up, metres.\n"
+      "Command: {}",
+      files, options.axesText, options.unitM, ground,
+      options.poseDirection == PoseDirection::kToCamera ? "source to camera" : "camera to source",
+      options.originCentre ? "the centre of the cameras' bounding box" : "the source origin",
+      cv::norm(options.offsetM) > 0
+          ? fmt::format(", then moved by ({}, {}, {}) m", options.offsetM[0], options.offsetM[1],
+                        options.offsetM[2])
+          : "",
+      options.commandLine);
+}
+
+}  // namespace
+
+ImportedRig importRig(const ImportOptions& options) {
+  const SourceFrame frame{options.axes, options.unitM, options.groundZ, options.groundZByCamera};
+  const auto inputs = readInputs(options);
+  for (const auto& [camera, z] : options.groundZByCamera) {
+    if (std::ranges::none_of(inputs,
+                             [&](const auto& in) { return lower(in.sourceName) == camera; })) {
+      throw UsageError(fmt::format("--ground-z: there is no camera '{}'", camera));
+    }
+  }
+  std::vector<daemon::RigCamera> cameras;
+  for (const auto& input : inputs) {
+    daemon::RigCamera camera;
+    auto& c = camera.calibration;
+    c.name = lower(input.sourceName);
+    const auto picture =
+        options.images ? findPicture(*options.images, input.sourceName) : std::nullopt;
+    cv::Mat image;
+    if (picture) {
+      image = cv::imread(picture->string(), cv::IMREAD_COLOR);
+      if (image.empty()) {
+        throw UsageError(fmt::format("{}: cannot read the picture", picture->string()));
+      }
+      // Relative to the rig file, so that the rig and the pictures can move together.
+      const auto folder = std::filesystem::absolute(options.out).parent_path();
+      camera.source = capture::FileSourceSettings{};
+      camera.source->path =
+          std::filesystem::absolute(*picture).lexically_normal().lexically_relative(
+              folder.lexically_normal());
+      camera.source->loop = true;
+    } else if (options.images) {
+      throw UsageError(fmt::format("--images: no picture named '{}' (.png, .jpg, ...) in {}",
+                                   input.sourceName, options.images->string()));
+    }
+    c.intrinsics = importedLens(c.name, input.calibration, options, image);
+    if (!image.empty() && image.size() != c.intrinsics.imageSize) {
+      throw UsageError(fmt::format("{} is {}x{}, but the calibration of camera '{}' is for {}x{}",
+                                   picture->string(), image.cols, image.rows, c.name,
+                                   c.intrinsics.imageSize.width, c.intrinsics.imageSize.height));
+    }
+    c.pose = poseOf(c.name, input.calibration, c.intrinsics, options, frame);
+    cameras.push_back(std::move(camera));
+  }
+  std::vector<processing::Pose> poses;
+  for (const auto& camera : cameras) poses.push_back(camera.calibration.pose);
+  const cv::Vec3d shift =
+      (options.originCentre ? -boundingBoxCentre(poses) : cv::Vec3d()) + options.offsetM;
+  for (auto& camera : cameras) {
+    camera.calibration.pose.position += shift;
+    camera.calibration.role = daemon::defaultRole(camera.calibration.pose);
+  }
+  const auto rank = [](const daemon::RigCamera& camera) {
+    const auto it = std::ranges::find(kRigOrder, camera.calibration.name);
+    return static_cast<int>(it - kRigOrder.begin());
+  };
+  std::ranges::stable_sort(cameras, {}, rank);
+  return {cameras, headerComment(options, inputs)};
+}
+
+void runImport(const ImportOptions& options, std::ostream& log) {
+  const auto [cameras, header] = importRig(options);
+  if (options.out.has_parent_path()) std::filesystem::create_directories(options.out.parent_path());
+  daemon::writeRigFile(options.out, cameras, header);
+  for (const auto& camera : cameras) {
+    const auto& pose = camera.calibration.pose;
+    const auto angles = processing::mountAnglesFromRotation(pose.rotation);
+    log << fmt::format(
+        "{:<6} x {:+.3f} y {:+.3f} z {:.3f} m, yaw {:+.2f} pitch {:+.2f} roll {:+.2f} deg{}\n",
+        camera.calibration.name, pose.position[0], pose.position[1], pose.position[2],
+        angles.yawDeg, angles.pitchDeg, angles.rollDeg,
+        camera.source ? ", picture " + camera.source->path.string() : "");
+  }
+  log << "wrote " << options.out.string() << "\n";
+}
+
+}  // namespace surroundd::calibrate

@@ -1,0 +1,28 @@
+#pragma once
+// surround-calibrate import: a calibration made by another tool (OpenCV FileStorage files,
+// OCamCalib's calib_results.txt, the pjlab layouts) in, a rig file in the vehicle frame out.
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "daemon/rig_yaml.hpp"
+#include "tools/calibrate/import_options.hpp"
+
+namespace surroundd::calibrate {
+
+struct ImportedRig {
+  // In the order front, right, back, left, then the others. Picture paths are relative to the
+  // folder of options.out.
+  std::vector<daemon::RigCamera> cameras;
+  std::string header;  // the rig file's comment: the inputs, the frame options, the command
+};
+
+// The rig the options describe. Throws UsageError naming the file and key for missing or
+// malformed input.
+ImportedRig importRig(const ImportOptions& options);
+
+// importRig, then writes options.out (beside and renamed) and prints each camera's mount to `log`.
+void runImport(const ImportOptions& options, std::ostream& log);
+
+}  // namespace surroundd::calibrate
