@@ -10,6 +10,7 @@
 //       lens: {model: pinhole, width_px: 1280, height_px: 720, fx_px: .., fy_px: .., cx_px: ..,
 //              cy_px: .., distortion: [k1, k2, p1, p2, k3]}
 //       mount: {x_m: .., y_m: .., z_m: .., yaw_deg: .., pitch_deg: .., roll_deg: ..}
+//       health: {frozen_check: auto}         # auto | on | off; auto: off for a looped still
 //
 // The same schema is used inline in a config (`rig: {cameras: [...]}`) and in a rig file of its own
 // (`rig: {file: rig.yaml}`; the generator writes one next to its recordings).
@@ -28,6 +29,10 @@
 
 namespace surroundd::daemon {
 
+// Whether a camera whose frames stop changing is reported frozen. auto: yes, unless its source
+// shows one picture by design (a still picture or a one-picture sequence, looped).
+enum class FrozenCheck { kAuto, kOn, kOff };
+
 struct RigCamera {
   processing::CameraCalibration calibration;
   // Where the frames come from: a file (replay), or a live V4L2 device. Both absent in rig presets
@@ -35,6 +40,7 @@ struct RigCamera {
   std::optional<capture::FileSourceSettings> source;
   std::optional<capture::V4l2Settings> device;
   std::optional<capture::LibcameraSettings> libcamera;
+  FrozenCheck frozenCheck = FrozenCheck::kAuto;
   bool live() const { return device.has_value() || libcamera.has_value(); }
 };
 
