@@ -57,7 +57,8 @@ CameraHealth CameraHealthMonitor::judge(Camera& camera, const Frame* frame, Time
 
   if (frame == nullptr) {
     if (camera.unmatchedSets >= settings_.outOfSyncSets) return CameraHealth::kOutOfSync;
-    if (repeatedTimestamp && camera.sameFrames + 1 >= settings_.frozenFrames) {
+    if (camera.frozenCheck && repeatedTimestamp &&
+        camera.sameFrames + 1 >= settings_.frozenFrames) {
       return CameraHealth::kFrozen;
     }
     const Timestamp since = now - camera.lastFrame.value_or(*firstSet_);
@@ -93,7 +94,9 @@ CameraHealth CameraHealthMonitor::judge(Camera& camera, const Frame* frame, Time
   if (mean < settings_.blackLevel) return CameraHealth::kBlack;
   if (mean > settings_.saturatedLevel) return CameraHealth::kSaturated;
   // n frames with the same pixels are n - 1 repeats of the first.
-  if (camera.sameFrames + 1 >= settings_.frozenFrames) return CameraHealth::kFrozen;
+  if (camera.frozenCheck && camera.sameFrames + 1 >= settings_.frozenFrames) {
+    return CameraHealth::kFrozen;
+  }
   return CameraHealth::kOk;
 }
 

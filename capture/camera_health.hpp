@@ -5,7 +5,8 @@
 //               less than `frozenChange` on average (a driver or link repeating one buffer; a
 //               lossy codec wobbles a repeated picture by up to about 0.9 level, while a live
 //               sensor's noise alone changes it by more: 1.7 levels at sigma 1.5), or whose
-//               timestamps stop moving (the synchronizer drops those frames);
+//               timestamps stop moving (the synchronizer drops those frames). Off for a camera
+//               that shows one picture by design (a still picture, looped): see setFrozenCheck;
 //   black       mean level under `blackLevel` (lens covered, sensor dead);
 //   saturated   mean level over `saturatedLevel` (blinded);
 //   out of sync its frames keep arriving but miss the sets (dropped as unmatched `outOfSyncSets`
@@ -51,11 +52,17 @@ class CameraHealthMonitor {
 
   CameraHealth health(std::size_t camera) const { return cameras_[camera].health; }
 
+  // On by default. Off, the camera is never judged frozen: its frames may repeat by design. A
+  // camera whose timestamps stop is then found lost instead, once its frames stop coming.
+  void setFrozenCheck(std::size_t camera, bool enabled) { cameras_[camera].frozenCheck = enabled; }
+  bool frozenCheck(std::size_t camera) const { return cameras_[camera].frozenCheck; }
+
  private:
   static constexpr int kSamplesAcross = 32;
   static constexpr int kSamplesDown = 18;
   struct Camera {
     CameraHealth health = CameraHealth::kOk;
+    bool frozenCheck = true;
     std::optional<Timestamp> lastFrame;
     std::array<std::uint8_t, static_cast<std::size_t>(kSamplesAcross) * kSamplesDown * 3> samples{};
     int sameFrames = 0;  // consecutive frames whose samples equal the previous frame's

@@ -16,6 +16,7 @@ CameraStream::CameraStream(std::string name, std::unique_ptr<FrameSource> source
       source_(std::move(source)),
       pool_(poolFrames, source_->frameSize()),
       nominalPeriod_(source_->nominalPeriod()),
+      repeatsOnePicture_(source_->repeatsOnePicture()),
       maxConsecutiveFaults_(maxConsecutiveFaults),
       queue_(poolFrames) {}
 

@@ -52,6 +52,7 @@ class CameraStream {
   const std::string& name() const { return name_; }
   cv::Size frameSize() const { return pool_.frameSize(); }
   Timestamp nominalPeriod() const { return nominalPeriod_; }
+  bool repeatsOnePicture() const { return repeatsOnePicture_; }  // see FrameSource
   CameraStreamStats stats() const;
   std::size_t queued() const;  // frames waiting to be taken by next()
 
@@ -62,7 +63,9 @@ class CameraStream {
   std::string name_;
   std::unique_ptr<FrameSource> source_;
   FramePool pool_;
-  Timestamp nominalPeriod_;  // read once: the source belongs to the capture thread once started
+  // Read once: the source belongs to the capture thread once started.
+  Timestamp nominalPeriod_;
+  bool repeatsOnePicture_;
   int maxConsecutiveFaults_;
 
   mutable std::mutex mutex_;

@@ -1,8 +1,11 @@
 #include "capture/file_source.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <optional>
+#include <string_view>
 #include <thread>
 
 #include <fmt/format.h>
@@ -31,6 +34,12 @@ bool isImageSequence(const std::string& path) {
     if (end < path.size() && path[end] == 'd') return true;
   }
   return false;
+}
+
+// FFmpeg's demuxers for pictures: image2 (a pattern, or one named file) and the per-format pipes
+// (png_pipe, jpeg_pipe, ...). Their frame rate is a made-up default, not the file's.
+bool isPictureDemuxer(std::string_view name) {
+  return name == "image2" || name == "image2pipe" || name.ends_with("_pipe");
 }
 
 int swsColorspaceOf(AVColorSpace space) {
@@ -64,6 +73,9 @@ struct FileSource::Impl {
   cv::Size size;
   Timestamp period{};
   std::string lastError;
+  // One picture (a still, or a sequence of one): decoded and converted once, into `still`.
+  bool onePicture = false;
+  cv::Mat still;
 
   // What `sws` was built and set up for; a frame that differs updates it.
   AVPixelFormat swsFormat = AV_PIX_FMT_NONE;
@@ -93,10 +105,11 @@ struct FileSource::Impl {
   // which decoding can go on.
   int decodeNext();
   bool restart();
-  bool convert(Frame& out);
+  bool convert(cv::Mat& out);
   bool setUpConverter(const AVFrame& frame);
   Timestamp timestampOf(const AVFrame& frame) const;
   ReadStatus fault(std::string message);
+  void pace(Timestamp timestamp);
 };
 
 void FileSource::Impl::open() {
@@ -138,11 +151,16 @@ void FileSource::Impl::open() {
   }
   size = {codec->width, codec->height};
   if (size.width <= 0 || size.height <= 0) fail("has no frame size");
+  const bool pictures = isPictureDemuxer(format->iformat->name);
+  // image2 counts a pattern's files: its duration is in frames (time base 1 / framerate).
+  onePicture = pictures && (!sequence || stream->duration == 1);
   AVRational rate = stream->avg_frame_rate;
   if (rate.num <= 0 || rate.den <= 0) rate = stream->r_frame_rate;
   const double fps =
-      sequence || rate.num <= 0 || rate.den <= 0 ? settings.sequenceFps : av_q2d(rate);
-  if (!(fps > 0 && std::isfinite(fps))) fail("has no frame rate, and sequenceFps is not positive");
+      pictures || rate.num <= 0 || rate.den <= 0 ? settings.sequenceFps : av_q2d(rate);
+  if (!(fps > 0 && std::isfinite(fps))) {
+    fail(fmt::format("needs a positive frame rate (sequence_fps), got {}", fps));
+  }
   period = std::chrono::nanoseconds(std::llround(1e9 / fps));
   lastTimestamp = -period;  // an untimed first frame is at 0
   packet.reset(av_packet_alloc());
@@ -157,6 +175,15 @@ void FileSource::Impl::open() {
   haveDecoded = true;
   firstTimestamp = timestampOf(*decoded);
   lastTimestamp = firstTimestamp - period;
+  if (onePicture) {
+    still.create(size, CV_8UC3);
+    if (!convert(still)) fail("has a pixel format that cannot be converted to BGR");
+    // The demuxer and decoder have nothing more to give.
+    packet.reset();
+    decoded.reset();
+    codec.reset();
+    format.reset();
+  }
 }
 
 int FileSource::Impl::decodeNext() {
@@ -241,7 +268,7 @@ bool FileSource::Impl::setUpConverter(const AVFrame& frame) {
   return true;
 }
 
-bool FileSource::Impl::convert(Frame& out) {
+bool FileSource::Impl::convert(cv::Mat& out) {
   if (decoded->width != size.width || decoded->height != size.height) {
     lastError =
         fmt::format("camera '{}': frame {} of '{}' is {}x{}, but the stream started at {}x{}",
@@ -258,8 +285,8 @@ bool FileSource::Impl::convert(Frame& out) {
     return false;
   }
   // Straight into the caller's buffer: no copy and no allocation per frame.
-  std::uint8_t* target[] = {out.image.data};
-  const int targetStride[] = {static_cast<int>(out.image.step[0])};
+  std::uint8_t* target[] = {out.data};
+  const int targetStride[] = {static_cast<int>(out.step[0])};
   sws_scale(sws.get(), decoded->data, decoded->linesize, 0, size.height, target, targetStride);
   return true;
 }
@@ -271,6 +298,24 @@ ReadStatus FileSource::Impl::fault(std::string message) {
   draining = true;
   avcodec_send_packet(codec.get(), nullptr);
   return ReadStatus::kFault;
+}
+
+void FileSource::Impl::pace(Timestamp timestamp) {
+  if (settings.pacing != Pacing::kRealtime) return;
+  // Frame k is due (its timestamp - the first's) after the first read, on the steady clock.
+  const auto now = std::chrono::steady_clock::now();
+  if (!pacingStart) pacingStart = now - (timestamp - firstTimestamp);
+  std::this_thread::sleep_until(*pacingStart + (timestamp - firstTimestamp));
+}
+
+bool isStillPicturePath(const std::filesystem::path& path) {
+  if (isImageSequence(path.string())) return false;
+  std::string extension = path.extension().string();
+  std::ranges::transform(extension, extension.begin(),
+                         [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  constexpr std::array<std::string_view, 9> kPictures{".png",  ".jpg",  ".jpeg", ".bmp", ".tif",
+                                                      ".tiff", ".webp", ".ppm",  ".pgm"};
+  return std::ranges::find(kPictures, extension) != kPictures.end();
 }
 
 FileSource::FileSource(std::string cameraName, FileSourceSettings settings)
@@ -288,8 +333,20 @@ Timestamp FileSource::nominalPeriod() const { return impl_->period; }
 
 const std::string& FileSource::lastError() const { return impl_->lastError; }
 
+bool FileSource::repeatsOnePicture() const { return impl_->onePicture && impl_->settings.loop; }
+
 ReadStatus FileSource::read(Frame& out) {
   auto& s = *impl_;
+  if (s.onePicture) {
+    if (s.framesRead > 0 && !s.settings.loop) return ReadStatus::kEndOfStream;
+    // A copy of the picture decoded at start (about 1 ms for 1080p): the frame is handed down the
+    // pipeline and back to the pool, while decoding the file again would cost a PNG decode each.
+    s.still.copyTo(out.image);
+    out.timestamp = s.firstTimestamp + static_cast<std::int64_t>(s.framesRead) * s.period;
+    out.sequence = s.framesRead++;
+    s.pace(out.timestamp);
+    return ReadStatus::kFrame;
+  }
   if (!s.haveDecoded) {
     int status = s.decodeNext();
     // A fresh pass that yields nothing (an unseekable or empty file) ends instead of looping.
@@ -304,18 +361,13 @@ ReadStatus FileSource::read(Frame& out) {
     // The caller's pool should match frameSize(); rather than write out of bounds, fix it once.
     out.image.create(s.size, CV_8UC3);
   }
-  if (!s.convert(out)) return s.fault(s.lastError);
+  if (!s.convert(out.image)) return s.fault(s.lastError);
   s.consecutiveFaults = 0;
   const Timestamp fileTimestamp = s.timestampOf(*s.decoded);
   s.lastTimestamp = std::max(s.lastTimestamp, fileTimestamp);
   out.timestamp = fileTimestamp + s.loopOffset;
   out.sequence = s.framesRead++;
-  if (s.settings.pacing == Pacing::kRealtime) {
-    // Frame k is due (its timestamp - the first's) after the first read, on the steady clock.
-    const auto now = std::chrono::steady_clock::now();
-    if (!s.pacingStart) s.pacingStart = now - (out.timestamp - s.firstTimestamp);
-    std::this_thread::sleep_until(*s.pacingStart + (out.timestamp - s.firstTimestamp));
-  }
+  s.pace(out.timestamp);
   return ReadStatus::kFrame;
 }
 

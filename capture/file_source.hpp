@@ -1,6 +1,11 @@
 #pragma once
-// A file-backed virtual camera: plays a video file (any container/codec FFmpeg decodes) or an image
-// sequence (printf pattern such as "front_%06d.png", FFmpeg's image2) as if it were a camera.
+// A file-backed virtual camera: plays a video file (any container/codec FFmpeg decodes), an image
+// sequence (printf pattern such as "front_%06d.png", FFmpeg's image2) or a still picture (one PNG,
+// JPEG, ...) as if it were a camera.
+//
+// Pictures (a sequence or a still) have no frame rate of their own: they are played at
+// `sequenceFps`. A still picture, or a sequence of one picture, is decoded once; looped, it is
+// delivered again every period with a timestamp one period on (repeatsOnePicture()).
 //
 // Frames carry the file's own presentation timestamps in nanoseconds (not rebased, so that the four
 // files of one recording stay aligned with each other); when looping, timestamps keep increasing
@@ -19,13 +24,18 @@ namespace surroundd::capture {
 enum class Pacing { kRealtime, kAsFastAsPossible };
 
 struct FileSourceSettings {
-  std::filesystem::path path;  // video file, or image-sequence pattern containing a printf %d
-  double sequenceFps = 30.0;   // frame rate of an image sequence; video files carry their own
+  std::filesystem::path path;  // video file, picture, or image-sequence pattern with a printf %d
+  double sequenceFps = 30.0;   // frame rate of pictures (a sequence, a still); videos carry theirs
   bool loop = false;           // restart at the end instead of reporting kEndOfStream
   Pacing pacing = Pacing::kRealtime;
 
   bool operator==(const FileSourceSettings&) const = default;
 };
+
+// Whether `path` names one picture file (by its extension: png, jpg, jpeg, bmp, tif, tiff, webp,
+// ppm, pgm) rather than a video or an image-sequence pattern. For a config's defaults; FileSource
+// itself goes by what FFmpeg finds in the file.
+bool isStillPicturePath(const std::filesystem::path& path);
 
 class FileSource final : public FrameSource {
  public:
@@ -39,6 +49,8 @@ class FileSource final : public FrameSource {
   Timestamp nominalPeriod() const override;
   ReadStatus read(Frame& out) override;
   const std::string& lastError() const override;
+  // A still picture or a one-picture sequence that loops.
+  bool repeatsOnePicture() const override;
 
  private:
   struct Impl;  // FFmpeg state stays out of the header

@@ -37,6 +37,9 @@ class FrameSource {
   // Blocks until the next frame is decoded or captured into `out` (whose image has frameSize()).
   virtual ReadStatus read(Frame& out) = 0;
   virtual const std::string& lastError() const = 0;
+  // True for a source that shows one picture over and over by design (a still picture, looped):
+  // its frames repeat without anything being wrong. Known once the source is constructed.
+  virtual bool repeatsOnePicture() const { return false; }
 };
 
 }  // namespace surroundd::capture

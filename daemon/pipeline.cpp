@@ -34,6 +34,7 @@ Pipeline::Pipeline(const Config& config)
       pool_(config.pipeline.threads),
       mosaic_(cv::Size(config.render.widthPx, config.render.heightPx), cameraNames(config)),
       canvas_(mosaic_.outputSize(), CV_8UC3, cv::Scalar::all(0)) {
+  setUpHealthChecks(config, cameras_, health_);
   const auto configured = [&](OutputStream stream) {
     return std::ranges::any_of(config.outputs, [&](const auto& o) { return o.stream == stream; });
   };

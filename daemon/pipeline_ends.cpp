@@ -65,6 +65,22 @@ std::vector<std::string> cameraNames(const Config& config) {
   return names;
 }
 
+void setUpHealthChecks(const Config& config,
+                       const std::vector<std::unique_ptr<capture::CameraStream>>& cameras,
+                       capture::CameraHealthMonitor& health) {
+  for (std::size_t c = 0; c < cameras.size(); ++c) {
+    const FrozenCheck check = config.cameras[c].frozenCheck;
+    const bool still = cameras[c]->repeatsOnePicture();
+    const bool on = check == FrozenCheck::kOn || (check == FrozenCheck::kAuto && !still);
+    health.setFrozenCheck(c, on);
+    if (!on) {
+      spdlog::info(
+          "camera '{}': not checked for frozen pictures ({})", cameras[c]->name(),
+          check == FrozenCheck::kOff ? "health.frozen_check: off" : "a still picture, looped");
+    }
+  }
+}
+
 std::unique_ptr<render::HttpStreamSink> openHttp(const OutputConfig& output, ViewKind view) {
   render::HttpStreamSettings settings;
   settings.address = output.listenAddress;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "capture/camera_health.hpp"
 #include "capture/camera_stream.hpp"
 #include "daemon/config.hpp"
 #include "render/frame_sink.hpp"
@@ -19,6 +20,10 @@ namespace surroundd::daemon {
 // One CameraStream per camera (not started yet), each checked against its lens's calibrated size.
 std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& config);
 std::vector<std::string> cameraNames(const Config& config);
+// Each camera's frozen check, from its `health.frozen_check` and its opened source.
+void setUpHealthChecks(const Config& config,
+                       const std::vector<std::unique_ptr<capture::CameraStream>>& cameras,
+                       capture::CameraHealthMonitor& health);
 
 // An HTTP output; for a surround stream its page offers every view, `view` first.
 std::unique_ptr<render::HttpStreamSink> openHttp(const OutputConfig& output, ViewKind view);

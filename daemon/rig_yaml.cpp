@@ -36,7 +36,8 @@ bool sequenceExists(const std::filesystem::path& pattern) {
 capture::FileSourceSettings readSource(YamlObject& source) {
   capture::FileSourceSettings settings;
   const auto path = source.outputPath("file");
-  settings.loop = source.boolean("loop", false);
+  // A still picture is a camera only if it repeats; a video or a sequence plays once by default.
+  settings.loop = source.boolean("loop", path && capture::isStillPicturePath(*path));
   settings.sequenceFps =
       source.number("sequence_fps", 30.0, {0.0, 1000.0, true, "frames per second"});
   source.finish();
@@ -53,7 +54,7 @@ capture::FileSourceSettings readSource(YamlObject& source) {
   } else if (!std::filesystem::is_regular_file(*path, ec)) {
     source.error(
         "file",
-        fmt::format("expected an existing video file, got '{}' ({})", path->string(),
+        fmt::format("expected an existing video file or picture, got '{}' ({})", path->string(),
                     std::filesystem::exists(*path, ec) ? "not a regular file" : "no such file"));
   }
   return settings;
@@ -262,6 +263,12 @@ std::vector<RigCamera> readRigCameras(YamlObject& rig) {
     calibration.role = entry.choice(
         "role", defaultRole(calibration.pose),
         {{"source", processing::ColourRole::kSource}, {"target", processing::ColourRole::kTarget}});
+    if (auto health = entry.object("health")) {
+      camera.frozenCheck = health->choice(
+          "frozen_check", FrozenCheck::kAuto,
+          {{"auto", FrozenCheck::kAuto}, {"on", FrozenCheck::kOn}, {"off", FrozenCheck::kOff}});
+      health->finish();
+    }
     if (auto source = entry.object("source")) {
       if (source->has("device")) {
         camera.device = readDevice(*source);
@@ -326,7 +333,12 @@ void emitCamera(YAML::Emitter& out, const RigCamera& camera, const std::filesyst
     const bool inside = path.parent_path() == folder;
     out << YAML::Key << "source" << YAML::Value << YAML::Flow << YAML::BeginMap;
     out << YAML::Key << "file" << YAML::Value << (inside ? path.filename() : path).string();
-    if (camera.source->loop) out << YAML::Key << "loop" << YAML::Value << true;
+    if (camera.source->loop || capture::isStillPicturePath(path)) {
+      out << YAML::Key << "loop" << YAML::Value << camera.source->loop;
+    }
+    if (camera.source->sequenceFps != capture::FileSourceSettings{}.sequenceFps) {
+      out << YAML::Key << "sequence_fps" << YAML::Value << camera.source->sequenceFps;
+    }
     out << YAML::EndMap;
   }
   if (camera.libcamera) {
@@ -386,6 +398,12 @@ void emitCamera(YAML::Emitter& out, const RigCamera& camera, const std::filesyst
   out << YAML::Key << "pitch_deg" << YAML::Value << angles.pitchDeg;
   out << YAML::Key << "roll_deg" << YAML::Value << angles.rollDeg;
   out << YAML::EndMap;
+  if (camera.frozenCheck != FrozenCheck::kAuto) {
+    out << YAML::Key << "health" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "frozen_check" << YAML::Value
+        << (camera.frozenCheck == FrozenCheck::kOn ? "on" : "off");
+    out << YAML::EndMap;
+  }
   out << YAML::EndMap;
 }
 

@@ -16,6 +16,7 @@
 //             # affine defaults to [1, 0, 0], image_to_world is optional; no fx_px, fy_px,
 //             # distortion
 //       mount: {x_m: .., y_m: .., z_m: .., yaw_deg: .., pitch_deg: .., roll_deg: ..}
+//       health: {frozen_check: auto}         # auto | on | off; auto: off for a looped still
 //       body_mask: {file: front-body.png, mode: add}  # optional, see vehicle_yaml.hpp
 //   vehicle: {length_m: .., width_m: .., height_m: ..}  # optional, see vehicle_yaml.hpp
 //
@@ -38,6 +39,10 @@
 
 namespace surroundd::daemon {
 
+// Whether a camera whose frames stop changing is reported frozen. auto: yes, unless its source
+// shows one picture by design (a still picture or a one-picture sequence, looped).
+enum class FrozenCheck { kAuto, kOn, kOff };
+
 struct RigCamera {
   processing::CameraCalibration calibration;
   // Where the frames come from: a file (replay), or a live V4L2 device. Both absent in rig presets
@@ -46,6 +51,7 @@ struct RigCamera {
   std::optional<capture::V4l2Settings> device;
   std::optional<capture::LibcameraSettings> libcamera;
   std::optional<BodyMaskConfig> bodyMask;  // added to or replacing the vehicle's computed mask
+  FrozenCheck frozenCheck = FrozenCheck::kAuto;
   bool live() const { return device.has_value() || libcamera.has_value(); }
 };
 

@@ -2,6 +2,7 @@
 // rig reader accepts out, within the accuracy asked of calibration; and for every kind of bad input
 // a non-zero exit and one message that names the file or option and what was wrong.
 
+#include <array>
 #include <fstream>
 #include <numbers>
 #include <sstream>
@@ -10,6 +11,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
+#include <yaml-cpp/yaml.h>
 
 #include "tests/calibration/calibration_test_support.hpp"
 #include "tests/support/child_process.hpp"
@@ -46,13 +48,51 @@ std::filesystem::path writeImages(const TempDir& dir, const std::string& folder,
   return path;
 }
 
-// A rig file of one camera, as the user's rig before calibration.
+constexpr std::string_view kRigHeader =
+    "# The test car's rig, measured by hand on 2024-05-02.\n#   (kept by --update-rig)\n\n";
+
+// A rig file as a user keeps one before calibration: a header comment, the camera with a still
+// picture as its source at a rate of its own, its colour role and health settings, and a second
+// camera. --update-rig must keep all of it but the block it replaces.
 std::filesystem::path writeRig(const TempDir& dir, const processing::CameraCalibration& camera) {
-  daemon::RigCamera entry;
-  entry.calibration = camera;
+  std::array<daemon::RigCamera, 2> entries;
+  entries[0].calibration = camera;
+  entries[1].calibration = camera;
+  entries[1].calibration.name = "spare";
+  entries[1].calibration.pose.position[0] += 1.25;
   auto file = dir / "rig.yaml";
-  daemon::writeRigFile(file, std::span(&entry, 1), "");
+  daemon::writeRigFile(file, entries, "");
+  cv::imwrite((dir / "still.png").string(),
+              cv::Mat(camera.intrinsics.imageSize, CV_8UC3, cv::Scalar::all(128)));
+  YAML::Node rig = YAML::LoadFile(file.string());
+  rig["cameras"][0]["source"] = YAML::Load("{file: still.png, sequence_fps: 12.5}");
+  rig["cameras"][0]["role"] = "target";
+  rig["cameras"][0]["health"] = YAML::Load("{frozen_check: off}");
+  YAML::Emitter out;
+  out << rig;
+  std::ofstream(file) << kRigHeader << out.c_str() << "\n";
   return file;
+}
+
+// What --update-rig must have kept of the rig writeRig wrote (`before`, as it read then).
+void expectRigKept(const std::filesystem::path& rig, const std::vector<daemon::RigCamera>& before) {
+  const std::string text = surroundd::testing::fileBytes(rig);
+  EXPECT_TRUE(text.starts_with(kRigHeader)) << text;
+  EXPECT_THAT(text, HasSubstr("# Written by surround-calibrate"));
+  EXPECT_FALSE(std::filesystem::exists(rig.string() + ".part"));
+  const auto after = daemon::loadRigFile(rig);
+  ASSERT_EQ(after.size(), 2u);
+  ASSERT_TRUE(after[0].source.has_value());
+  EXPECT_EQ(after[0].source->path.filename(), "still.png");
+  EXPECT_EQ(after[0].source->sequenceFps, 12.5);
+  EXPECT_TRUE(after[0].source->loop);
+  EXPECT_EQ(after[0].frozenCheck, daemon::FrozenCheck::kOff);
+  EXPECT_EQ(after[0].calibration.role, processing::ColourRole::kTarget);
+  // The other camera, value for value.
+  EXPECT_EQ(after[1].calibration.name, "spare");
+  EXPECT_EQ(after[1].calibration.intrinsics, before[1].calibration.intrinsics);
+  EXPECT_EQ(after[1].calibration.pose.position, before[1].calibration.pose.position);
+  EXPECT_EQ(after[1].calibration.pose.rotation, before[1].calibration.pose.rotation);
 }
 
 std::string markerYaml(const processing::MarkerLayout& layout) {
@@ -96,6 +136,7 @@ TEST(CalibrateCli, IntrinsicsWriteALensBlockTheRigAccepts) {
   const auto& truth = camera.intrinsics;
   const auto images = writeImages(dir, "views", boardViews(truth, kBoard, 12, 8));
   const auto rig = writeRig(dir, camera);
+  const auto before = daemon::loadRigFile(rig);
   const CalibrateRun run = calibrate(
       dir, {"intrinsics", "--images", images.string(), "--board", "9x6", "--model", "fisheye",
             "--out", (dir / "lens.yaml").string(), "--residuals", (dir / "residuals.png").string(),
@@ -114,10 +155,13 @@ TEST(CalibrateCli, IntrinsicsWriteALensBlockTheRigAccepts) {
   // short.
   EXPECT_NEAR(lens.maxFieldAngleRad * 360 / std::numbers::pi, 190, 8);
   EXPECT_FALSE(cv::imread((dir / "residuals.png").string()).empty());
-  // --update-rig: the rig's camera has the new lens and keeps its mount.
+  // --update-rig: the rig's camera has the new lens and keeps its mount, and the rig keeps every
+  // other key.
   const auto updated = daemon::loadRigFile(rig).front().calibration;
   EXPECT_NEAR(updated.intrinsics.fx, lens.fx, 1e-6);
+  EXPECT_NEAR(updated.intrinsics.maxFieldAngleRad, lens.maxFieldAngleRad, 1e-9);
   EXPECT_LT(poseError(updated.pose, camera.pose).positionCm, 1e-9);
+  expectRigKept(rig, before);
 }
 
 TEST(CalibrateCli, ExtrinsicsWriteAMountBlockTheRigAccepts) {
@@ -129,6 +173,7 @@ TEST(CalibrateCli, ExtrinsicsWriteAMountBlockTheRigAccepts) {
   const processing::Pose truth = camera.pose;
   camera.pose = nominal(truth);
   const auto rig = writeRig(dir, camera);
+  const auto before = daemon::loadRigFile(rig);
   const CalibrateRun run =
       calibrate(dir, {"extrinsics", "--rig", rig.string(), "--camera", "front", "--image",
                       (dir / "front.png").string(), "--markers", markers.string(), "--out",
@@ -144,7 +189,11 @@ TEST(CalibrateCli, ExtrinsicsWriteAMountBlockTheRigAccepts) {
   EXPECT_LT(error.positionCm, 1.0);
   EXPECT_LT(error.rotationDeg, 0.2);
   EXPECT_FALSE(cv::imread((dir / "residuals.png").string()).empty());
-  EXPECT_LT(poseError(daemon::loadRigFile(rig).front().calibration.pose, truth).positionCm, 1.0);
+  const auto updated = daemon::loadRigFile(rig).front().calibration;
+  EXPECT_LT(poseError(updated.pose, pose).positionCm, 1e-6);
+  EXPECT_LT(poseError(updated.pose, pose).rotationDeg, 1e-6);
+  EXPECT_EQ(updated.intrinsics, before[0].calibration.intrinsics);  // the lens as it was
+  expectRigKept(rig, before);
 }
 
 // Bad input: one line on stderr that names the file or option, and the exit status says whose
@@ -303,8 +352,9 @@ TEST(CalibrateCli, ExtrinsicsWithBadMarkerFilesNameTheLineAndKey) {
 TEST(CalibrateCli, ExtrinsicsWithTheWrongCameraOrImage) {
   const TempDir dir;
   const auto in = extrinsicsInputs(dir);
-  expectFailure(calibrate(dir, extrinsicsOn(dir, in, "rear")), 2,
-                "--camera: the rig '" + in.rig.string() + "' has no camera 'rear' (it has front)");
+  expectFailure(
+      calibrate(dir, extrinsicsOn(dir, in, "rear")), 2,
+      "--camera: the rig '" + in.rig.string() + "' has no camera 'rear' (it has front, spare)");
   cv::imwrite(in.image.string(), cv::Mat(100, 100, CV_8UC3, cv::Scalar(0)));
   expectFailure(calibrate(dir, extrinsicsOn(dir, in)), 2,
                 "--image: " + in.image.string() + " is 100x100, but camera 'front' in " +

@@ -53,6 +53,19 @@ TEST_F(CameraHealthMonitorTest, ARepeatedPictureIsFrozenOnItsThirdShowingAndReco
   EXPECT_EQ(observe(100, &next).at(0).to, CameraHealth::kOk);
 }
 
+// A still picture, looped: the same pixels for ever are what it is meant to show.
+TEST_F(CameraHealthMonitorTest, WithoutTheFrozenCheckARepeatedPictureStaysFine) {
+  monitor_.setFrozenCheck(0, false);
+  const cv::Mat still = moving(0);
+  for (int k = 0; k < 30; ++k) EXPECT_TRUE(observe(k * 33, &still).empty()) << k;
+  EXPECT_EQ(monitor_.health(0), CameraHealth::kOk);
+  // The other checks still hold.
+  const cv::Mat black(kSize, CV_8UC3, cv::Scalar::all(3));
+  EXPECT_EQ(observe(1000, &black).at(0).to, CameraHealth::kBlack);
+  EXPECT_EQ(observe(1033, nullptr).size(), 0u);
+  EXPECT_EQ(observe(1200, nullptr).at(0).to, CameraHealth::kLost);
+}
+
 TEST_F(CameraHealthMonitorTest, BlackAndBlindedPicturesAreSeenAtOnce) {
   const cv::Mat black(kSize, CV_8UC3, cv::Scalar::all(3));
   EXPECT_EQ(observe(0, &black).at(0).to, CameraHealth::kBlack);

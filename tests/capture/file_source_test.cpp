@@ -276,6 +276,54 @@ TEST(FileSource, ImageSequenceReplaysExactly) {
   EXPECT_EQ(source.read(frame), ReadStatus::kEndOfStream);
 }
 
+// A still picture as a camera: played at sequence_fps, looped with timestamps one period apart.
+TEST(FileSource, StillPictureLoopsAtTheSequenceRate) {
+  const testing::TempDir dir;
+  for (const char* name : {"still.png", "still.JPG"}) {
+    SCOPED_TRACE(name);
+    cv::imwrite((dir / name).string(), picture(4), {cv::IMWRITE_JPEG_QUALITY, 95});
+    const cv::Mat expected = cv::imread((dir / name).string());
+    EXPECT_TRUE(isStillPicturePath(dir / name));
+    FileSource source("front", {dir / name, 10.0, true, Pacing::kAsFastAsPossible});
+    EXPECT_EQ(source.frameSize(), kSize);
+    EXPECT_EQ(source.nominalPeriod(), milliseconds(100));
+    EXPECT_TRUE(source.repeatsOnePicture());
+    Frame frame;
+    frame.image.create(source.frameSize(), CV_8UC3);
+    for (int i = 0; i < 50; ++i) {
+      ASSERT_EQ(source.read(frame), ReadStatus::kFrame) << source.lastError();
+      EXPECT_EQ(frame.timestamp, milliseconds(100 * i));
+      EXPECT_EQ(frame.sequence, static_cast<std::uint64_t>(i));
+    }
+    cv::Mat difference;
+    cv::absdiff(frame.image, expected, difference);
+    EXPECT_LT(cv::mean(difference)[0], 1.5);  // JPEG: FFmpeg's decoding against OpenCV's
+  }
+  // Not looped, it is one frame.
+  FileSource once("front", fastSettings(dir / "still.png"));
+  EXPECT_FALSE(once.repeatsOnePicture());
+  EXPECT_EQ(readStatuses(once), (std::vector{ReadStatus::kFrame, ReadStatus::kEndOfStream}));
+  EXPECT_FALSE(isStillPicturePath(dir / "front_%04d.png"));
+  EXPECT_FALSE(isStillPicturePath(dir / "front.mkv"));
+}
+
+TEST(FileSource, OnlyASequenceOfOnePictureRepeatsIt) {
+  const testing::TempDir dir;
+  cv::imwrite((dir / "one_0.png").string(), noise(1));
+  for (int i = 0; i < 3; ++i) cv::imwrite((dir / cv::format("three_%d.png", i)).string(), noise(i));
+  FileSource one("front", fastSettings(dir / "one_%d.png", true));
+  EXPECT_TRUE(one.repeatsOnePicture());
+  Frame frame;
+  frame.image.create(one.frameSize(), CV_8UC3);
+  for (int i = 0; i < 5; ++i) {
+    ASSERT_EQ(one.read(frame), ReadStatus::kFrame);
+    EXPECT_EQ(cv::norm(frame.image, noise(1), cv::NORM_INF), 0.0);
+    EXPECT_EQ(frame.timestamp, std::chrono::nanoseconds(33'333'333 * i));
+  }
+  FileSource three("front", fastSettings(dir / "three_%d.png", true));
+  EXPECT_FALSE(three.repeatsOnePicture());
+}
+
 TEST(FileSource, FullRangeSourcesKeepTheirLevels) {
   const testing::TempDir dir;
   // Gray PNG: full-range gray, which must come out exactly.

@@ -305,6 +305,27 @@ TEST_F(ConfigTest, MissingFile) {
                   (dir_ / "lfet.mkv").string(), "no such file"});
 }
 
+// A still picture loops unless told not to, at sequence_fps; the frozen check is set per camera.
+TEST_F(ConfigTest, StillPicturesLoopAndTheFrozenCheckIsPerCamera) {
+  dir_.write("front.png", "");
+  const Config config = loadConfig(configWith(
+      "source: {file: front.mkv}\n",
+      "source: {file: front.png, sequence_fps: 10}\n      health: {frozen_check: on}\n"));
+  ASSERT_TRUE(config.cameras[0].source.has_value());
+  EXPECT_TRUE(config.cameras[0].source->loop);
+  EXPECT_EQ(config.cameras[0].source->sequenceFps, 10.0);
+  EXPECT_EQ(config.cameras[0].frozenCheck, FrozenCheck::kOn);
+  EXPECT_FALSE(config.cameras[1].source->loop);  // a video plays once by default
+  EXPECT_EQ(config.cameras[1].frozenCheck, FrozenCheck::kAuto);
+
+  const Config once =
+      loadConfig(configWith("source: {file: front.mkv}", "source: {file: front.png, loop: false}"));
+  EXPECT_FALSE(once.cameras[0].source->loop);
+  expectOneError("source: {file: front.mkv}\n",
+                 "source: {file: front.mkv}\n      health: {frozen_check: never}\n",
+                 {"rig.cameras[0].health.frozen_check: expected one of 'auto' 'on' 'off'"});
+}
+
 TEST_F(ConfigTest, CameraNamesAreIdentifiers) {
   expectOneError("name: front", "name: \"front cam\"",
                  {"name: expected letters, digits, '-' and '_', got 'front cam'"});
@@ -537,6 +558,7 @@ TEST(ReferenceConfig, DocumentsTheDefaults) {
   const Config config = loadConfig(dir / "config/surroundd.reference.yaml");
   EXPECT_EQ(config.logLevel, spdlog::level::info);
   EXPECT_EQ(config.cameras.size(), 4u);
+  EXPECT_EQ(config.cameras[0].frozenCheck, FrozenCheck::kAuto);
   EXPECT_EQ(config.capture, CaptureConfig{});
   EXPECT_EQ(config.pipeline, PipelineConfig{});
   EXPECT_EQ(config.panorama, PanoramaConfig{});

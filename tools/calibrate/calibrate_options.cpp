@@ -24,7 +24,7 @@ block in the rig schema (daemon/rig_yaml.hpp).
   --out FILE                 the lens: block (YAML)
   --residuals FILE           a PNG of every detected corner with its residual magnified
   --field-of-view-deg D      fisheye: the lens's full field; default: as far as the images are lit
-  --update-rig FILE          also write the lens into this rig file (rewritten; comments are lost)
+  --update-rig FILE          also write the lens into this rig file (see "--update-rig" below)
   --camera NAME              with --update-rig: the camera to update
 )";
 
@@ -41,11 +41,27 @@ and the change from the rig's current mount; writes the camera's mount: block.
   --camera NAME              the camera in the rig
   --image FILE               the camera's image of the markers
   --markers FILE             ground markers (YAML; see tools/calibrate/marker_file.hpp)
-  --points FILE              points with known pixels (YAML; see tools/calibrate/marker_file.hpp)
+  --points FILE              points with known pixels in this camera's image (YAML), at least
+                             6, spread over the image, not all on one line:
+                               points:
+                                 - {name: pole_base, x_m: 4.0, y_m: 0.5, z_m: 0,
+                                    u_px: 612.4, v_px: 388.1}
+                             x_m y_m z_m: the point in the vehicle frame (x forward, y left,
+                             z up; z_m defaults to 0, the ground); u_px v_px: its pixel (column,
+                             row; pixel centres at whole numbers); name: used in messages
   --out FILE                 the mount: block (YAML)
   --residuals FILE           a PNG of the image with each point's residual magnified
   --inlier-px X              points missing by more are outliers (default 3)
-  --update-rig               also write the mount into the rig file (rewritten; comments are lost)
+  --update-rig               also write the mount into the rig file (see "--update-rig" below)
+)";
+
+constexpr std::string_view kUpdateRigUsage =
+    R"(--update-rig edits the rig file's YAML: only the camera's lens: (intrinsics) or mount:
+(extrinsics) block is replaced. Every other key stays as it was (sources with their sequence_fps,
+health, roles, the other cameras), and so does the comment block at the head of the file. Comments
+inside the document are lost (the YAML library keeps none); a one-line note beside the new block
+says where it came from. The result must read back to the new calibration, or the rig is left as
+it was and the command fails.
 )";
 
 cv::Size parseBoard(std::string_view option, std::string_view text) {
@@ -182,11 +198,13 @@ Command parseArguments(std::span<const std::string_view> arguments) {
     return HelpRequest{usage()};
   }
   if (subcommand == "intrinsics") {
-    if (asksForHelp(rest)) return HelpRequest{std::string(kIntrinsicsUsage)};
+    if (asksForHelp(rest))
+      return HelpRequest{fmt::format("{}\n{}", kIntrinsicsUsage, kUpdateRigUsage)};
     return parseIntrinsics(rest);
   }
   if (subcommand == "extrinsics") {
-    if (asksForHelp(rest)) return HelpRequest{std::string(kExtrinsicsUsage)};
+    if (asksForHelp(rest))
+      return HelpRequest{fmt::format("{}\n{}", kExtrinsicsUsage, kUpdateRigUsage)};
     return parseExtrinsics(rest);
   }
   if (subcommand == "import") {
@@ -200,10 +218,10 @@ Command parseArguments(std::span<const std::string_view> arguments) {
 
 std::string usage() {
   return fmt::format(
-      "surround-calibrate: camera calibration for surroundd.\n\n{}\n{}\n{}\n"
+      "surround-calibrate: camera calibration for surroundd.\n\n{}\n{}\n{}\n{}\n"
       "exit status: 0 done, 1 calibration failed (too little in the images), 2 bad arguments or "
       "input files\n",
-      kIntrinsicsUsage, kExtrinsicsUsage, kImportUsage);
+      kIntrinsicsUsage, kExtrinsicsUsage, kUpdateRigUsage, kImportUsage);
 }
 
 }  // namespace surroundd::calibrate

@@ -1,8 +1,12 @@
 #include "tools/calibrate/calibration_output.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
+#include <functional>
+#include <iterator>
 #include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
@@ -13,7 +17,10 @@
 namespace surroundd::calibrate {
 namespace {
 
-void writeAtomically(const std::filesystem::path& file, const std::string& text) {
+// `check`, when given, looks at the written file before it takes the name; what it throws leaves
+// the old file as it was.
+void writeAtomically(const std::filesystem::path& file, const std::string& text,
+                     const std::function<void(const std::filesystem::path&)>& check = {}) {
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
   const auto partial = std::filesystem::path(file.string() + ".part");
   {
@@ -23,12 +30,21 @@ void writeAtomically(const std::filesystem::path& file, const std::string& text)
       throw std::runtime_error(fmt::format("{}: cannot write the file", partial.string()));
     }
   }
+  if (check) {
+    try {
+      check(partial);
+    } catch (...) {
+      std::filesystem::remove(partial);
+      throw;
+    }
+  }
   std::filesystem::rename(partial, file);
 }
 
+using Fields = std::function<void(YAML::Emitter&)>;
+
 // One block `key: {name: value, ...}` of the rig schema, with a comment on top.
-std::string block(std::string_view key, std::string_view comment,
-                  const std::function<void(YAML::Emitter&)>& fields) {
+std::string block(std::string_view key, std::string_view comment, const Fields& fields) {
   YAML::Emitter out;
   out.SetDoublePrecision(12);  // far below any calibration's uncertainty, still readable
   if (!comment.empty()) out << YAML::Comment(std::string(comment));
@@ -43,50 +59,176 @@ void emitFields(YAML::Emitter& out, std::initializer_list<std::pair<const char*,
   for (const auto& [name, value] : fields) out << YAML::Key << name << YAML::Value << value;
 }
 
-// Reads a rig, lets `change` edit the named camera, writes the rig back.
+// The rig reader's own writer, so that every lens model comes out as the rig schema reads it.
+Fields lensFields(const processing::Intrinsics& lens) {
+  return [&lens](YAML::Emitter& out) { daemon::emitLensFields(out, lens); };
+}
+
+Fields mountFields(const processing::Pose& pose) {
+  return [&pose](YAML::Emitter& out) {
+    const auto angles = processing::mountAnglesFromRotation(pose.rotation);
+    emitFields<double>(out, {{"x_m", pose.position[0]},
+                             {"y_m", pose.position[1]},
+                             {"z_m", pose.position[2]},
+                             {"yaw_deg", angles.yawDeg},
+                             {"pitch_deg", angles.pitchDeg},
+                             {"roll_deg", angles.rollDeg}});
+  };
+}
+
+// The file's leading comment block, verbatim: every line before the first that holds YAML.
+std::string headerOf(const std::string& text) {
+  std::size_t end = 0;
+  while (end < text.size()) {
+    const auto next = text.find('\n', end);
+    const auto line = std::string_view(text).substr(
+        end, next == std::string::npos ? std::string::npos : next - end);
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first != std::string_view::npos && line[first] != '#') break;
+    end = next == std::string::npos ? text.size() : next + 1;
+  }
+  std::string header = text.substr(0, end);
+  if (!header.empty() && header.back() != '\n') header += '\n';
+  return header;
+}
+
+// The rig document again, with `comment` beside `key` of the camera named `camera`. Only the
+// path down to that camera is walked; every other node is emitted as it was read (its keys, their
+// order and flow or block style).
+std::string emitRig(const YAML::Node& document, const std::string& camera, const std::string& key,
+                    const std::string& comment) {
+  const auto styled = [](YAML::Emitter& out, const YAML::Node& node) {
+    if (node.Style() == YAML::EmitterStyle::Flow) out << YAML::Flow;
+  };
+  YAML::Emitter out;
+  styled(out, document);
+  out << YAML::BeginMap;
+  for (const auto& top : document) {
+    out << YAML::Key << top.first << YAML::Value;
+    if (top.first.Scalar() != "cameras" || !top.second.IsSequence()) {
+      out << top.second;
+      continue;
+    }
+    styled(out, top.second);
+    out << YAML::BeginSeq;
+    for (const auto& entry : top.second) {
+      if (!entry.IsMap() || !entry["name"] || entry["name"].Scalar() != camera) {
+        out << entry;
+        continue;
+      }
+      styled(out, entry);
+      out << YAML::BeginMap;
+      for (const auto& field : entry) {
+        out << YAML::Key << field.first << YAML::Value;
+        if (field.first.Scalar() == key) out << YAML::Comment(comment);
+        out << field.second;
+      }
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+  }
+  out << YAML::EndMap;
+  if (!out.good())
+    throw std::runtime_error(fmt::format("cannot emit the rig: {}", out.GetLastError()));
+  return std::string(out.c_str()) + "\n";
+}
+
+bool near(double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(1.0, std::abs(b)); }
+
+// Equal within the digits written (12 significant; a pose also goes through its angles).
+bool sameCalibration(const processing::CameraCalibration& a,
+                     const processing::CameraCalibration& b) {
+  const auto& i = a.intrinsics;
+  const auto& j = b.intrinsics;
+  bool same =
+      a.name == b.name && a.role == b.role && i.model == j.model && i.imageSize == j.imageSize &&
+      near(i.fx, j.fx) && near(i.fy, j.fy) && near(i.cx, j.cx) && near(i.cy, j.cy) &&
+      // A pinhole's field is not written: it follows from the distortion.
+      (i.model != processing::LensModel::kFisheye || near(i.maxFieldAngleRad, j.maxFieldAngleRad));
+  const std::size_t coefficients = i.model == processing::LensModel::kFisheye ? 4 : 5;
+  for (std::size_t k = 0; k < coefficients; ++k) {
+    same = same && near(i.distortion[k], j.distortion[k]);
+  }
+  for (int k = 0; k < 3; ++k) same = same && near(a.pose.position[k], b.pose.position[k]);
+  for (int k = 0; k < 9; ++k) same = same && near(a.pose.rotation.val[k], b.pose.rotation.val[k]);
+  return same;
+}
+
+// Replaces the `key` block (lens or mount) of one camera in a rig file with `fields`, editing the
+// YAML document itself so that every other key stays, and the file's header comment with it.
+// `change` makes the calibration the rig must read back to; a result that does not is refused.
 template <typename Change>
-void updateRig(const std::filesystem::path& rig, const std::string& camera, Change change,
-               std::string_view comment) {
-  auto cameras = daemon::loadRigFile(rig);
-  const auto it = std::find_if(cameras.begin(), cameras.end(),
+void updateRig(const std::filesystem::path& rig, const std::string& camera, const std::string& key,
+               const Fields& fields, Change change, std::string_view comment) {
+  const auto before = daemon::loadRigFile(rig);  // a rig that does not load is not edited
+  auto expected = before;
+  const auto it = std::find_if(expected.begin(), expected.end(),
                                [&](const auto& c) { return c.calibration.name == camera; });
-  if (it == cameras.end()) rigCamera(rig, camera);  // throws the message naming the cameras
+  if (it == expected.end()) rigCamera(rig, camera);  // throws the message naming the cameras
   change(it->calibration);
-  daemon::writeRigFile(rig, cameras, comment);
+
+  std::ifstream in(rig);
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  YAML::Node document = YAML::Load(text);
+  YAML::Node replacement = YAML::Load(block(key, "", fields))[key];
+  for (auto entry : document["cameras"]) {
+    if (entry.IsMap() && entry["name"] && entry["name"].Scalar() == camera) {
+      entry[key] = replacement;
+    }
+  }
+  // One line beside the block: yaml-cpp keeps no comment of the document, so this one is all the
+  // record the rig has of where the values came from. The block is written in block style, so
+  // that its values do not drop to the line below the comment as a flow map's would.
+  std::string note(comment);
+  std::ranges::replace(note, '\n', ' ');
+  const std::string updated = headerOf(text) + emitRig(document, camera, key, note);
+
+  writeAtomically(rig, updated, [&](const std::filesystem::path& written) {
+    const auto refuse = [&](const std::string& why) {
+      throw std::runtime_error(
+          fmt::format("{}: the updated rig would not read back to the new calibration ({}); the "
+                      "rig is left as it was",
+                      rig.string(), why));
+    };
+    std::vector<daemon::RigCamera> after;
+    try {
+      after = daemon::loadRigFile(written);
+    } catch (const daemon::ConfigError& e) {
+      refuse(e.what());
+    }
+    if (after.size() != expected.size()) refuse("the number of cameras changed");
+    for (std::size_t c = 0; c < after.size(); ++c) {
+      if (!sameCalibration(after[c].calibration, expected[c].calibration)) {
+        refuse(fmt::format("camera '{}' differs", expected[c].calibration.name));
+      }
+    }
+  });
 }
 
 }  // namespace
 
 void writeLensBlock(const std::filesystem::path& file, const processing::Intrinsics& lens,
                     std::string_view comment) {
-  // The rig reader's own writer, so that every lens model comes out as the rig schema reads it.
-  writeAtomically(
-      file, block("lens", comment, [&](YAML::Emitter& out) { daemon::emitLensFields(out, lens); }));
+  writeAtomically(file, block("lens", comment, lensFields(lens)));
 }
 
 void writeMountBlock(const std::filesystem::path& file, const processing::Pose& pose,
                      std::string_view comment) {
-  const auto angles = processing::mountAnglesFromRotation(pose.rotation);
-  writeAtomically(file, block("mount", comment, [&](YAML::Emitter& out) {
-                    emitFields<double>(out, {{"x_m", pose.position[0]},
-                                             {"y_m", pose.position[1]},
-                                             {"z_m", pose.position[2]},
-                                             {"yaw_deg", angles.yawDeg},
-                                             {"pitch_deg", angles.pitchDeg},
-                                             {"roll_deg", angles.rollDeg}});
-                  }));
+  writeAtomically(file, block("mount", comment, mountFields(pose)));
 }
 
 void updateRigLens(const std::filesystem::path& rig, const std::string& camera,
                    const processing::Intrinsics& lens, std::string_view comment) {
   updateRig(
-      rig, camera, [&](processing::CameraCalibration& c) { c.intrinsics = lens; }, comment);
+      rig, camera, "lens", lensFields(lens),
+      [&](processing::CameraCalibration& c) { c.intrinsics = lens; }, comment);
 }
 
 void updateRigMount(const std::filesystem::path& rig, const std::string& camera,
                     const processing::Pose& pose, std::string_view comment) {
   updateRig(
-      rig, camera, [&](processing::CameraCalibration& c) { c.pose = pose; }, comment);
+      rig, camera, "mount", mountFields(pose),
+      [&](processing::CameraCalibration& c) { c.pose = pose; }, comment);
 }
 
 processing::CameraCalibration rigCamera(const std::filesystem::path& rig,

@@ -17,8 +17,12 @@ void writeLensBlock(const std::filesystem::path& file, const processing::Intrins
 void writeMountBlock(const std::filesystem::path& file, const processing::Pose& pose,
                      std::string_view comment);
 
-// Replaces one camera's lens or pose in a rig file (read and rewritten with daemon's rig reader
-// and writer, so it stays valid). Throws UsageError when the rig has no camera of that name.
+// Replaces one camera's lens: or mount: block in a rig file, editing the YAML document: every
+// other key (sources with their sequence_fps, health, other cameras, ...) stays, and so does the
+// file's leading comment block, verbatim; comments inside the document are lost (yaml-cpp keeps
+// none), and `comment` goes on one line beside the new block. The result must read back through
+// daemon::loadRigFile to the new calibration, or nothing is written (std::runtime_error). Throws
+// UsageError when the rig has no camera of that name.
 void updateRigLens(const std::filesystem::path& rig, const std::string& camera,
                    const processing::Intrinsics& lens, std::string_view comment);
 void updateRigMount(const std::filesystem::path& rig, const std::string& camera,

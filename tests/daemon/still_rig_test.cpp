@@ -1,0 +1,123 @@
+// A rig of still pictures (one PNG per camera, as a user brings from a parked car): each picture
+// is a camera that shows it again every period, and the pipeline runs it live, every camera ok.
+// Only a camera whose frozen check is asked for ('health: {frozen_check: on}') is reported frozen.
+
+#include <fstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include "capture/file_source.hpp"
+#include "daemon/pipeline.hpp"
+#include "daemon/rig_yaml.hpp"
+#include "tests/support/temp_dir.hpp"
+
+namespace surroundd::daemon {
+namespace {
+
+const std::filesystem::path kRecording =
+    std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
+constexpr std::uint64_t kSets = 60;  // two seconds at the pictures' 30 fps
+
+// Stops the run after kSets frame sets, noting each camera's health then.
+class StopAfter final : public PipelineObserver {
+ public:
+  explicit StopAfter(std::atomic<bool>& stop) : stop_(stop) {}
+  void onLoop(Pipeline& pipeline, std::chrono::steady_clock::time_point /*now*/,
+              std::uint64_t frameSets) override {
+    if (frameSets < kSets || stop_) return;
+    for (const auto& camera : pipeline.report().cameras) health.push_back(camera.health);
+    stop_ = true;
+  }
+  void onStopping() override {}
+  std::vector<capture::CameraHealth> health;
+
+ private:
+  std::atomic<bool>& stop_;
+};
+
+class StillRigTest : public ::testing::Test {
+ protected:
+  // A rig file beside one PNG per camera (its recording's 10th frame), each camera's source the
+  // bare picture: `{file: front.png}`, plus `extra` for the first camera.
+  std::filesystem::path writeStillRig(const std::string& extra = "") {
+    YAML::Node rig = YAML::LoadFile((kRecording / "rig.yaml").string());
+    for (std::size_t c = 0; c < rig["cameras"].size(); ++c) {
+      YAML::Node camera = rig["cameras"][c];
+      const auto video = kRecording / camera["source"]["file"].as<std::string>();
+      capture::FileSource source("check", {video, 30.0, false, capture::Pacing::kAsFastAsPossible});
+      capture::Frame frame;
+      frame.image.create(source.frameSize(), CV_8UC3);
+      for (int k = 0; k < 10; ++k) EXPECT_EQ(source.read(frame), capture::ReadStatus::kFrame);
+      const std::string picture = camera["name"].as<std::string>() + ".png";
+      cv::imwrite((dir_ / picture).string(), frame.image);
+      YAML::Node still;
+      still["file"] = picture;
+      camera["source"] = still;
+      if (c == 0 && !extra.empty()) camera["health"] = YAML::Load(extra);
+    }
+    YAML::Emitter out;
+    out << rig;
+    std::ofstream(dir_ / "rig.yaml") << out.c_str() << '\n';
+    return dir_ / "rig.yaml";
+  }
+
+  RunSummary run(const std::filesystem::path& rig, std::vector<capture::CameraHealth>& health) {
+    Config config;
+    config.file = rig;
+    config.cameras = loadRigFile(rig);
+    config.capture.pacing = capture::Pacing::kAsFastAsPossible;
+    config.pipeline.threads = 1;
+    config.panorama.widthPx = 512;
+    config.panorama.heightPx = 256;
+    config.panorama.cacheDir = dir_ / "lut-cache";
+    config.render.widthPx = 320;
+    config.render.heightPx = 180;
+    OutputConfig panorama;
+    panorama.kind = OutputKind::kSnapshot;
+    panorama.stream = OutputStream::kPanorama;
+    panorama.path = dir_ / "panorama.png";
+    panorama.atSeconds = 1.0;
+    config.outputs = {panorama};
+    Pipeline pipeline(config);
+    std::atomic<bool> stop{false};
+    StopAfter observer(stop);
+    RunSummary summary = pipeline.run(stop, &observer);
+    health = observer.health;
+    return summary;
+  }
+
+  const testing::TempDir dir_;
+};
+
+TEST_F(StillRigTest, StillPicturesRunLiveWithEveryCameraOk) {
+  const auto rig = writeStillRig();
+  for (const auto& camera : loadRigFile(rig)) {
+    ASSERT_TRUE(camera.source.has_value());
+    EXPECT_TRUE(camera.source->loop) << camera.calibration.name;  // a bare picture loops
+  }
+  std::vector<capture::CameraHealth> health;
+  const RunSummary summary = run(rig, health);
+  EXPECT_GE(summary.frameSets, kSets);
+  EXPECT_THAT(summary.healthChanges, ::testing::IsEmpty());
+  ASSERT_EQ(health.size(), 4u);
+  for (const auto h : health) EXPECT_EQ(h, capture::CameraHealth::kOk) << capture::toString(h);
+  for (std::size_t c = 0; c < 4; ++c) EXPECT_EQ(summary.sync.unmatchedDropped[c], 0u) << c;
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "panorama.png"));
+}
+
+TEST_F(StillRigTest, AnAskedForFrozenCheckStillFindsTheStillFrozen) {
+  std::vector<capture::CameraHealth> health;
+  const RunSummary summary = run(writeStillRig("{frozen_check: on}"), health);
+  ASSERT_EQ(health.size(), 4u);
+  EXPECT_EQ(health[0], capture::CameraHealth::kFrozen);
+  for (std::size_t c = 1; c < 4; ++c) EXPECT_EQ(health[c], capture::CameraHealth::kOk) << c;
+  ASSERT_FALSE(summary.healthChanges.empty());
+  EXPECT_EQ(summary.healthChanges[0].camera, 0u);
+  EXPECT_EQ(summary.healthChanges[0].to, capture::CameraHealth::kFrozen);
+}
+
+}  // namespace
+}  // namespace surroundd::daemon
