@@ -14,6 +14,7 @@
 
 #include "capture/file_source.hpp"
 #include "daemon/rig_yaml.hpp"
+#include "daemon/vehicle_yaml.hpp"
 #include "processing/panorama_lut.hpp"
 #include "processing/poisson_correction.hpp"
 #include "processing/surround_mesh.hpp"
@@ -72,6 +73,8 @@ struct ColourCorrectionConfig {
 
 using processing::MeshModel;
 
+// The bowl's floor and rim, the top view's range and the orbit's distance default to sizes that
+// follow the vehicle (vehicleSizes()); these are the figures for the default car.
 struct MeshConfig {
   MeshModel model = MeshModel::kBowl;
   double flatRadiusM = 9.0;       // flat disk
@@ -94,7 +97,7 @@ struct RenderConfig {
   render::EglPlatform platform = render::EglPlatform::kAuto;
   render::ViewSettings views;
   std::string splitCamera;  // the camera beside the 3D view in the split view; empty: the first
-  render::CarDimensions car;
+  render::CarDimensions car;  // from the vehicle
 
   bool operator==(const RenderConfig&) const = default;
 };
@@ -145,6 +148,9 @@ struct Config {
   std::filesystem::path file;
   spdlog::level::level_enum logLevel = spdlog::level::info;
   std::vector<RigCamera> cameras;
+  // The config's `vehicle:`, else the rig file's; none: the default car is drawn and no camera is
+  // masked.
+  std::optional<VehicleConfig> vehicle;
   CaptureConfig capture;
   PipelineConfig pipeline;
   PanoramaConfig panorama;
@@ -153,7 +159,18 @@ struct Config {
   RenderConfig render;
   ControlConfig control;
   std::vector<OutputConfig> outputs;
+  // What is worth saying about a valid config (surroundd logs them at start, --check-config prints
+  // them).
+  std::vector<std::string> warnings;
 };
+
+// Default sizes that follow the vehicle: a small robot in a room wants a closer look than a bus.
+struct VehicleSizes {
+  double topRangeM = 0, topHeightM = 0, orbitRadiusM = 0, orbitHeightM = 0;
+};
+VehicleSizes vehicleSizes(const VehicleConfig& vehicle);
+// How far from the vehicle frame's origin the top view shows the ground (its picture's corners).
+double topViewReachM(const RenderConfig& render);
 
 // Reads and validates the whole file; throws ConfigError with one line per problem. Every camera
 // must have a source.

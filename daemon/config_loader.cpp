@@ -26,7 +26,9 @@ void readRig(YamlObject& root, Config& config) {
   } else if (rig->has("file")) {
     if (const auto file = rig->existingFile("file")) {
       try {
-        config.cameras = loadRigFile(*file);
+        auto loaded = loadRig(*file);
+        config.cameras = std::move(loaded.cameras);
+        config.vehicle = loaded.vehicle;
       } catch (const ConfigError& e) {
         // The rig file's own messages already name it, its lines and keys.
         for (const auto& message : e.messages()) rig->diagnostics().add(message);
@@ -130,8 +132,12 @@ void readMesh(YamlObject& section, MeshConfig& m) {
   m.flatRadiusM = section.number("flat_radius_m", m.flatRadiusM, radius);
   m.sphereRadiusM = section.number("sphere_radius_m", m.sphereRadiusM, radius);
   m.bowlFloorRadiusM = section.number("bowl_floor_radius_m", m.bowlFloorRadiusM, radius);
-  m.bowlRadiusM = section.number("bowl_radius_m", m.bowlRadiusM, radius);
-  m.bowlHeightM = section.number("bowl_height_m", m.bowlHeightM, {0.1, 50.0, false, "metres"});
+  // The wall rises over as much again as the floor's radius (the rim far enough for a gentle
+  // slope), to a height in proportion.
+  m.bowlRadiusM = section.number("bowl_radius_m", 2 * m.bowlFloorRadiusM, radius);
+  m.bowlHeightM = section.number("bowl_height_m",
+                                 std::max(1.0, 0.3 * (m.bowlRadiusM - m.bowlFloorRadiusM)),
+                                 {0.1, 50.0, false, "metres"});
   if (m.bowlFloorRadiusM >= m.bowlRadiusM) {
     section.error("bowl_floor_radius_m",
                   fmt::format("expected less than bowl_radius_m ({:g}), got {:g}", m.bowlRadiusM,
@@ -172,10 +178,11 @@ void readRender(YamlObject& section, RenderConfig& r) {
   v.orbitFovDeg = section.number("orbit_fov_deg", v.orbitFovDeg, {10.0, 150.0, false, "degrees"});
   v.stripTopDeg = section.number("strip_top_deg", v.stripTopDeg, {-60.0, 60.0, false, "degrees"});
   r.splitCamera = section.string("split_camera", r.splitCamera);
-  const NumberRange size{0.5, 30.0, false, "metres"};
-  r.car.lengthM = section.number("car_length_m", r.car.lengthM, size);
-  r.car.widthM = section.number("car_width_m", r.car.widthM, size);
-  r.car.heightM = section.number("car_height_m", r.car.heightM, {0.3, 10.0, false, "metres"});
+  for (const auto* moved : {"car_length_m", "car_width_m", "car_height_m"}) {
+    if (section.has(moved)) {
+      section.error(moved, "the car's size is the vehicle's now: vehicle.length_m, width_m, height_m");
+    }
+  }
   section.finish();
 }
 
@@ -288,6 +295,19 @@ OutputConfig readOutput(YamlObject& item) {
 
 }  // namespace
 
+VehicleSizes vehicleSizes(const VehicleConfig& vehicle) {
+  // Three times the body's reach frames a car as the familiar 8 m top view (4.5 m car: 8.0 m), a
+  // 0.3 m robot as a 1.5 m room; the eyes keep their proportions to the range.
+  const double range = std::max(1.5, 3.3 * vehicle.reachM());
+  return {range, 1.75 * range, range, 0.5625 * range};
+}
+
+double topViewReachM(const RenderConfig& render) {
+  const double longer = std::max(render.widthPx, render.heightPx);
+  const double shorter = std::min(render.widthPx, render.heightPx);
+  return render.views.topRangeM * std::hypot(1.0, longer / shorter);
+}
+
 Config loadConfig(const std::filesystem::path& file) {
   Diagnostics diag;
   Config config;
@@ -322,7 +342,15 @@ Config loadConfig(const std::filesystem::path& file) {
       root.error("panorama", message);
     }
   }
-  readSection("mesh", [&](YamlObject& s) { readMesh(s, config.mesh); });
+  readSection("vehicle", [&](YamlObject& s) { config.vehicle = readVehicle(s); });
+  const VehicleConfig vehicle = config.vehicle.value_or(VehicleConfig{});
+  config.render.car = vehicle.car();
+  // The render's size and views first: the bowl's default floor follows the top view.
+  const VehicleSizes sizes = vehicleSizes(vehicle);
+  config.render.views.topRangeM = sizes.topRangeM;
+  config.render.views.topHeightM = sizes.topHeightM;
+  config.render.views.orbitRadiusM = sizes.orbitRadiusM;
+  config.render.views.orbitHeightM = sizes.orbitHeightM;
   readSection("render", [&](YamlObject& s) {
     readRender(s, config.render);
     const auto& split = config.render.splitCamera;
@@ -332,6 +360,15 @@ Config loadConfig(const std::filesystem::path& file) {
       s.error("split_camera", fmt::format("no camera is named '{}'", split));
     }
   });
+  const double topReach = topViewReachM(config.render);
+  config.mesh.bowlFloorRadiusM = topReach;
+  readSection("mesh", [&](YamlObject& s) { readMesh(s, config.mesh); });
+  if (config.mesh.model == MeshModel::kBowl && config.mesh.bowlFloorRadiusM + 1e-9 < topReach) {
+    config.warnings.push_back(fmt::format(
+        "mesh.bowl_floor_radius_m {:g} is less than the {:g} m the top view shows from the "
+        "vehicle's centre: straight lines on the ground bend where the bowl's wall begins",
+        config.mesh.bowlFloorRadiusM, topReach));
+  }
   readSection("control", [&](YamlObject& s) {
     config.control.socket = s.outputPath("socket").value_or("");
     s.finish();

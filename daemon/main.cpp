@@ -119,12 +119,16 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (arguments->checkOnly) {
+    for (const auto& warning : config.warnings) {
+      fmt::print(stderr, "surroundd: warning: {}\n", warning);
+    }
     fmt::print("surroundd: {}: good ({} cameras, {} outputs)\n", arguments->configFile,
                config.cameras.size(), config.outputs.size());
     return 0;
   }
   if (arguments->pacing) config.capture.pacing = *arguments->pacing;
   daemon::setUpLogging(arguments->logLevel.value_or(config.logLevel));
+  for (const auto& warning : config.warnings) spdlog::warn("{}", warning);
   installSignalHandlers();
 
   try {

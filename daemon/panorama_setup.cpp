@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <numbers>
 
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
 #include "processing/panorama_lut_cache.hpp"
@@ -22,9 +24,56 @@ const char* environment(const char* name) {
 
 }  // namespace
 
-processing::Rig rigOf(const Config& config) {
+cv::Mat bodyMaskOf(const Config& config, std::size_t index, WorkPool& pool) {
+  const RigCamera& camera = config.cameras[index];
+  const cv::Size size = camera.calibration.intrinsics.imageSize;
+  const bool replace =
+      camera.bodyMask && camera.bodyMask->mode == BodyMaskConfig::Mode::kReplace;
+  cv::Mat mask;
+  if (config.vehicle && config.vehicle->bodyMasks && !replace) {
+    mask = processing::computeBodyMask(config.vehicle->body(), camera.calibration, pool);
+  } else {
+    mask = cv::Mat(size, CV_8U, cv::Scalar(0));
+  }
+  if (camera.bodyMask) {
+    const auto& own = *camera.bodyMask;
+    if (!own.file.empty()) {
+      const cv::Mat picture = cv::imread(own.file.string(), cv::IMREAD_GRAYSCALE);
+      if (picture.empty() || picture.size() != size) {
+        throw std::runtime_error(fmt::format(
+            "{}: camera '{}': body_mask.file {}: expected a {}x{} picture (white = body), got {}",
+            config.file.string(), camera.calibration.name, own.file.string(), size.width,
+            size.height,
+            picture.empty() ? std::string("none that can be read")
+                            : fmt::format("{}x{}", picture.cols, picture.rows)));
+      }
+      mask |= picture > 127;
+    }
+    if (!own.polygon.empty()) {
+      std::vector<cv::Point> corners;
+      for (const auto& [u, v] : own.polygon) {
+        corners.emplace_back(static_cast<int>(std::lround(u)), static_cast<int>(std::lround(v)));
+      }
+      cv::fillPoly(mask, std::vector{corners}, cv::Scalar(255));
+    }
+  }
+  return cv::countNonZero(mask) == 0 ? cv::Mat() : mask;
+}
+
+processing::Rig rigOf(const Config& config, WorkPool& pool) {
   processing::Rig rig;
-  for (const auto& camera : config.cameras) rig.cameras.push_back(camera.calibration);
+  for (std::size_t c = 0; c < config.cameras.size(); ++c) {
+    rig.cameras.push_back(config.cameras[c].calibration);
+    auto& camera = rig.cameras.back();
+    camera.bodyMask = bodyMaskOf(config, c, pool);
+    if (!camera.bodyMask.empty()) {
+      spdlog::info("camera '{}': {:.1f} % of the picture sees the vehicle's body, left out of the "
+                   "panorama and colour correction",
+                   camera.name,
+                   100.0 * cv::countNonZero(camera.bodyMask) /
+                       static_cast<double>(camera.bodyMask.total()));
+    }
+  }
   return rig;
 }
 
@@ -60,8 +109,8 @@ std::filesystem::path lutCacheDir(const Config& config) {
   return std::filesystem::temp_directory_path() / "surroundd";
 }
 
-processing::PanoramaLut obtainPanoramaLut(const Config& config, WorkPool& pool) {
-  const processing::Rig rig = rigOf(config);
+processing::PanoramaLut obtainPanoramaLut(const Config& config, const processing::Rig& rig,
+                                          WorkPool& pool) {
   const processing::PanoramaSettings settings = panoramaSettings(config);
   const std::string key = processing::panoramaLutKey(rig, settings);
   const processing::PanoramaLutCache cache(lutCacheDir(config));

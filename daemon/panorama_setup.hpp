@@ -14,7 +14,13 @@ class WorkPool;
 
 namespace surroundd::daemon {
 
-processing::Rig rigOf(const Config& config);
+// The rig's calibration with each camera's body mask: computed from the vehicle (when the config
+// has one and body_masks is on) and the camera's own body_mask. Throws std::runtime_error naming a
+// mask picture that cannot be used.
+processing::Rig rigOf(const Config& config, WorkPool& pool);
+
+// The pixels of camera `index` that see the vehicle's body (CV_8U, 255 = body), or an empty Mat.
+cv::Mat bodyMaskOf(const Config& config, std::size_t index, WorkPool& pool);
 
 // The panorama is seen from (0, 0, mean camera height): the rig's virtual centre, where the
 // generator's ground truth is rendered from too.
@@ -28,6 +34,7 @@ std::filesystem::path lutCacheDir(const Config& config);
 
 // Throws std::runtime_error naming the config for a rig that cannot make a panorama. A cache that
 // cannot be written is logged and skipped.
-processing::PanoramaLut obtainPanoramaLut(const Config& config, WorkPool& pool);
+processing::PanoramaLut obtainPanoramaLut(const Config& config, const processing::Rig& rig,
+                                          WorkPool& pool);
 
 }  // namespace surroundd::daemon

@@ -38,7 +38,8 @@ Pipeline::Pipeline(const Config& config)
     return std::ranges::any_of(config.outputs, [&](const auto& o) { return o.stream == stream; });
   };
   if (configured(OutputStream::kPanorama) || configured(OutputStream::kSurround)) {
-    lut_ = std::make_unique<processing::PanoramaLut>(obtainPanoramaLut(config, pool_));
+    const processing::Rig rig = rigOf(config, pool_);
+    lut_ = std::make_unique<processing::PanoramaLut>(obtainPanoramaLut(config, rig, pool_));
     stitcher_ = std::make_unique<processing::Stitcher>(*lut_, pool_);
     ownership_ = std::make_unique<processing::PanoramaOwnership>(*lut_);
     panorama_.create(lut_->size, CV_8UC3);
@@ -47,7 +48,7 @@ Pipeline::Pipeline(const Config& config)
     }
     frames_.resize(cameras_.size());
     stitchInputs_.resize(cameras_.size());
-    setUpColourCorrection(config);
+    setUpColourCorrection(config, rig);
   }
   if (configured(OutputStream::kSurround)) setUpSurround(config);
   const double nominalFps = 1e9 / static_cast<double>(cameras_.front()->nominalPeriod().count());
@@ -77,8 +78,7 @@ Pipeline::Pipeline(const Config& config)
   }
 }
 
-void Pipeline::setUpColourCorrection(const Config& config) {
-  const processing::Rig rig = rigOf(config);
+void Pipeline::setUpColourCorrection(const Config& config, const processing::Rig& rig) {
   if (config.colour.method == ColourMethod::kGain) {
     gains_ = std::make_unique<processing::GainCompensation>(*lut_, pool_);
     spdlog::info("colour correction: global gain compensation");

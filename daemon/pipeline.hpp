@@ -128,7 +128,7 @@ class Pipeline {
   void recordStages();  // this set's stage times into the histograms
   const cv::Mat& imageOf(OutputStream stream) const;
   bool shows(OutputStream stream) const;  // a working output shows it
-  void setUpColourCorrection(const Config& config);
+  void setUpColourCorrection(const Config& config, const processing::Rig& rig);
   void setUpSurround(const Config& config);
 
   std::vector<std::unique_ptr<capture::CameraStream>> cameras_;

@@ -226,19 +226,26 @@ std::vector<RigCamera> readRigCameras(YamlObject& rig) {
         camera.source = readSource(*source);
       }
     }
+    if (auto mask = entry.object("body_mask")) camera.bodyMask = readBodyMask(*mask);
     entry.finish();
     cameras.push_back(std::move(camera));
   }
   return cameras;
 }
 
-std::vector<RigCamera> loadRigFile(const std::filesystem::path& file) {
+RigFile loadRig(const std::filesystem::path& file) {
   Diagnostics diag;
   YamlObject root(parseYamlFile(file), "", file, diag);
-  auto cameras = readRigCameras(root);
+  RigFile rig;
+  rig.cameras = readRigCameras(root);
+  if (auto vehicle = root.object("vehicle")) rig.vehicle = readVehicle(*vehicle);
   root.finish();
   diag.throwIfAny();
-  return cameras;
+  return rig;
+}
+
+std::vector<RigCamera> loadRigFile(const std::filesystem::path& file) {
+  return loadRig(file).cameras;
 }
 
 namespace {
@@ -303,6 +310,22 @@ void emitCamera(YAML::Emitter& out, const RigCamera& camera, const std::filesyst
         << in.maxFieldAngleRad * 2 * 180.0 / std::numbers::pi;
   }
   out << YAML::EndMap;
+  if (camera.bodyMask) {
+    const auto& mask = *camera.bodyMask;
+    out << YAML::Key << "body_mask" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "mode" << YAML::Value
+        << (mask.mode == BodyMaskConfig::Mode::kAdd ? "add" : "replace");
+    if (!mask.file.empty()) {
+      const bool inside = mask.file.parent_path() == folder;
+      out << YAML::Key << "file" << YAML::Value << (inside ? mask.file.filename() : mask.file).string();
+    }
+    if (!mask.polygon.empty()) {
+      out << YAML::Key << "polygon" << YAML::Value << YAML::BeginSeq;
+      for (const auto& [u, v] : mask.polygon) out << YAML::BeginSeq << u << v << YAML::EndSeq;
+      out << YAML::EndSeq;
+    }
+    out << YAML::EndMap;
+  }
   const auto angles = processing::mountAnglesFromRotation(c.pose.rotation);
   out << YAML::Key << "mount" << YAML::Value << YAML::Flow << YAML::BeginMap;
   out << YAML::Key << "x_m" << YAML::Value << c.pose.position[0];
@@ -318,13 +341,15 @@ void emitCamera(YAML::Emitter& out, const RigCamera& camera, const std::filesyst
 }  // namespace
 
 void writeRigFile(const std::filesystem::path& file, std::span<const RigCamera> cameras,
-                  std::string_view headerComment) {
+                  std::string_view headerComment, const VehicleConfig* vehicle) {
   YAML::Emitter out;
   out.SetDoublePrecision(17);  // shortest exact round trip of a double is at most 17 digits
   if (!headerComment.empty()) out << YAML::Comment(std::string(headerComment));
   out << YAML::BeginMap << YAML::Key << "cameras" << YAML::Value << YAML::BeginSeq;
   for (const auto& camera : cameras) emitCamera(out, camera, file.parent_path());
-  out << YAML::EndSeq << YAML::EndMap;
+  out << YAML::EndSeq;
+  if (vehicle != nullptr) emitVehicle(out, *vehicle);
+  out << YAML::EndMap;
   if (!out.good())
     throw ConfigError(
         {fmt::format("{}: cannot write the rig: {}", file.string(), out.GetLastError())});

@@ -10,6 +10,8 @@
 //       lens: {model: pinhole, width_px: 1280, height_px: 720, fx_px: .., fy_px: .., cx_px: ..,
 //              cy_px: .., distortion: [k1, k2, p1, p2, k3]}
 //       mount: {x_m: .., y_m: .., z_m: .., yaw_deg: .., pitch_deg: .., roll_deg: ..}
+//       body_mask: {file: front-body.png, mode: add}  # optional, see vehicle_yaml.hpp
+//   vehicle: {length_m: .., width_m: .., height_m: ..}  # optional, see vehicle_yaml.hpp
 //
 // The same schema is used inline in a config (`rig: {cameras: [...]}`) and in a rig file of its own
 // (`rig: {file: rig.yaml}`; the generator writes one next to its recordings).
@@ -23,6 +25,7 @@
 #include "capture/file_source.hpp"
 #include "capture/libcamera_source.hpp"
 #include "capture/v4l2_source.hpp"
+#include "daemon/vehicle_yaml.hpp"
 #include "daemon/yaml_reader.hpp"
 #include "processing/rig.hpp"
 
@@ -35,18 +38,26 @@ struct RigCamera {
   std::optional<capture::FileSourceSettings> source;
   std::optional<capture::V4l2Settings> device;
   std::optional<capture::LibcameraSettings> libcamera;
+  std::optional<BodyMaskConfig> bodyMask;  // added to or replacing the vehicle's computed mask
   bool live() const { return device.has_value() || libcamera.has_value(); }
+};
+
+struct RigFile {
+  std::vector<RigCamera> cameras;
+  std::optional<VehicleConfig> vehicle;
 };
 
 // Reads and validates the `cameras` list of `rig`; errors go to the object's Diagnostics.
 std::vector<RigCamera> readRigCameras(YamlObject& rig);
 
 // A whole rig file; throws ConfigError listing every problem.
+RigFile loadRig(const std::filesystem::path& file);
+// Its cameras only.
 std::vector<RigCamera> loadRigFile(const std::filesystem::path& file);
 
 // Writes a rig file that loadRigFile reads back to the same calibration (doubles round-trip
 // exactly). Source paths are written relative to the file's folder when they lie inside it.
 void writeRigFile(const std::filesystem::path& file, std::span<const RigCamera> cameras,
-                  std::string_view headerComment);
+                  std::string_view headerComment, const VehicleConfig* vehicle = nullptr);
 
 }  // namespace surroundd::daemon

@@ -112,6 +112,7 @@ ControlReply Service::reload() {
   spdlog::info("reload: reading {}", config_.file.string());
   try {
     Config fresh = loadConfig(config_.file);
+    for (const auto& warning : fresh.warnings) spdlog::warn("reload: {}", warning);
     if (fresh.control != config_.control) {
       spdlog::warn("reload: control.socket changes only when surroundd restarts");
     }

@@ -247,6 +247,35 @@ std::optional<std::vector<double>> YamlObject::numbers(std::string_view key,
   return result;
 }
 
+std::optional<std::vector<std::array<double, 2>>> YamlObject::points(std::string_view key,
+                                                                    std::size_t minCount) {
+  if (!has(key)) return std::nullopt;
+  const std::string expected =
+      fmt::format("a list of at least {} [x, y] pairs of numbers", minCount);
+  YAML::Node list = at(key);
+  if (!list.IsSequence() || list.size() < minCount) {
+    error(key,
+          fmt::format("expected {}, got {}", expected,
+                      list.IsSequence() ? fmt::format("{} items", list.size()) : describe(list)));
+    return std::nullopt;
+  }
+  std::vector<std::array<double, 2>> result;
+  for (const auto& item : list) {
+    std::array<double, 2> point{};
+    const bool pair = item.IsSequence() && item.size() == 2 && item[0].IsScalar() &&
+                      item[1].IsScalar() && YAML::convert<double>::decode(item[0], point[0]) &&
+                      YAML::convert<double>::decode(item[1], point[1]) &&
+                      std::isfinite(point[0]) && std::isfinite(point[1]);
+    if (!pair) {
+      diag_->error(file_, item.Mark(), childPath(key),
+                   fmt::format("expected {}, got {}", expected, describe(item)));
+      return std::nullopt;
+    }
+    result.push_back(point);
+  }
+  return result;
+}
+
 std::optional<std::string> YamlObject::choiceText(std::string_view key,
                                                   const std::vector<std::string_view>& names) {
   std::string expected = "one of";

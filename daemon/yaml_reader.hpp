@@ -6,6 +6,7 @@
 // error. ConfigLoader throws ConfigError with all of them at the end (the start-up boundary),
 // before any device or output is opened.
 
+#include <array>
 #include <filesystem>
 #include <initializer_list>
 #include <optional>
@@ -71,6 +72,9 @@ class YamlObject {
   // A list of numbers whose length is one of `sizes`.
   std::optional<std::vector<double>> numbers(std::string_view key,
                                              std::initializer_list<std::size_t> sizes);
+  // A list of [x, y] pairs, at least `minCount` of them (a polygon).
+  std::optional<std::vector<std::array<double, 2>>> points(std::string_view key,
+                                                           std::size_t minCount);
 
   template <class E>
   E choice(std::string_view key, E fallback,

@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
 
 #include "common/work_pool.hpp"
 
@@ -91,6 +92,13 @@ PanoramaProjector::PanoramaProjector(const Rig& rig, const PanoramaSettings& set
   for (const auto& camera : rig.cameras) {
     models_.emplace_back(camera.intrinsics);
     poses_.push_back(camera.pose);
+    cv::Mat grown;
+    if (!camera.bodyMask.empty()) {
+      cv::dilate(camera.bodyMask, grown,
+                 cv::getStructuringElement(cv::MORPH_RECT,
+                                           cv::Size(2 * kBodyMargin + 1, 2 * kBodyMargin + 1)));
+    }
+    bodyMasks_.push_back(grown);
     // The optical axis seen from above; a camera looking straight down is placed by its mount.
     const cv::Vec3d axis(camera.pose.rotation(0, 2), camera.pose.rotation(1, 2),
                          camera.pose.rotation(2, 2));
@@ -119,6 +127,11 @@ std::optional<cv::Point2d> PanoramaProjector::cameraPixel(std::size_t camera,
   const cv::Size size = models_[camera].intrinsics().imageSize;
   if (!pixel || pixel->x < 0 || pixel->y < 0 || pixel->x > size.width - 1 ||
       pixel->y > size.height - 1) {
+    return std::nullopt;
+  }
+  const cv::Mat& body = bodyMasks_[camera];
+  if (!body.empty() && body.at<std::uint8_t>(static_cast<int>(std::lround(pixel->y)),
+                                             static_cast<int>(std::lround(pixel->x))) != 0) {
     return std::nullopt;
   }
   return pixel;

@@ -96,7 +96,8 @@ class PanoramaProjector {
   PanoramaProjector(const Rig& rig, const PanoramaSettings& settings);
 
   // Where camera `camera` sees a panorama (sub-)pixel; nullopt when the point is outside its lens
-  // or its image (with room for the 2x2 bilinear neighbourhood).
+  // or its image (with room for the 2x2 bilinear neighbourhood), or hidden by the vehicle's body
+  // (the camera's body mask, grown by kBodyMargin pixels so that no bilinear tap reaches it).
   std::optional<cv::Point2d> cameraPixel(std::size_t camera,
                                          const cv::Point2d& panoramaPixel) const;
   // The vehicle-frame point a panorama pixel stands for: on the bowl, or (sphere) one metre from
@@ -109,8 +110,10 @@ class PanoramaProjector {
 
  private:
   PanoramaSettings settings_;
+  static constexpr int kBodyMargin = 2;
   std::vector<CameraModel> models_;
   std::vector<Pose> poses_;
+  std::vector<cv::Mat> bodyMasks_;  // grown; empty where a camera has none
   std::vector<double> axisAzimuth_;
 };
 

@@ -132,6 +132,11 @@ std::string panoramaLutKey(const Rig& rig, const PanoramaSettings& settings) {
     key += fmt::format("  pose {:a} {:a} {:a} {:a} {:a} {:a} {:a} {:a} {:a} at {:a} {:a} {:a}\n",
                        r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0), r(2, 1),
                        r(2, 2), t[0], t[1], t[2]);
+    if (!camera.bodyMask.empty()) {
+      const cv::Mat mask = camera.bodyMask.isContinuous() ? camera.bodyMask : camera.bodyMask.clone();
+      key += fmt::format("  body mask {}x{} crc {:08x}\n", mask.cols, mask.rows,
+                         crc(mask.data, mask.total() * mask.elemSize()));
+    }
   }
   const auto& g = settings.geometry;
   const auto& b = settings.bowl;

@@ -48,6 +48,9 @@ struct CameraCalibration {
   ColourRole role = ColourRole::kSource;
   Intrinsics intrinsics;
   Pose pose;
+  // The pixels that see the vehicle's own body (CV_8U of the image size, non-zero = body; see
+  // vehicle_body.hpp); empty: none. The panorama never samples them.
+  cv::Mat bodyMask;
 };
 
 struct Rig {

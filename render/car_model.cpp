@@ -95,33 +95,44 @@ std::vector<CarVertex> buildCarModel(const CarDimensions& car, double footprintR
   const auto l = static_cast<float>(car.lengthM / 2);
   const auto w = static_cast<float>(car.widthM / 2);
   const auto h = static_cast<float>(car.heightM);
+  const auto cx = static_cast<float>(car.centreXM);
+  const auto cy = static_cast<float>(car.centreYM);
+  const auto margin = static_cast<float>(car.marginM);
+  const auto ring = static_cast<float>(footprintRadiusM) + 0.05F;
 
   // Footprint, just above the ground so that it wins the depth test against the floor.
-  const float fx = std::max(l + 0.3F, static_cast<float>(footprintRadiusM) + 0.05F);
-  const float fy = std::max(w + 0.3F, static_cast<float>(footprintRadiusM) + 0.05F);
-  build.face({{-fx, -fy, 0.01F}, {fx, -fy, 0.01F}, {fx, fy, 0.01F}, {-fx, fy, 0.01F}}, kFootprint,
+  const float x0 = std::min(cx - l - margin, -ring);
+  const float x1 = std::max(cx + l + margin, ring);
+  const float y0 = std::min(cy - w - margin, -ring);
+  const float y1 = std::max(cy + w + margin, ring);
+  build.face({{x0, y0, 0.01F}, {x1, y0, 0.01F}, {x1, y1, 0.01F}, {x0, y1, 0.01F}}, kFootprint,
              {0, 0, -1});
 
-  const float wheelRadius = std::min(0.34F, h * 0.23F);
-  const float sill = wheelRadius * 0.9F;
-  const float belt = h * 0.58F;
-  build.box({-l, l, -w, w}, sill, belt, kBody);
+  const float wheelRadius = std::min({0.34F, h * 0.23F, l * 0.3F});
+  const float sill = std::max(static_cast<float>(car.groundClearanceM), wheelRadius * 0.9F);
+  const float belt = sill + (h - sill) * 0.45F;
+  build.box({cx - l, cx + l, cy - w, cy + w}, sill, belt, kBody);
   // Cabin: narrower and shorter at the roof, set back from the bonnet.
-  build.frustum({-l + 0.35F * l, l - 0.55F * l, -w + 0.06F, w - 0.06F}, belt,
-                {-l + 0.5F * l, l - 0.85F * l, -w + 0.2F, w - 0.2F}, h, kGlass);
+  build.frustum({cx - l + 0.35F * l, cx + l - 0.55F * l, cy - w + 0.06F * w, cy + w - 0.06F * w},
+                belt,
+                {cx - l + 0.5F * l, cx + l - 0.85F * l, cy - w + 0.2F * w, cy + w - 0.2F * w}, h,
+                kGlass);
+  const float frontAxle = cx + l - static_cast<float>(car.frontOverhangM);
+  const float rearAxle = cx - l + static_cast<float>(car.rearOverhangM);
+  const float tyre = std::min(0.24F, w * 0.25F);
   for (const float sx : {-1.0F, 1.0F}) {
     for (const float sy : {-1.0F, 1.0F}) {
-      build.wheel(sx * (l - 0.75F), sy * (w - 0.1F), wheelRadius, 0.24F);
+      build.wheel(sx > 0 ? frontAxle : rearAxle, cy + sy * (w - tyre / 2), wheelRadius, tyre);
     }
     // Lights across the front and back faces.
     const Colour& light = sx > 0 ? kHeadlight : kTaillight;
-    const float face = sx * (l + 0.01F);
+    const float face = cx + sx * (l + 0.01F);
     for (const float sy : {-1.0F, 1.0F}) {
-      build.face({{face, sy * (w - 0.1F), belt - 0.18F},
-                  {face, sy * (w - 0.45F), belt - 0.18F},
-                  {face, sy * (w - 0.45F), belt - 0.05F},
-                  {face, sy * (w - 0.1F), belt - 0.05F}},
-                 light, {0, 0, (belt + sill) / 2});
+      build.face({{face, cy + sy * w * 0.9F, belt - (belt - sill) * 0.35F},
+                  {face, cy + sy * w * 0.55F, belt - (belt - sill) * 0.35F},
+                  {face, cy + sy * w * 0.55F, belt - (belt - sill) * 0.1F},
+                  {face, cy + sy * w * 0.9F, belt - (belt - sill) * 0.1F}},
+                 light, {cx, cy, (belt + sill) / 2});
     }
   }
   return vertices;

@@ -82,7 +82,9 @@ TEST(EndToEnd, MosaicVideoMatchesTheSourceFrames) {
 // The recording of a config, and the panorama the daemon makes of each of its frame sets.
 struct Replay {
   explicit Replay(daemon::Config loaded)
-      : config(std::move(loaded)), lut(daemon::obtainPanoramaLut(config, pool)) {
+      : config(std::move(loaded)),
+        rig(daemon::rigOf(config, pool)),
+        lut(daemon::obtainPanoramaLut(config, rig, pool)) {
     for (const auto& camera : config.cameras) {
       auto decoded = testing::decodeAll(camera.source->path);
       sources.push_back(std::move(decoded.images));
@@ -102,7 +104,7 @@ struct Replay {
     cv::Mat stitched;
     stitcher.stitch(frames, stitched);
     processing::PoissonColourCorrection correction(
-        daemon::rigOf(config), daemon::panoramaSettings(config), lut, config.colour.poisson, pool);
+        rig, daemon::panoramaSettings(config), lut, config.colour.poisson, pool);
     correction.update(frames);
     correction.apply(stitched);
     return stitched;
@@ -110,6 +112,7 @@ struct Replay {
 
   daemon::Config config;
   mutable WorkPool pool{2};
+  processing::Rig rig;
   processing::PanoramaLut lut;
   std::vector<std::vector<cv::Mat>> sources;
   std::vector<std::vector<capture::Timestamp>> timestamps;

@@ -71,7 +71,7 @@ TEST(CameraHealth, FaultsAreDetectedWithin200MsAndMarkedWhileTheOthersGoOn) {
   ASSERT_EQ(shot.size(), cv::Size(512, 256));
   const processing::PanoramaLut lut = [&] {
     WorkPool pool(1);
-    return obtainPanoramaLut(config, pool);
+    return obtainPanoramaLut(config, rigOf(config, pool), pool);
   }();
   const auto markedShare = [&](std::uint8_t camera) {
     int owned = 0, marked = 0;

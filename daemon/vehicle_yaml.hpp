@@ -1,0 +1,66 @@
+#pragma once
+// The ego vehicle in YAML: one `vehicle:` block (in the config, or in a rig file) that feeds the car
+// model of the render, the body masks of the stitcher and the default sizes of the views.
+//
+//   vehicle:
+//     length_m: 4.5            # bumper to bumper
+//     width_m: 1.85            # without mirrors
+//     height_m: 1.5            # roof above the ground
+//     ground_clearance_m: 0.15 # underside above the ground
+//     front_overhang_m: 0.9    # front bumper to front axle (the model's wheels)
+//     rear_overhang_m: 1.0     # rear axle to rear bumper
+//     x_m: 0.0                 # the body's centre in the vehicle frame (a rig whose origin is
+//     y_m: 0.0                 #   not under the body's centre)
+//     footprint: [[x, y], ...] # a polygon (vehicle frame, metres) instead of length and width
+//     margin_m: 0.3            # the dark ground patch drawn around the model
+//     body_masks: true         # mask the body out of each camera (false: the model only)
+//
+// Per camera, `body_mask:` adds to or replaces the computed mask: `{file: mask.png}` (white =
+// body, the lens's size) and/or `{polygon: [[u, v], ...]}` in pixels, `mode: add | replace`.
+
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+#include "daemon/yaml_reader.hpp"
+#include "processing/vehicle_body.hpp"
+#include "render/car_model.hpp"
+
+namespace surroundd::daemon {
+
+struct VehicleConfig {
+  double lengthM = 4.5;
+  double widthM = 1.85;
+  double heightM = 1.5;
+  double groundClearanceM = 0.15;
+  double frontOverhangM = 0.9;
+  double rearOverhangM = 1.0;
+  double xM = 0.0, yM = 0.0;
+  std::vector<std::array<double, 2>> footprint;  // empty: the length x width box
+  double marginM = 0.3;
+  bool bodyMasks = true;
+
+  processing::VehicleBody body() const;
+  render::CarDimensions car() const;
+  // The furthest the body reaches from the vehicle frame's origin, metres.
+  double reachM() const;
+
+  bool operator==(const VehicleConfig&) const = default;
+};
+
+struct BodyMaskConfig {
+  enum class Mode { kAdd, kReplace } mode = Mode::kAdd;
+  std::filesystem::path file;                  // white = body; empty: none
+  std::vector<std::array<double, 2>> polygon;  // pixels; empty: none
+
+  bool operator==(const BodyMaskConfig&) const = default;
+};
+
+// Reads and validates a `vehicle:` mapping; errors go to its Diagnostics.
+VehicleConfig readVehicle(YamlObject& vehicle);
+BodyMaskConfig readBodyMask(YamlObject& mask);
+
+void emitVehicle(YAML::Emitter& out, const VehicleConfig& vehicle);
+
+}  // namespace surroundd::daemon
