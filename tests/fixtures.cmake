@@ -9,6 +9,8 @@ endfunction()
 
 set(paper ${PROJECT_SOURCE_DIR}/config/rigs/paper.yaml)
 set(fisheye ${PROJECT_SOURCE_DIR}/config/rigs/fisheye.yaml)
+set(paper_body ${PROJECT_SOURCE_DIR}/config/rigs/paper-body.yaml)
+set(fisheye_body ${PROJECT_SOURCE_DIR}/config/rigs/fisheye-body.yaml)
 set(small --size 320x180 --panorama-size 512x256)
 
 surroundd_fixture(synth_small --rig ${paper} ${small} --seconds 1 --seed 7)
@@ -24,3 +26,9 @@ surroundd_fixture(synth_fisheye --rig ${fisheye} ${small} --seconds 1 --seed 5)
 # From 0.5 s on, 'left' freezes, 'right' goes black and 'back' stops: for camera health.
 surroundd_fixture(synth_faults --rig ${paper} ${small} --seconds 1 --seed 13
                   --fault left:freeze@0.5 --fault right:black@0.5 --fault back:stop@0.5)
+# The ego vehicle's body in view (and, for comparison, the same rig without it): 640x360 so that
+# the masks' outlines are a small part of their area when masks are compared.
+set(body --size 640x360 --panorama-size 256x128 --seconds 0.2 --photometrics identity)
+surroundd_fixture(synth_body_paper --rig ${paper_body} ${body} --seed 3)
+surroundd_fixture(synth_body_paper_plain --rig ${paper_body} ${body} --seed 3 --no-body)
+surroundd_fixture(synth_body_fisheye --rig ${fisheye_body} ${body} --seed 3 --scene near-objects)

@@ -88,7 +88,9 @@ RecordingPlan planRecording(const SynthOptions& options) {
   plan.rigText = readFile(options.rig);
   std::vector<daemon::RigCamera> rig;
   try {
-    rig = daemon::loadRigFile(options.rig);
+    auto file = daemon::loadRig(options.rig);
+    rig = std::move(file.cameras);
+    if (options.body) plan.vehicle = file.vehicle;
   } catch (const daemon::ConfigError& error) {
     std::string message = fmt::format("--rig: '{}' is not a valid rig:", options.rig.string());
     for (const auto& line : error.messages()) message += "\n  " + line;

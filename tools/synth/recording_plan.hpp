@@ -35,6 +35,7 @@ struct RecordingPlan {
   SynthOptions options;
   std::string rigText;  // the preset as read (part of the key)
   std::vector<CameraPlan> cameras;
+  std::optional<daemon::VehicleConfig> vehicle;  // the preset's `vehicle:`: its body is rendered
   int frames = 0;
   std::vector<int> groundTruthFrames;  // sorted, unique
   cv::Vec3d virtualCentre;             // panorama centre, vehicle frame: (0, 0, mean camera height)

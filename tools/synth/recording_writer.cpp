@@ -93,14 +93,17 @@ RecordingResult writeRecording(const SynthOptions& options, std::ostream& log) {
 
   // Set-up: everything heavy, once.
   auto stage = Clock::now();
-  const Scene scene(options.seed, options.seconds);
+  const Scene scene(options.seed, options.seconds, options.scene);
   durations["scene"] = secondsSince(stage);
   stage = Clock::now();
+  std::optional<EgoBody> body;
+  if (plan.vehicle) body.emplace(*plan.vehicle);
   std::vector<std::unique_ptr<CameraRays>> rays;
   std::vector<std::unique_ptr<PhotometricCamera>> sensors, neutral;
   for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
     const auto& calibration = plan.cameras[c].camera.calibration;
-    rays.push_back(std::make_unique<CameraRays>(calibration));
+    rays.push_back(std::make_unique<CameraRays>(calibration, body ? &*body : nullptr));
+    if (body) writePng(folder.path() / bodyMaskName(calibration.name), rays.back()->bodyMask());
     sensors.push_back(std::make_unique<PhotometricCamera>(
         plan.cameras[c].photometrics, options.seed, static_cast<int>(c),
         rays.back()->offAxisAngle(), rays.back()->fisheye()));
@@ -196,7 +199,8 @@ RecordingResult writeRecording(const SynthOptions& options, std::ostream& log) {
   daemon::writeRigFile(folder.path() / "rig.yaml", rig,
                        fmt::format("Written by surround-synth from {} (seed {}): the exact "
                                    "calibration of the cameras that rendered these videos.",
-                                   options.rig.filename().string(), options.seed));
+                                   options.rig.filename().string(), options.seed),
+                       plan.vehicle ? &*plan.vehicle : nullptr);
   writeGroundTruthYaml(folder.path() / "ground_truth.yaml", plan, framesWritten);
   durations["total"] = secondsSince(start);
   writeManifest(folder.path() / "manifest.yaml", plan, durations);

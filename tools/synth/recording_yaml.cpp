@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include "tools/synth/ego_body.hpp"
 #include "tools/synth/vehicle_path.hpp"
 
 namespace surroundd::synth {
@@ -29,6 +30,9 @@ void writeText(const std::filesystem::path& file, const YAML::Emitter& out) {
 std::string panoramaName(int frame) { return fmt::format("ground_truth/panorama_{}.png", frame); }
 std::string cameraImageName(const std::string& camera, int frame) {
   return fmt::format("ground_truth/{}_{}.png", camera, frame);
+}
+std::string bodyMaskName(const std::string& camera) {
+  return fmt::format("ground_truth/body_mask_{}.png", camera);
 }
 
 void writeGroundTruthYaml(const std::filesystem::path& file, const RecordingPlan& plan,
@@ -62,6 +66,17 @@ void writeGroundTruthYaml(const std::filesystem::path& file, const RecordingPlan
   out << YAML::Key << "elevation_top_deg" << YAML::Value << 30;
   out << YAML::Key << "elevation_bottom_deg" << YAML::Value << -60;
   out << YAML::EndMap;
+  if (plan.vehicle) {
+    // Only with a body, so that recordings without one keep their bytes.
+    out << YAML::Key << "ego_body" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "shape" << YAML::Value << "rounded box";
+    out << YAML::Key << "corner_radius_m" << YAML::Value << EgoBody::kCornerRadiusM;
+    out << YAML::Key << "edge_radius_m" << YAML::Value << EgoBody::kEdgeRadiusM;
+    out << YAML::Key << "note" << YAML::Value
+        << "cameras[].body_mask: 255 where the pixel's ray meets the body (rendered with a "
+           "glossy roof); the panoramas leave the body out";
+    out << YAML::EndMap;
+  }
 
   out << YAML::Key << "cameras" << YAML::Value << YAML::BeginSeq;
   for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
@@ -71,6 +86,7 @@ void writeGroundTruthYaml(const std::filesystem::path& file, const RecordingPlan
     out << YAML::BeginMap;
     out << YAML::Key << "name" << YAML::Value << name;
     out << YAML::Key << "video" << YAML::Value << name + ".mkv";
+    if (plan.vehicle) out << YAML::Key << "body_mask" << YAML::Value << bodyMaskName(name);
     out << YAML::Key << "photometrics" << YAML::Value << YAML::BeginMap;
     out << YAML::Key << "gain" << YAML::Value << p.gain;
     out << YAML::Key << "white_balance_bgr" << YAML::Value << YAML::Flow << YAML::BeginSeq

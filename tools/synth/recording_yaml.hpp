@@ -23,5 +23,7 @@ std::optional<std::string> readManifestKey(const std::filesystem::path& file);
 // Ground-truth image names, relative to the recording folder.
 std::string panoramaName(int frame);
 std::string cameraImageName(const std::string& camera, int frame);
+// The true body mask of a camera (recordings of a rig with a `vehicle:` only).
+std::string bodyMaskName(const std::string& camera);
 
 }  // namespace surroundd::synth

@@ -17,6 +17,7 @@ namespace {
 const cv::Size kFacadeSize(2048, 1024);  // 20.48 m wide (repeats), 10.24 m tall
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 constexpr std::uint64_t kLayoutStream = 11;
+constexpr std::uint64_t kNearObjectsStream = 12;
 
 // Fixed sun, so faces of boxes and walls differ in brightness as real surfaces do.
 const cv::Vec3f kSun = cv::normalize(cv::Vec3f(0.45f, 0.3f, 0.84f));
@@ -105,15 +106,81 @@ std::vector<SceneBox> makeBoxes(HashRng& rng, double seconds) {
   return boxes;
 }
 
+SceneBox makeBox(cv::Point2d centre, double yaw, const cv::Vec3f& halfSize, const cv::Vec3f& colour,
+                 int pattern) {
+  SceneBox box;
+  box.centre = {static_cast<float>(centre.x), static_cast<float>(centre.y)};
+  box.yaw = static_cast<float>(yaw);
+  box.cosYaw = std::cos(box.yaw);
+  box.sinYaw = std::sin(box.yaw);
+  box.halfSize = halfSize;
+  box.boundingRadius = std::sqrt(halfSize[0] * halfSize[0] + halfSize[1] * halfSize[1] +
+                                 halfSize[2] * halfSize[2] * 0.25f);
+  box.colour = colour;
+  box.pattern = pattern;
+  return box;
+}
+
+// Crates at the seams and a wall along the left, placed around the start pose (where the world and
+// the vehicle frame coincide), measured from a typical car's footprint so that they stand 1-3 m
+// from the body of either preset rig.
+std::vector<SceneBox> makeNearObjects(HashRng& rng) {
+  const cv::Point2d carHalf(2.3, 0.95);
+  const auto gapTo = [&](cv::Point2d p) {
+    return std::hypot(std::max(std::abs(p.x) - carHalf.x, 0.0),
+                      std::max(std::abs(p.y) - carHalf.y, 0.0));
+  };
+  std::vector<SceneBox> objects;
+  const double wallGap = rng.uniform(2.3, 3.0);
+  const float wallHeight = static_cast<float>(rng.uniform(2.0, 2.6));
+  objects.push_back(makeBox({0, carHalf.y + wallGap + 0.1}, 0, {5.0f, 0.1f, wallHeight},
+                            cv::Vec3f(150, 155, 160), 1));
+  // The left crates stand between the car and the wall.
+  const std::array<std::pair<double, double>, 4> seams{
+      {{45, 1.4}, {135, 1.4}, {-45, 3.0}, {-135, 3.0}}};  // azimuth (degrees), widest gap (m)
+  for (const auto& [azimuthDeg, widestGap] : seams) {
+    const double azimuth = (azimuthDeg + rng.uniform(-2, 2)) * std::numbers::pi / 180;
+    const cv::Vec3f half(static_cast<float>(rng.uniform(0.25, 0.35)),
+                         static_cast<float>(rng.uniform(0.25, 0.35)),
+                         static_cast<float>(rng.uniform(0.8, 1.5)));
+    // Out along the seam until the crate's near side is `gap` from the car.
+    const double gap = rng.uniform(1.0, widestGap) + half[0];
+    double lo = 0, hi = 20;
+    for (int i = 0; i < 40; ++i) {
+      const double mid = (lo + hi) / 2;
+      (gapTo(mid * cv::Point2d(std::cos(azimuth), std::sin(azimuth))) < gap ? lo : hi) = mid;
+    }
+    objects.push_back(makeBox(
+        hi * cv::Point2d(std::cos(azimuth), std::sin(azimuth)), azimuth + rng.uniform(-0.3, 0.3),
+        half, hsvToBgr(rng.uniform(0, 180), rng.uniform(150, 230), rng.uniform(150, 220)),
+        rng.integer(0, 1)));
+  }
+  return objects;
+}
+
 }  // namespace
 
-Scene::Scene(std::uint64_t seed, double seconds)
+float Scene::sunShading(const cv::Vec3f& normal) { return shadeFor(normal); }
+
+Scene::Scene(std::uint64_t seed, double seconds, SceneLayout layout)
     : ground_(makeGroundTexture(seed, kGroundSize, kGroundTexelM)),
       facade_(makeFacadeTexture(seed, kFacadeSize, kFacadeTexelM)),
       clouds_(makeCloudTexture(seed, 256)) {
   HashRng rng(seed, kLayoutStream);
   walls_ = makeWalls(rng, seconds);
   boxes_ = makeBoxes(rng, seconds);
+  if (layout == SceneLayout::kNearObjects) {
+    HashRng near(seed, kNearObjectsStream);
+    const auto objects = makeNearObjects(near);
+    // The drive's boxes make way for them.
+    std::erase_if(boxes_, [&](const SceneBox& box) {
+      return std::any_of(objects.begin(), objects.end(), [&](const SceneBox& object) {
+        return cv::norm(box.centre - object.centre) <
+               box.boundingRadius + object.boundingRadius + 0.3;
+      });
+    });
+    boxes_.insert(boxes_.end(), objects.begin(), objects.end());
+  }
   static const std::array<cv::Vec3f, 4> kNormals{cv::Vec3f(-1, 0, 0), cv::Vec3f(1, 0, 0),
                                                  cv::Vec3f(0, -1, 0), cv::Vec3f(0, 1, 0)};
   for (std::size_t w = 0; w < 4; ++w) wallColour_[w] = walls_.tint[w] * shadeFor(kNormals[w]);

@@ -20,6 +20,11 @@ namespace surroundd::synth {
 
 enum class Surface : std::uint8_t { kGround, kBox, kWall, kSky };
 
+// kNearObjects adds, around the vehicle's start pose, crates and a wall 1-3 m from a car-sized body
+// in the seam directions (+-45 and +-135 degrees azimuth): parallax at the seams, for measuring
+// colour correction and masking where objects stand close. The vehicle drives on past them.
+enum class SceneLayout { kDefault, kNearObjects };
+
 struct Hit {
   Surface surface = Surface::kSky;
   float distance = 0;  // along the (unit) ray, metres; infinite for the sky
@@ -62,7 +67,7 @@ class Scene {
   static constexpr int kMaxBoxes = 32;
 
   // `seconds`: how long the recording runs, so the yard is placed around the whole drive.
-  Scene(std::uint64_t seed, double seconds);
+  Scene(std::uint64_t seed, double seconds, SceneLayout layout = SceneLayout::kDefault);
 
   // Radiance along a ray (BGR, 0..255).
   cv::Vec3f radiance(const RayQuery& query) const;
@@ -99,6 +104,9 @@ class Scene {
     constexpr float kHalf = kGroundSize / 2;
     return ground_.sample(x * (1 / kGroundTexelM) + kHalf, y * (1 / kGroundTexelM) + kHalf, lod);
   }
+
+  // Brightness factor of a surface facing `normal` (world frame, unit) under the fixed sun.
+  static float sunShading(const cv::Vec3f& normal);
 
   const std::vector<SceneBox>& boxes() const { return boxes_; }
   const SceneWalls& walls() const { return walls_; }

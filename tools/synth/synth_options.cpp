@@ -75,6 +75,9 @@ std::string SynthOptions::canonical() const {
     s << "default";
   }
   s << " panorama_size=" << panoramaSize.width << "x" << panoramaSize.height << " crf=" << crf;
+  // Only when not the default, as for faults: earlier recordings keep their keys.
+  if (scene != SceneLayout::kDefault) s << " scene=near-objects";
+  if (!body) s << " body=off";
   if (!faults.empty()) {  // only then: earlier recordings keep their keys
     s << " faults=";
     for (const auto& f : faults) {
@@ -140,9 +143,10 @@ SynthOptions parseSynthArguments(std::span<const std::string_view> arguments) {
       const auto v = value();
       const auto colon = v.find(':');
       const auto at = v.find('@');
-      const auto kind = colon != std::string_view::npos && at != std::string_view::npos && colon < at
-                            ? v.substr(colon + 1, at - colon - 1)
-                            : std::string_view();
+      const auto kind =
+          colon != std::string_view::npos && at != std::string_view::npos && colon < at
+              ? v.substr(colon + 1, at - colon - 1)
+              : std::string_view();
       if (colon == 0 || (kind != "freeze" && kind != "black" && kind != "stop")) {
         throw UsageError(fmt::format(
             "{}: expected CAMERA:freeze|black|stop@SECONDS (e.g. left:freeze@0.5), got '{}'",
@@ -154,6 +158,15 @@ SynthOptions parseSynthArguments(std::span<const std::string_view> arguments) {
                                             : SynthOptions::Fault::Kind::kStop,
                           parseNumber<double>(option, v.substr(at + 1), 0.0, 3600.0,
                                               "CAMERA:KIND@SECONDS with 0 <= SECONDS <= 3600")});
+    } else if (option == "--no-body") {
+      o.body = false;
+    } else if (option == "--scene") {
+      const auto v = value();
+      if (v != "default" && v != "near-objects") {
+        throw UsageError(
+            fmt::format("{}: expected 'default' or 'near-objects', got '{}'", option, v));
+      }
+      o.scene = v == "default" ? SceneLayout::kDefault : SceneLayout::kNearObjects;
     } else if (option == "--ground-truth-frames") {
       o.groundTruthFrames = parseFrames(option, value());
     } else if (option == "--panorama-size") {
@@ -190,7 +203,9 @@ std::string synthUsage() {
 
 usage: surround-synth --rig FILE --out DIR [options]
 
-  --rig FILE                 rig preset YAML (cameras, lenses, mounts; sources not needed)
+  --rig FILE                 rig preset YAML (cameras, lenses, mounts; sources not needed); its
+                             `vehicle:` block, if any, is rendered as the car's body (with true
+                             body masks in ground_truth/)
   --out DIR                  output folder: <camera>.mkv, rig.yaml, ground_truth.yaml,
                              ground_truth/*.png, manifest.yaml (written atomically)
   --size WxH                 image size of every camera (intrinsics scaled; default: preset's)
@@ -206,6 +221,10 @@ usage: surround-synth --rig FILE --out DIR [options]
   --fault NAME:KIND@S        from S seconds on, camera NAME freezes (repeats one picture), goes
                              black, or stops (its video ends); KIND freeze|black|stop (repeatable)
   --ground-truth-frames LIST frames with ground truth images (default: first, middle, last)
+  --no-body                  leave the rig's vehicle body out (what the cameras would see
+                             without it; the recording's rig then has no `vehicle:`)
+  --scene LAYOUT             default, or near-objects: crates at the four seam directions and a
+                             wall on the left, 1-3 m from the car at its start pose
   --panorama-size WxH        ground-truth panorama size (default 2048x1024)
   --crf N                    x264 CRF of the videos (default 14, visually lossless)
   --force                    replace DIR if it exists (a DIR made by the same arguments, rig and

@@ -14,6 +14,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "tools/synth/scene.hpp"
+
 namespace surroundd::synth {
 
 class UsageError : public std::runtime_error {
@@ -44,7 +46,10 @@ struct SynthOptions {
     double fromS = 0;
   };
   std::vector<Fault> faults;
-  std::optional<std::vector<int>> groundTruthFrames;   // default: first, middle, last
+  std::optional<std::vector<int>> groundTruthFrames;  // default: first, middle, last
+  SceneLayout scene = SceneLayout::kDefault;
+  bool body =
+      true;  // render the rig's `vehicle:` body (false: the same rig with nothing in the way)
   cv::Size panoramaSize{2048, 1024};
   int crf = 14;        // x264 CRF: visually lossless camera masters
   bool force = false;  // replace an existing output folder
