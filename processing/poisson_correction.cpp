@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -40,6 +41,10 @@ float medianOf(float* values, std::size_t count) {
 // that already agree the seams would otherwise drop in and out with the noise.
 constexpr double kWorseLevels = 0.5;
 constexpr double kWorseShare = 0.05;
+// The rule is also kept for each stretch of this many blocks along a seam, which needs at least
+// kMinimumSegmentBlocks of them measured.
+constexpr std::size_t kSegmentBlocks = 16;
+constexpr std::size_t kMinimumSegmentBlocks = 4;
 
 // A seam needs this share of its blocks measured to be matched at all; with fewer it keeps gain 1.
 constexpr double kMinimumMeasuredShare = 0.25;
@@ -148,7 +153,7 @@ PoissonColourCorrection::Configuration& PoissonColourCorrection::configurationFo
   configuration->saidDropped.assign(seams, 0);
   resolve_.resize(std::max(resolve_.size(), configuration->domain.regions.size()));
   for (const auto& seam : configuration->domain.seams) {
-    stepScratch_.resize(std::max(stepScratch_.size(), 2 * seam.blocks.size()));
+    stepScratch_.resize(std::max(stepScratch_.size(), 4 * seam.blocks.size()));
   }
   return *configuration;
 }
@@ -307,17 +312,39 @@ bool PoissonColourCorrection::dropWorseningSeams() {
   const bool multiplicative = settings_.field == CorrectionField::kMultiplicative;
   std::fill(resolve_.begin(), resolve_.end(), 0);
   bool dropped = false;
+  // Per block of a seam (NaN where not measured): its step without and with the field; then room
+  // to take medians in.
+  const std::size_t room = stepScratch_.size() / 4;
   float* uncorrected = stepScratch_.data();
-  float* corrected = uncorrected + stepScratch_.size() / 2;
+  float* corrected = uncorrected + room;
+  float* pickBefore = corrected + room;
+  float* pickAfter = pickBefore + room;
+  // The median steps of positions [first, last) of the seam; false with too few measured.
+  const auto steps = [&](std::size_t first, std::size_t last, double& before, double& after) {
+    std::size_t count = 0;
+    for (std::size_t j = first; j < last; ++j) {
+      if (std::isnan(uncorrected[j])) continue;
+      pickBefore[count] = uncorrected[j];
+      pickAfter[count++] = corrected[j];
+    }
+    if (count < kMinimumSegmentBlocks) return false;
+    before = medianOf(pickBefore, count);
+    after = medianOf(pickAfter, count);
+    return true;
+  };
+  const auto worse = [](double before, double after) {
+    return after > before * (1 + kWorseShare) + kWorseLevels;
+  };
   for (std::size_t i = 0; i < active.domain.seams.size(); ++i) {
     const CorrectionSeam& seam = active.domain.seams[i];
     const CorrectionRegion& region = active.domain.regions[seam.region];
     RegionState& state = active.regions[seam.region];
     SeamReport& report = seamReports_[i];
-    std::size_t measured = 0;
-    for (const auto k : seam.blocks) {
+    for (std::size_t j = 0; j < seam.blocks.size(); ++j) {
+      const auto k = seam.blocks[j];
       const auto first = region.unknownsBegin[k];
       const auto count = region.unknownsBegin[k + 1] - first;
+      uncorrected[j] = corrected[j] = std::numeric_limits<float>::quiet_NaN();
       if (state.measuredValid[k] == 0 || count == 0) continue;
       const SeamBlockLevels& levels = state.levels[k];
       float before = 0;
@@ -334,27 +361,39 @@ bool PoissonColourCorrection::dropWorseningSeams() {
         before += std::abs(levels.target[c] - levels.source[c]) / 3;
         after += std::abs(levels.target[c] - std::clamp(source, 0.0f, 255.0f)) / 3;
       }
-      uncorrected[measured] = before;
-      corrected[measured] = after;
-      ++measured;
+      uncorrected[j] = before;
+      corrected[j] = after;
     }
-    if (measured == 0 || report.validBlocks < kMinimumMeasuredShare * report.blocks) continue;
-    // The typical block, not the mean: an object on a few blocks must not decide for the seam.
-    report.stepUncorrected = medianOf(uncorrected, measured);
-    report.stepCorrected = medianOf(corrected, measured);
-    if (report.stepCorrected <= report.stepUncorrected * (1 + kWorseShare) + kWorseLevels) continue;
+    if (report.validBlocks < kMinimumMeasuredShare * report.blocks ||
+        !steps(0, seam.blocks.size(), report.stepUncorrected, report.stepCorrected)) {
+      continue;
+    }
+    // The whole seam's typical block, then each stretch of it: near ground and far ground differ
+    // (vignetting, light), and a field that helps one may hurt the other.
+    const bool whole = worse(report.stepUncorrected, report.stepCorrected);
+    for (std::size_t first = 0; first < seam.blocks.size(); first += kSegmentBlocks) {
+      const std::size_t last = std::min(first + kSegmentBlocks, seam.blocks.size());
+      double before = 0;
+      double after = 0;
+      if (!whole && (!steps(first, last, before, after) || !worse(before, after))) continue;
+      report.droppedBlocks += static_cast<int>(last - first);
+      for (std::size_t j = first; j < last; ++j) {
+        std::fill_n(state.dirichlet.begin() + static_cast<std::ptrdiff_t>(seam.blocks[j]) * 3, 3,
+                    0.0f);
+      }
+    }
+    if (report.droppedBlocks == 0) continue;
     noteOnce(active.saidDropped, i,
-             fmt::format("seam {}/{}: correcting it would make its step worse ({:.1f} against "
-                         "{:.1f} levels uncorrected): its data is dropped (gain 1 there)",
+             fmt::format("seam {}/{}: correcting {} of its {} blocks would make their step worse "
+                         "(the seam's: {:.1f} against {:.1f} levels uncorrected): their data is "
+                         "dropped (gain 1 there)",
                          rig_.cameras[region.source].name, rig_.cameras[seam.target].name,
-                         report.stepCorrected, report.stepUncorrected));
-    report.dropped = true;
-    report.stepCorrected = report.stepUncorrected;
+                         report.droppedBlocks, report.blocks, report.stepCorrected,
+                         report.stepUncorrected));
+    report.dropped = whole;
+    if (whole) report.stepCorrected = report.stepUncorrected;
     dropped = true;
     resolve_[seam.region] = 1;
-    for (const auto k : seam.blocks) {
-      std::fill_n(state.dirichlet.begin() + static_cast<std::ptrdiff_t>(k) * 3, 3, 0.0f);
-    }
   }
   return dropped;
 }

@@ -15,8 +15,9 @@
 // bounded to gains in [minGain, maxGain], and one rule stands above the rest: correction never
 // makes a seam worse than none. After each solve, every seam's step (its typical block's: the
 // target's levels against the source's as the field next to the seam leaves them) is compared
-// with its step uncorrected; a seam that got worse (by more than noise: 5 % and half a level) has
-// its data dropped (gain 1 there) and its region is solved again. Clamps, seams with too little
+// with its step uncorrected, and so is each stretch of 16 blocks along it (near and far ground
+// differ); a seam or stretch that got worse (by more than noise: 5 % and half a level) has its
+// data dropped (gain 1 there) and its region is solved again. Clamps, seams with too little
 // usable data and dropped seams are said once each in notesOfLastUpdate().
 //
 // Set up once (domain, systems, solver factorizations, buffers); update() and apply() are the
@@ -81,7 +82,8 @@ class PoissonColourCorrection {
   struct SeamReport {
     std::uint8_t source = 0, target = 0;
     int blocks = 0, validBlocks = 0, clampedBlocks = 0;
-    bool dropped = false;  // the correction would have made it worse: gain 1 there
+    int droppedBlocks = 0;  // in stretches the correction would have made worse: gain 1 there
+    bool dropped = false;   // the whole seam would have got worse: gain 1 all along it
     // Median over measured blocks of the mean over channels of |target - source| in levels:
     // without correction, and with the field as it leaves the source next to the seam.
     double stepUncorrected = 0, stepCorrected = 0;

@@ -132,7 +132,7 @@ TEST_F(RobustColourTest, ASeamThatCorrectionWouldMakeWorseKeepsGainOne) {
   const auto& notes = poisson.notesOfLastUpdate();
   EXPECT_EQ(std::ranges::count_if(notes,
                                   [](const std::string& note) {
-                                    return note.find("would make its step worse") !=
+                                    return note.find("would make their step worse") !=
                                            std::string::npos;
                                   }),
             2)

@@ -68,17 +68,17 @@ void reportRigColour(const std::filesystem::path& configFile, int threads,
       "{}: {} cameras, panorama {}x{}, {} with a body mask, Poisson {} field at scale {:g}\n",
       configFile.filename().string(), rig.cameras.size(), lut.size.width, lut.size.height, masked,
       processing::correctionFieldName(colour.field), colour.scale);
-  fmt::print("  {:<14} {:>16}   {:^23}   {:^23}\n", "seam", "misalignment",
+  fmt::print("  {:<14} {:>24}   {:^23}   {:^23}\n", "seam", "misalignment",
              "step near: none gain PLCC", "step far: none gain PLCC");
   for (const auto& seam : seamLines(rig, settings)) {
     const auto alignment = seamAlignment(rig, frames, settings, seam);
     const auto none = seamColourStep(raw, lut, settings, seam);
     const auto gain = seamColourStep(gained, lut, settings, seam);
     const auto plcc = seamColourStep(poisson, lut, settings, seam);
-    fmt::print("  {:<14} {:>16}   {}  {}  {}     {}  {}  {}\n", seam.name,
-               alignment
-                   ? fmt::format("{:.1f} cm ({:.2f})", alignment->shiftCm, alignment->response)
-                   : std::string("n/a"),
+    fmt::print("  {:<14} {:>24}   {}  {}  {}     {}  {}  {}\n", seam.name,
+               alignment ? fmt::format("{:.1f} cm at {:.1f} m ({:.2f})", alignment->shiftCm,
+                                       alignment->distanceM, alignment->response)
+                         : std::string("n/a"),
                levels(none.nearLevels), levels(gain.nearLevels), levels(plcc.nearLevels),
                levels(none.farLevels), levels(gain.farLevels), levels(plcc.farLevels));
   }
@@ -97,10 +97,12 @@ void reportRigColour(const std::filesystem::path& configFile, int threads,
   cv::minMaxLoc(correction.field().reshape(1), &lowest, &highest);
   fmt::print("  Poisson field: x{:.2f} .. x{:.2f} at 255\n", 1 + lowest / 255, 1 + highest / 255);
   for (const auto& seam : correction.seams()) {
-    fmt::print("    seam {}/{}: {} of {} blocks measured, {} clamped, step {:.1f} -> {:.1f}{}\n",
-               rig.cameras[seam.source].name, rig.cameras[seam.target].name, seam.validBlocks,
-               seam.blocks, seam.clampedBlocks, seam.stepUncorrected, seam.stepCorrected,
-               seam.dropped ? " (dropped: it would have got worse)" : "");
+    fmt::print(
+        "    seam {}/{}: {} of {} blocks measured, {} clamped, {} dropped, step {:.1f} -> "
+        "{:.1f}{}\n",
+        rig.cameras[seam.source].name, rig.cameras[seam.target].name, seam.validBlocks, seam.blocks,
+        seam.clampedBlocks, seam.droppedBlocks, seam.stepUncorrected, seam.stepCorrected,
+        seam.dropped ? " (all dropped: it would have got worse)" : "");
   }
   for (const auto& note : correction.notes()) fmt::print("    note: {}\n", note);
   for (const auto& note : correction.notesOfLastUpdate()) fmt::print("    note: {}\n", note);

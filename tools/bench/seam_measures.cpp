@@ -47,6 +47,53 @@ std::optional<cv::Vec3d> stripMedian(const cv::Mat& panorama, const processing::
   return median;
 }
 
+std::optional<SeamAlignment> alignmentAt(const processing::Rig& rig,
+                                         std::span<const cv::Mat> frames, const SeamLine& seam,
+                                         double distance) {
+  const cv::Point2d centre(distance * std::cos(seam.azimuthRad),
+                           distance * std::sin(seam.azimuthRad));
+  const int side = static_cast<int>(kPatchM / kPatchPixelM);
+  std::array<cv::Mat, 2> patches;
+  for (int k = 0; k < 2; ++k) {
+    const std::size_t camera = k == 0 ? seam.left : seam.right;
+    const auto& calibration = rig.cameras[camera];
+    const processing::CameraModel model(calibration.intrinsics);
+    cv::Mat mapX(side, side, CV_32F, cv::Scalar(-1));
+    cv::Mat mapY(side, side, CV_32F, cv::Scalar(-1));
+    int seen = 0;
+    for (int y = 0; y < side; ++y) {
+      for (int x = 0; x < side; ++x) {
+        // Patch rows run along -x of the vehicle, columns along -y: a top view, front up.
+        const cv::Vec3d ground(centre.x + (side / 2.0 - y) * kPatchPixelM,
+                               centre.y + (side / 2.0 - x) * kPatchPixelM, 0);
+        const auto pixel = model.project(calibration.pose.toCamera(ground));
+        if (!pixel || !model.inImage(*pixel)) continue;
+        const cv::Mat& body = calibration.bodyMask;
+        if (!body.empty() && body.at<std::uint8_t>(static_cast<int>(std::lround(pixel->y)),
+                                                   static_cast<int>(std::lround(pixel->x))) != 0) {
+          continue;
+        }
+        mapX.at<float>(y, x) = static_cast<float>(pixel->x);
+        mapY.at<float>(y, x) = static_cast<float>(pixel->y);
+        ++seen;
+      }
+    }
+    if (seen < kMinimumSeen * side * side) return std::nullopt;
+    cv::Mat grey;
+    cv::cvtColor(frames[camera], grey, cv::COLOR_BGR2GRAY);
+    cv::Mat patch;
+    cv::remap(grey, patch, mapX, mapY, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+    patch.convertTo(patches[static_cast<std::size_t>(k)], CV_32F);
+  }
+  cv::Mat window;
+  cv::createHanningWindow(window, patches[0].size(), CV_32F);
+  SeamAlignment alignment;
+  alignment.distanceM = distance;
+  const cv::Point2d shift = cv::phaseCorrelate(patches[0], patches[1], window, &alignment.response);
+  alignment.shiftCm = std::hypot(shift.x, shift.y) * kPatchPixelM * 100;
+  return alignment;
+}
+
 }  // namespace
 
 std::vector<SeamLine> seamLines(const processing::Rig& rig,
@@ -99,49 +146,13 @@ std::optional<SeamAlignment> seamAlignment(const processing::Rig& rig,
                                            std::span<const cv::Mat> frames,
                                            const processing::PanoramaSettings& settings,
                                            const SeamLine& seam) {
-  // The middle of the near band: elevation -25 deg from the panorama's centre.
-  const double distance = settings.geometry.centre[2] / std::tan(25 * kDegree);
-  const cv::Point2d centre(distance * std::cos(seam.azimuthRad),
-                           distance * std::sin(seam.azimuthRad));
-  const int side = static_cast<int>(kPatchM / kPatchPixelM);
-  std::array<cv::Mat, 2> patches;
-  for (int k = 0; k < 2; ++k) {
-    const std::size_t camera = k == 0 ? seam.left : seam.right;
-    const auto& calibration = rig.cameras[camera];
-    const processing::CameraModel model(calibration.intrinsics);
-    cv::Mat mapX(side, side, CV_32F, cv::Scalar(-1));
-    cv::Mat mapY(side, side, CV_32F, cv::Scalar(-1));
-    int seen = 0;
-    for (int y = 0; y < side; ++y) {
-      for (int x = 0; x < side; ++x) {
-        // Patch rows run along -x of the vehicle, columns along -y: a top view, front up.
-        const cv::Vec3d ground(centre.x + (side / 2.0 - y) * kPatchPixelM,
-                               centre.y + (side / 2.0 - x) * kPatchPixelM, 0);
-        const auto pixel = model.project(calibration.pose.toCamera(ground));
-        if (!pixel || !model.inImage(*pixel)) continue;
-        const cv::Mat& body = calibration.bodyMask;
-        if (!body.empty() && body.at<std::uint8_t>(static_cast<int>(std::lround(pixel->y)),
-                                                   static_cast<int>(std::lround(pixel->x))) != 0) {
-          continue;
-        }
-        mapX.at<float>(y, x) = static_cast<float>(pixel->x);
-        mapY.at<float>(y, x) = static_cast<float>(pixel->y);
-        ++seen;
-      }
-    }
-    if (seen < kMinimumSeen * side * side) return std::nullopt;
-    cv::Mat grey;
-    cv::cvtColor(frames[camera], grey, cv::COLOR_BGR2GRAY);
-    cv::Mat patch;
-    cv::remap(grey, patch, mapX, mapY, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
-    patch.convertTo(patches[static_cast<std::size_t>(k)], CV_32F);
+  // The nearest ground under the seam that both cameras see past the vehicle's body: at
+  // elevations -25, -18, -12, -8 and -5 degrees from the panorama's centre.
+  for (const double elevationDeg : {25.0, 18.0, 12.0, 8.0, 5.0}) {
+    const double distance = settings.geometry.centre[2] / std::tan(elevationDeg * kDegree);
+    if (auto alignment = alignmentAt(rig, frames, seam, distance)) return alignment;
   }
-  cv::Mat window;
-  cv::createHanningWindow(window, patches[0].size(), CV_32F);
-  SeamAlignment alignment;
-  const cv::Point2d shift = cv::phaseCorrelate(patches[0], patches[1], window, &alignment.response);
-  alignment.shiftCm = std::hypot(shift.x, shift.y) * kPatchPixelM * 100;
-  return alignment;
+  return std::nullopt;
 }
 
 double meanLevel(const cv::Mat& panorama, const processing::PanoramaLut& lut) {

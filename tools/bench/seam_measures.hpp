@@ -5,8 +5,9 @@
 //                 of the seam, compared (mean over channels of the absolute difference, levels),
 //                 on near ground (elevation -15..-35 deg) and far ground (-2..-12 deg);
 //   misalignment  phase correlation of the two cameras' own pictures of a 1.6 m ground patch
-//                 under the seam (1 cm a pixel), as their calibration projects it: the shift
-//                 between them in centimetres, with the correlation's peak response;
+//                 under the seam (1 cm a pixel; the nearest of 25, 18, 12, 8 and 5 degrees below
+//                 the panorama's centre that both see past the body), as their calibration projects
+//                 it: the shift between them in centimetres, with the correlation's peak response;
 //   brightness    the panorama's mean level.
 
 #include <optional>
@@ -39,11 +40,12 @@ SeamColourStep seamColourStep(const cv::Mat& panorama, const processing::Panoram
                               const processing::PanoramaSettings& settings, const SeamLine& seam);
 
 struct SeamAlignment {
+  double distanceM = 0;  // of the patch from the vehicle's centre
   double shiftCm = 0;
   double response = 0;  // phase correlation peak, 0..1: under ~0.05 the shift means little
 };
 
-// nullopt where either camera sees under 80 % of the patch (body, image edge).
+// nullopt where either camera sees under 80 % of every patch (body, image edge).
 std::optional<SeamAlignment> seamAlignment(const processing::Rig& rig,
                                            std::span<const cv::Mat> frames,
                                            const processing::PanoramaSettings& settings,
