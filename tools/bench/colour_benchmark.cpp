@@ -13,6 +13,7 @@
 #include "tools/bench/panorama_accuracy.hpp"
 #include "tools/bench/poisson_benchmark.hpp"
 #include "tools/bench/recording_truth.hpp"
+#include "tools/bench/rig_colour_report.hpp"
 #include "tools/bench/timing.hpp"
 
 namespace surroundd::bench {
@@ -70,6 +71,8 @@ void measure(const std::filesystem::path& folder, const ColourBenchmarkOptions& 
       correction = std::make_unique<processing::PoissonColourCorrection>(truth.rig, settings, lut,
                                                                          correctionSettings, pool);
     });
+    for (const auto& note : correction->notes()) fmt::print("    note: {}\n", note);
+    if (correction->domain().regions.empty()) continue;
     const auto& region = correction->domain().regions.front();
     fmt::print("  scale {:g}: {} regions, set-up {:.1f} ms (domain, solvers); solver '{}'\n", scale,
                correction->domain().regions.size(), setupMs, correction->solverNames());
@@ -102,7 +105,8 @@ void measure(const std::filesystem::path& folder, const ColourBenchmarkOptions& 
           seamError(corrected, frames));
     }
   }
-  fmt::print("\n");
+  // Per seam, as on any rig: misalignment, and the step next to each seam on near and far ground.
+  reportRigColour({folder.filename().string(), truth.rig, settings, {}, frames}, pool);
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 
 #include <fmt/format.h>
 
+#include "common/work_pool.hpp"
 #include "tools/bench/colour_benchmark.hpp"
 #include "tools/bench/pipeline_benchmark.hpp"
 #include "tools/bench/rig_colour_report.hpp"
@@ -151,7 +152,8 @@ int main(int argc, char** argv) {
       bench::ColourBenchmarkOptions colour{{}, options.threads, options.repeats};
       for (const auto& input : options.recordings) {
         if (std::filesystem::is_regular_file(input)) {
-          bench::reportRigColour(input, options.threads, pictures);
+          surroundd::WorkPool pool(options.threads);
+          bench::reportRigColour(bench::rigColourInput(input, pool), pool, pictures);
         } else {
           colour.recordings.push_back(input);
         }

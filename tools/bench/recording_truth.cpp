@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include "common/work_pool.hpp"
 #include "daemon/rig_yaml.hpp"
 
 namespace surroundd::bench {
@@ -25,9 +26,17 @@ T read(const YAML::Node& node, const char* key, const std::filesystem::path& fil
 RecordingTruth loadRecordingTruth(const std::filesystem::path& folder) {
   RecordingTruth truth;
   truth.folder = folder;
-  for (const auto& camera : daemon::loadRigFile(folder / "rig.yaml")) {
+  const daemon::RigFile rig = daemon::loadRig(folder / "rig.yaml");
+  for (const auto& camera : rig.cameras) {
     truth.rig.cameras.push_back(camera.calibration);
     truth.videos.push_back(camera.source ? camera.source->path : std::filesystem::path());
+  }
+  // The body the recording shows, masked as surroundd would mask it.
+  if (rig.vehicle && rig.vehicle->bodyMasks) {
+    WorkPool pool;
+    for (auto& camera : truth.rig.cameras) {
+      camera.bodyMask = processing::computeBodyMask(rig.vehicle->body(), camera, pool);
+    }
   }
   const auto file = folder / "ground_truth.yaml";
   YAML::Node root;

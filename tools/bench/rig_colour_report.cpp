@@ -40,19 +40,23 @@ std::string levels(const std::optional<double>& value) {
 
 }  // namespace
 
-void reportRigColour(const std::filesystem::path& configFile, int threads,
-                     const std::filesystem::path& pictures) {
+RigColourInput rigColourInput(const std::filesystem::path& configFile, WorkPool& pool) {
   const daemon::Config config = daemon::loadConfig(configFile);
-  WorkPool pool(threads);
-  const processing::Rig rig = daemon::rigOf(config, pool);
-  const processing::PanoramaSettings settings = daemon::panoramaSettings(config);
+  return {configFile.filename().string(), daemon::rigOf(config, pool),
+          daemon::panoramaSettings(config), config.colour.poisson, firstFrames(config)};
+}
+
+void reportRigColour(const RigColourInput& input, WorkPool& pool,
+                     const std::filesystem::path& pictures) {
+  const processing::Rig& rig = input.rig;
+  const processing::PanoramaSettings& settings = input.panorama;
+  const std::vector<cv::Mat>& frames = input.frames;
   const processing::PanoramaLut lut = processing::buildPanoramaLut(rig, settings, pool);
-  const std::vector<cv::Mat> frames = firstFrames(config);
   processing::Stitcher stitcher(lut, pool);
   cv::Mat raw;
   stitcher.stitch(frames, raw);
 
-  const auto& colour = config.colour.poisson;
+  const auto& colour = input.colour;
   cv::Mat gained = raw.clone();
   processing::GainCompensation gains(lut, pool, colour.minGain, colour.maxGain);
   gains.update(frames);
@@ -66,7 +70,7 @@ void reportRigColour(const std::filesystem::path& configFile, int threads,
   for (const auto& camera : rig.cameras) masked += camera.bodyMask.empty() ? 0 : 1;
   fmt::print(
       "{}: {} cameras, panorama {}x{}, {} with a body mask, Poisson {} field at scale {:g}\n",
-      configFile.filename().string(), rig.cameras.size(), lut.size.width, lut.size.height, masked,
+      input.name, rig.cameras.size(), lut.size.width, lut.size.height, masked,
       processing::correctionFieldName(colour.field), colour.scale);
   fmt::print("  {:<14} {:>24}   {:^23}   {:^23}\n", "seam", "misalignment",
              "step near: none gain PLCC", "step far: none gain PLCC");
@@ -108,7 +112,7 @@ void reportRigColour(const std::filesystem::path& configFile, int threads,
   for (const auto& note : correction.notesOfLastUpdate()) fmt::print("    note: {}\n", note);
   if (!pictures.empty()) {
     std::filesystem::create_directories(pictures);
-    const std::string stem = configFile.stem().string();
+    const std::string stem = std::filesystem::path(input.name).stem().string();
     cv::imwrite((pictures / (stem + "-none.png")).string(), raw);
     cv::imwrite((pictures / (stem + "-gain.png")).string(), gained);
     cv::imwrite((pictures / (stem + "-poisson.png")).string(), poisson);

@@ -6,10 +6,32 @@
 // clamped or dropped. With an output folder, the panoramas as PNG.
 
 #include <filesystem>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "processing/poisson_correction.hpp"
+
+namespace surroundd {
+class WorkPool;
+}
 
 namespace surroundd::bench {
 
-void reportRigColour(const std::filesystem::path& config, int threads,
+// One rig's cameras (body masks included) and first frames, and how to correct them.
+struct RigColourInput {
+  std::string name;
+  processing::Rig rig;
+  processing::PanoramaSettings panorama;
+  processing::ColourCorrectionSettings colour;
+  std::vector<cv::Mat> frames;
+};
+
+// From a surroundd config whose cameras are files.
+RigColourInput rigColourInput(const std::filesystem::path& config, WorkPool& pool);
+
+void reportRigColour(const RigColourInput& input, WorkPool& pool,
                      const std::filesystem::path& pictures = {});
 
 }  // namespace surroundd::bench
