@@ -262,11 +262,11 @@ TEST(CalibrateCli, IntrinsicsWithAnUnreadableOrOddSizedImage) {
 
 TEST(CalibrateCli, UsageErrorsNameTheOption) {
   const TempDir dir;
-  expectFailure(
-      calibrate(dir, {}), 2,
-      "surround-calibrate: missing the subcommand: intrinsics, extrinsics or import (see --help)");
+  expectFailure(calibrate(dir, {}), 2,
+                "surround-calibrate: missing the subcommand: intrinsics, extrinsics, import or "
+                "mask (see --help)");
   expectFailure(calibrate(dir, {"calibrate"}), 2,
-                "unknown subcommand 'calibrate': expected intrinsics, extrinsics or import");
+                "unknown subcommand 'calibrate': expected intrinsics, extrinsics, import or mask");
   expectFailure(calibrate(dir, {"import", "--pjlab", dir.path().string(), "--axes",
                                 "right,forward,down", "--out", "rig.yaml"}),
                 2,

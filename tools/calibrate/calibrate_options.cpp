@@ -55,6 +55,25 @@ and the change from the rig's current mount; writes the camera's mount: block.
   --update-rig               also write the mount into the rig file (see "--update-rig" below)
 )";
 
+constexpr std::string_view kMaskUsage =
+    R"(usage: surround-calibrate mask --config FILE --out DIR [--camera NAME]
+
+Each camera's body mask (the pixels that see the vehicle, left out of the panorama and colour
+correction) drawn on the camera's first picture, to check it, and the mask itself, to edit it. The
+mask is what surroundd uses: computed from the config's vehicle: block (or the rig's), then the
+camera's body_mask: added or put in its place. Writes, per camera:
+
+  DIR/NAME-mask-overlay.png  the picture with the masked pixels tinted red and outlined, labelled
+                             with the masked share and where the mask came from (a live camera's
+                             picture is grey: no frame is read from a device)
+  DIR/NAME-body.png          the mask, white = body: edit it in any paint program and give it back
+                             as the camera's body_mask: {file: NAME-body.png, mode: replace}
+
+  --config FILE              the surroundd config
+  --out DIR                  folder for the pictures (made when missing)
+  --camera NAME              only this camera
+)";
+
 constexpr std::string_view kUpdateRigUsage =
     R"(--update-rig edits the rig file's YAML: only the camera's lens: (intrinsics) or mount:
 (extrinsics) block is replaced. Every other key stays as it was (sources with their sequence_fps,
@@ -155,6 +174,18 @@ ExtrinsicsOptions parseExtrinsics(std::span<const std::string_view> arguments) {
   return o;
 }
 
+MaskOptions parseMask(std::span<const std::string_view> arguments) {
+  MaskOptions o;
+  parseOptions(arguments,
+               {{"--config", [&](auto v) { o.config = std::string(v); }},
+                {"--out", [&](auto v) { o.out = std::string(v); }},
+                {"--camera", [&](auto v) { o.camera = std::string(v); }}},
+               {});
+  if (o.config.empty()) throw UsageError("--config: missing (the surroundd config)");
+  if (o.out.empty()) throw UsageError("--out: missing (the folder to write the pictures to)");
+  return o;
+}
+
 bool asksForHelp(std::span<const std::string_view> arguments) {
   return std::any_of(arguments.begin(), arguments.end(),
                      [](auto a) { return a == "--help" || a == "-h"; });
@@ -190,7 +221,7 @@ void parseOptions(std::span<const std::string_view> arguments, const Handlers& v
 
 Command parseArguments(std::span<const std::string_view> arguments) {
   if (arguments.empty()) {
-    throw UsageError("missing the subcommand: intrinsics, extrinsics or import (see --help)");
+    throw UsageError("missing the subcommand: intrinsics, extrinsics, import or mask (see --help)");
   }
   const std::string_view subcommand = arguments.front();
   const auto rest = arguments.subspan(1);
@@ -211,17 +242,21 @@ Command parseArguments(std::span<const std::string_view> arguments) {
     if (asksForHelp(rest)) return HelpRequest{std::string(kImportUsage)};
     return parseImport(rest);
   }
-  throw UsageError(
-      fmt::format("unknown subcommand '{}': expected intrinsics, extrinsics or import (see --help)",
-                  subcommand));
+  if (subcommand == "mask") {
+    if (asksForHelp(rest)) return HelpRequest{std::string(kMaskUsage)};
+    return parseMask(rest);
+  }
+  throw UsageError(fmt::format(
+      "unknown subcommand '{}': expected intrinsics, extrinsics, import or mask (see --help)",
+      subcommand));
 }
 
 std::string usage() {
   return fmt::format(
-      "surround-calibrate: camera calibration for surroundd.\n\n{}\n{}\n{}\n{}\n"
+      "surround-calibrate: camera calibration for surroundd.\n\n{}\n{}\n{}\n{}\n{}\n"
       "exit status: 0 done, 1 calibration failed (too little in the images), 2 bad arguments or "
       "input files\n",
-      kIntrinsicsUsage, kExtrinsicsUsage, kUpdateRigUsage, kImportUsage);
+      kIntrinsicsUsage, kExtrinsicsUsage, kUpdateRigUsage, kImportUsage, kMaskUsage);
 }
 
 }  // namespace surroundd::calibrate

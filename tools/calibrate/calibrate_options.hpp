@@ -49,11 +49,18 @@ struct ExtrinsicsOptions {
   bool updateRig = false;  // write the new mount into the rig file
 };
 
+struct MaskOptions {
+  std::filesystem::path config;  // the surroundd config (its rig, vehicle: and body_mask:s)
+  std::filesystem::path out;     // folder for the pictures
+  std::string camera;            // empty: every camera
+};
+
 struct HelpRequest {
   std::string text;
 };
 
-using Command = std::variant<IntrinsicsOptions, ExtrinsicsOptions, ImportOptions, HelpRequest>;
+using Command =
+    std::variant<IntrinsicsOptions, ExtrinsicsOptions, ImportOptions, MaskOptions, HelpRequest>;
 
 // `arguments` excludes the program name. Throws UsageError.
 Command parseArguments(std::span<const std::string_view> arguments);

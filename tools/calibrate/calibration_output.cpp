@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
 #include <yaml-cpp/yaml.h>
 
 #include "daemon/rig_yaml.hpp"
@@ -24,7 +25,7 @@ void writeAtomically(const std::filesystem::path& file, const std::string& text,
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
   const auto partial = std::filesystem::path(file.string() + ".part");
   {
-    std::ofstream stream(partial, std::ios::trunc);
+    std::ofstream stream(partial, std::ios::trunc | std::ios::binary);
     stream << text;
     if (!stream.flush()) {
       throw std::runtime_error(fmt::format("{}: cannot write the file", partial.string()));
@@ -206,6 +207,14 @@ void updateRig(const std::filesystem::path& rig, const std::string& camera, cons
 }
 
 }  // namespace
+
+void writePng(const std::filesystem::path& file, const cv::Mat& picture) {
+  std::vector<unsigned char> bytes;
+  if (!cv::imencode(".png", picture, bytes)) {
+    throw std::runtime_error(fmt::format("{}: cannot encode the picture", file.string()));
+  }
+  writeAtomically(file, std::string(bytes.begin(), bytes.end()));
+}
 
 void writeLensBlock(const std::filesystem::path& file, const processing::Intrinsics& lens,
                     std::string_view comment) {

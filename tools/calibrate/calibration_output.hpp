@@ -1,11 +1,14 @@
 #pragma once
 // What surround-calibrate writes: the camera's lens: or mount: block in the rig schema
 // (daemon/rig_yaml.hpp), ready to paste under the camera, and optionally the same values written
-// into a rig file. Every file is written beside and renamed, so a reader never sees half of one.
+// into a rig file; the mask pictures. Every file is written beside and renamed, so a reader never
+// sees half of one.
 
 #include <filesystem>
 #include <string>
 #include <string_view>
+
+#include <opencv2/core.hpp>
 
 #include "processing/rig.hpp"
 
@@ -16,6 +19,9 @@ void writeLensBlock(const std::filesystem::path& file, const processing::Intrins
                     std::string_view comment);
 void writeMountBlock(const std::filesystem::path& file, const processing::Pose& pose,
                      std::string_view comment);
+
+// A PNG of `picture` (8-bit, 1 or 3 channels).
+void writePng(const std::filesystem::path& file, const cv::Mat& picture);
 
 // Replaces one camera's lens: or mount: block in a rig file, editing the YAML document: every
 // other key (sources with their sequence_fps, health, other cameras, ...) stays, and so does the

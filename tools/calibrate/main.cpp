@@ -1,5 +1,6 @@
 // surround-calibrate: camera intrinsics from checkerboard images, extrinsics from ground markers,
-// and other tools' calibrations imported into a rig file (see --help).
+// other tools' calibrations imported into a rig file, and the body masks drawn for checking (see
+// --help).
 
 #include <iostream>
 #include <string_view>
@@ -11,15 +12,16 @@
 #include "tools/calibrate/extrinsics_command.hpp"
 #include "tools/calibrate/import_command.hpp"
 #include "tools/calibrate/intrinsics_command.hpp"
+#include "tools/calibrate/mask_command.hpp"
 
 int main(int argc, char** argv) {
   using namespace surroundd::calibrate;
   const std::vector<std::string_view> arguments(argv + 1, argv + argc);
   std::string_view subcommand = arguments.empty() ? "" : arguments.front();
-  const std::string prefix =
-      subcommand == "intrinsics" || subcommand == "extrinsics" || subcommand == "import"
-          ? "surround-calibrate " + std::string(subcommand) + ": "
-          : std::string("surround-calibrate: ");
+  const std::string prefix = subcommand == "intrinsics" || subcommand == "extrinsics" ||
+                                     subcommand == "import" || subcommand == "mask"
+                                 ? "surround-calibrate " + std::string(subcommand) + ": "
+                                 : std::string("surround-calibrate: ");
   try {
     const Command command = parseArguments(arguments);
     if (const auto* help = std::get_if<HelpRequest>(&command)) {
@@ -28,6 +30,8 @@ int main(int argc, char** argv) {
       runIntrinsics(*intrinsics, std::cout);
     } else if (const auto* import = std::get_if<ImportOptions>(&command)) {
       runImport(*import, std::cout);
+    } else if (const auto* mask = std::get_if<MaskOptions>(&command)) {
+      runMask(*mask, std::cout);
     } else {
       runExtrinsics(std::get<ExtrinsicsOptions>(command), std::cout);
     }
