@@ -1,10 +1,13 @@
 // The ego vehicle's body: which rays it blocks, the body masks computed from it for each camera of
-// the paper's rig (roof cameras see the roof at the bottom of their pictures), and the panorama LUT
-// that never samples a masked pixel but takes that ground from a camera that sees it.
+// the paper's rig (roof cameras see the roof at the bottom of their pictures), the panorama LUT
+// that never samples a masked pixel but takes that ground from a camera that sees it, and on the
+// generator's recordings with a rendered body, never a pixel of the true body.
 
 #include "processing/vehicle_body.hpp"
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <yaml-cpp/yaml.h>
 
 #include "common/work_pool.hpp"
 #include "processing/panorama_lut.hpp"
@@ -102,6 +105,49 @@ TEST_F(BodyMaskTest, TheLutNeverSamplesTheBodyAndTakesThatGroundFromAnotherCamer
   EXPECT_GT(moved, 0);
   EXPECT_GT(lost, 0);
 }
+
+// The generator's own body (rounded, its roof a mirror of the scene) and its true masks: the
+// panorama stitched with the masks computed from the rig's vehicle never samples a pixel of the
+// body.
+class TrueBodyTest : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(TrueBodyTest, StitchedGroundNeverComesFromTheBody) {
+  const auto folder = std::filesystem::path(SURROUNDD_FIXTURE_DIR) / GetParam();
+  const bench::RecordingTruth truth = bench::loadRecordingTruth(folder);
+  const YAML::Node groundTruth = YAML::LoadFile((folder / "ground_truth.yaml").string());
+  std::vector<cv::Mat> bodies;
+  for (const auto& camera : truth.rig.cameras) {
+    ASSERT_FALSE(camera.bodyMask.empty()) << camera.name << ": the recording's vehicle is masked";
+    for (const auto& entry : groundTruth["cameras"]) {
+      if (entry["name"].as<std::string>() == camera.name) {
+        bodies.push_back(cv::imread((folder / entry["body_mask"].as<std::string>()).string(),
+                                    cv::IMREAD_GRAYSCALE));
+      }
+    }
+    ASSERT_EQ(bodies.size(), &camera - truth.rig.cameras.data() + 1) << camera.name;
+    ASSERT_GT(cv::countNonZero(bodies.back()), 0) << camera.name << " sees the body";
+  }
+  WorkPool pool(2);
+  const PanoramaSettings settings = testing::settingsFor(truth);
+  const PanoramaLut lut = buildPanoramaLut(truth.rig, settings, pool);
+  const auto onBody = [&](const LutTap& tap) {
+    const cv::Mat& body = bodies[tap.camera];
+    const int x = static_cast<int>(tap.offset % static_cast<std::uint32_t>(body.cols));
+    const int y = static_cast<int>(tap.offset / static_cast<std::uint32_t>(body.cols));
+    return cv::countNonZero(body(cv::Rect(x, y, 2, 2))) > 0;
+  };
+  std::size_t seen = 0;
+  for (const auto& tap : lut.taps) {
+    if (tap.camera == PanoramaLut::kUnseen) continue;
+    ++seen;
+    ASSERT_FALSE(onBody(tap)) << truth.rig.cameras[tap.camera].name;
+  }
+  for (const auto& blend : lut.blendTaps) ASSERT_FALSE(onBody(blend.tap));
+  EXPECT_GT(seen, lut.taps.size() / 3);  // and the ground around the body is there
+}
+
+INSTANTIATE_TEST_SUITE_P(GeneratedBodies, TrueBodyTest,
+                         ::testing::Values("synth_body_paper", "synth_body_fisheye"));
 
 }  // namespace
 }  // namespace surroundd::processing
