@@ -280,7 +280,9 @@ std::vector<RigCamera> readRigCameras(YamlObject& rig) {
         camera.source = readSource(*source);
       }
     }
-    if (auto mask = entry.object("body_mask")) camera.bodyMask = readBodyMask(*mask);
+    if (auto mask = entry.object("body_mask")) {
+      camera.bodyMask = readBodyMask(*mask, calibration.intrinsics.imageSize);
+    }
     entry.finish();
     cameras.push_back(std::move(camera));
   }

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
 
 namespace surroundd::daemon {
 
@@ -81,12 +82,22 @@ VehicleConfig readVehicle(YamlObject& v) {
   return c;
 }
 
-BodyMaskConfig readBodyMask(YamlObject& m) {
+BodyMaskConfig readBodyMask(YamlObject& m, cv::Size lensSize) {
   BodyMaskConfig c;
   c.mode =
       m.choice("mode", c.mode,
                {{"add", BodyMaskConfig::Mode::kAdd}, {"replace", BodyMaskConfig::Mode::kReplace}});
   if (m.has("file")) c.file = m.existingFile("file").value_or("");
+  if (!c.file.empty()) {
+    const cv::Mat picture = cv::imread(c.file.string(), cv::IMREAD_GRAYSCALE);
+    if (picture.size() != lensSize) {
+      m.error("file",
+              fmt::format("expected a {}x{} picture (the lens's size; white = body), got {}",
+                          lensSize.width, lensSize.height,
+                          picture.empty() ? std::string("none that can be read")
+                                          : fmt::format("{}x{}", picture.cols, picture.rows)));
+    }
+  }
   if (auto polygon = m.points("polygon", 3)) c.polygon = *polygon;
   if (!m.has("file") && !m.has("polygon")) {
     m.errorHere("expected 'file' (a mask picture, white = body) and/or 'polygon' (pixels)");

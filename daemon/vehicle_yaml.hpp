@@ -59,7 +59,8 @@ struct BodyMaskConfig {
 
 // Reads and validates a `vehicle:` mapping; errors go to its Diagnostics.
 VehicleConfig readVehicle(YamlObject& vehicle);
-BodyMaskConfig readBodyMask(YamlObject& mask);
+// A camera's `body_mask:`; its picture must be of the lens's size.
+BodyMaskConfig readBodyMask(YamlObject& mask, cv::Size lensSize);
 
 void emitVehicle(YAML::Emitter& out, const VehicleConfig& vehicle);
 

@@ -9,6 +9,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "tests/support/temp_dir.hpp"
 
@@ -448,6 +449,10 @@ TEST_F(ConfigTest, VehicleAndBodyMaskMistakesAreNamed) {
   expectOneError("      source: {file: left.mkv}",
                  "      source: {file: left.mkv}\n      body_mask: {file: nowhere.png}",
                  {"body_mask.file", "nowhere.png"});
+  cv::imwrite((dir_ / "small.png").string(), cv::Mat(10, 20, CV_8U, cv::Scalar(255)));
+  expectOneError("      source: {file: left.mkv}",
+                 "      source: {file: left.mkv}\n      body_mask: {file: small.png}",
+                 {"body_mask.file", "expected a 640x360 picture", "got 20x10"});
   expectOneError("  height_px: 360\noutputs", "  height_px: 360\n  car_length_m: 4\noutputs",
                  {"render.car_length_m", "vehicle.length_m"});
 }
