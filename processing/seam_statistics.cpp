@@ -77,13 +77,13 @@ void medianAlongSeam(std::span<const std::uint32_t> blocks, std::span<const floa
                      std::span<float> filtered, std::span<std::uint8_t> filteredValid) {
   const auto n = static_cast<int>(blocks.size());
   for (int i = 0; i < n; ++i) {
-    const std::uint32_t block = blocks[static_cast<std::size_t>(i)];
+    const std::size_t block = blocks[static_cast<std::size_t>(i)];
     const int first = std::max(0, i - halfWindow);
     const int last = std::min(n - 1, i + halfWindow);
     for (int c = 0; c < 3; ++c) {
       std::size_t count = 0;
       for (int j = first; j <= last; ++j) {
-        const std::uint32_t other = blocks[static_cast<std::size_t>(j)];
+        const std::size_t other = blocks[static_cast<std::size_t>(j)];
         if (valid[other] != 0) window[count++] = values[other * 3 + static_cast<std::size_t>(c)];
       }
       filtered[block * 3 + static_cast<std::size_t>(c)] =
