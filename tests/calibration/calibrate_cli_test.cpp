@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include "tests/calibration/calibrate_run.hpp"
 #include "tests/calibration/calibration_test_support.hpp"
 #include "tests/support/child_process.hpp"
 #include "tests/support/temp_dir.hpp"
@@ -23,18 +24,6 @@ namespace {
 
 using surroundd::testing::TempDir;
 using ::testing::HasSubstr;
-
-struct CalibrateRun {
-  int status;
-  std::string output;
-};
-
-CalibrateRun calibrate(const TempDir& dir, std::vector<std::string> arguments) {
-  arguments.insert(arguments.begin(), SURROUND_CALIBRATE);
-  surroundd::testing::ChildProcess child(arguments, dir / "log.txt");
-  const int status = child.wait();
-  return {status, child.output()};
-}
 
 const processing::Checkerboard kBoard{{9, 6}, 0.05};
 

@@ -16,6 +16,7 @@
 #include "common/work_pool.hpp"
 #include "daemon/config.hpp"
 #include "daemon/panorama_setup.hpp"
+#include "tests/calibration/calibrate_run.hpp"
 #include "tests/support/child_process.hpp"
 #include "tests/support/temp_dir.hpp"
 
@@ -30,18 +31,6 @@ using ::testing::HasSubstr;
 const std::filesystem::path kRecording =
     std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
 constexpr std::string_view kVehicle = "vehicle: {length_m: 4.5, width_m: 1.85, height_m: 1.5}\n";
-
-struct CalibrateRun {
-  int status;
-  std::string output;
-};
-
-CalibrateRun calibrate(const TempDir& dir, std::vector<std::string> arguments) {
-  arguments.insert(arguments.begin(), SURROUND_CALIBRATE);
-  surroundd::testing::ChildProcess child(arguments, dir / "log.txt");
-  const int status = child.wait();
-  return {status, child.output()};
-}
 
 // The recording's rig in `dir` (sources made absolute), edited by `edit`.
 std::filesystem::path writeRig(const TempDir& dir, const std::function<void(YAML::Node&)>& edit) {
