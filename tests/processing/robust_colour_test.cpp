@@ -1,7 +1,8 @@
 // Colour correction made for real rigs (issue 15), on the generator's recordings: an object on a
 // seam does not pull the field; gains beyond the configured range are clamped and said; a seam
 // that correction would make worse keeps gain 1 (here: a sudden exposure change under heavy
-// temporal smoothing); gain compensation keeps the rig's brightness.
+// temporal smoothing); gain compensation keeps the rig's brightness; and on the shared real rigs
+// (skipped without ../shared/data) no near-ground seam gets worse.
 
 #include <gtest/gtest.h>
 
@@ -11,6 +12,7 @@
 #include "processing/stitcher.hpp"
 #include "tests/processing/panorama_test_support.hpp"
 #include "tests/support/test_support.hpp"
+#include "tools/bench/rig_colour_report.hpp"
 #include "tools/bench/seam_measures.hpp"
 
 namespace surroundd::processing {
@@ -193,6 +195,40 @@ TEST_F(RobustColourTest, GainCompensationKeepsTheRigsBrightness) {
   gains.apply(gained);
   EXPECT_NEAR(bench::meanLevel(gained, lut_) / bench::meanLevel(raw, lut_), 1.0, 0.1);
 }
+
+// The shared real rigs (../shared/data, with the configs of config/real/: their vehicles masked):
+// on the near ground, where the seam data is, Poisson never leaves a seam worse than none, and
+// leaves every one within 5 levels; the panorama keeps its mean level within 10 %.
+class RealRigTest : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(RealRigTest, PoissonNeverMakesANearGroundSeamWorseAndKeepsTheLevel) {
+  const std::filesystem::path source(SURROUNDD_SOURCE_DIR);
+  if (!std::filesystem::is_directory(source / ".." / "shared" / "data")) {
+    GTEST_SKIP() << "../shared/data is absent";
+  }
+  WorkPool pool(2);
+  const bench::RigColourInput input =
+      bench::rigColourInput(source / "config" / "real" / GetParam(), pool);
+  const PanoramaLut lut = buildPanoramaLut(input.rig, input.panorama, pool);
+  Stitcher stitcher(lut, pool);
+  cv::Mat raw;
+  stitcher.stitch(input.frames, raw);
+  PoissonColourCorrection poisson(input.rig, input.panorama, lut, input.colour, pool);
+  poisson.update(input.frames);
+  cv::Mat corrected = raw.clone();
+  poisson.apply(corrected);
+  for (const auto& seam : bench::seamLines(input.rig, input.panorama)) {
+    const auto before = bench::seamColourStep(raw, lut, input.panorama, seam).nearLevels;
+    const auto after = bench::seamColourStep(corrected, lut, input.panorama, seam).nearLevels;
+    if (!before || !after) continue;
+    EXPECT_LE(*after, *before + 0.5) << GetParam() << " " << seam.name;
+    EXPECT_LE(*after, 5.0) << GetParam() << " " << seam.name;
+  }
+  EXPECT_NEAR(bench::meanLevel(corrected, lut) / bench::meanLevel(raw, lut), 1.0, 0.1);
+}
+
+INSTANTIATE_TEST_SUITE_P(SharedData, RealRigTest,
+                         ::testing::Values("pjlab-fisheye-real.yaml", "pjlab-ocam-real.yaml"));
 
 }  // namespace
 }  // namespace surroundd::processing
