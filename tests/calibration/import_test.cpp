@@ -1,8 +1,8 @@
 // surround-calibrate import: foreign calibration files written from the project's rig presets in a
 // foreign frame (other axes, unit, ground height and origin) are imported back to the presets
 // (position within 1 cm, rotation within 0.2 degrees, lenses exact or, for an OCamCalib lens
-// fitted to a fisheye, projections within 0.5 px); the three shared pjlab samples give sensible
-// rigs; bad input is refused naming the file and key.
+// fitted to a fisheye, projections within 0.5 px); bad input is refused naming the file and key.
+// The shared pjlab samples: import_shared_samples_test.cpp.
 
 #include <cmath>
 #include <fstream>
@@ -18,6 +18,7 @@
 
 #include "daemon/rig_yaml.hpp"
 #include "processing/camera_model.hpp"
+#include "tests/calibration/import_test_support.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 #include "tools/calibrate/import_command.hpp"
@@ -26,103 +27,8 @@
 namespace surroundd::calibrate {
 namespace {
 
-using processing::CameraCalibration;
 using surroundd::testing::TempDir;
 using ::testing::HasSubstr;
-
-constexpr double kRadToDeg = 180 / std::numbers::pi;
-
-std::vector<CameraCalibration> preset(const std::string& name) {
-  std::vector<CameraCalibration> cameras;
-  for (const auto& camera :
-       daemon::loadRigFile(std::string(SURROUNDD_SOURCE_DIR) + "/config/rigs/" + name)) {
-    cameras.push_back(camera.calibration);
-  }
-  return cameras;
-}
-
-// A frame as another tool might use: axes, unit, where the ground is on its vertical axis, and
-// the vehicle-frame ground point under its origin.
-struct ForeignFrame {
-  std::string axesText;
-  cv::Matx33d axes;  // columns: source x, y, z in the vehicle frame
-  double unitM;
-  double groundZ;
-  cv::Vec3d originOnGround;
-
-  cv::Vec3d toSource(const cv::Vec3d& vehicle) const {
-    cv::Vec3d source = axes.t() * (vehicle - originOnGround) * (1 / unitM);
-    for (int k = 0; k < 3; ++k) {
-      if (std::abs(axes(2, k)) > 0.5) source[k] += groundZ;
-    }
-    return source;
-  }
-  // P_camera = rotation * P_source + translation.
-  std::pair<cv::Matx33d, cv::Vec3d> cameraFromSource(const processing::Pose& pose) const {
-    const cv::Matx33d rotation = pose.rotation.t() * axes;
-    return {rotation, -(rotation * toSource(pose.position))};
-  }
-  std::vector<std::string> options() const {
-    return {"--axes",     axesText,
-            "--unit-m",   fmt::format("{}", unitM),
-            "--ground-z", fmt::format("{:.17g}", groundZ),
-            "--offset-m", fmt::format("{:.17g},{:.17g},0", originOnGround[0], originOnGround[1])};
-  }
-};
-
-// A top-down frame (x right, y towards the rear, z down) in decimetres, its origin 5 m above the
-// ground at vehicle (0.7, -0.4): the pjlab samples' kind of frame, off-centre.
-const ForeignFrame kTopDown{
-    "right,back,down", {0, -1, 0, -1, 0, 0, 0, 0, -1}, 0.1, 50, {0.7, -0.4, 0}};
-
-std::vector<daemon::RigCamera> runImport(std::vector<std::string> arguments) {
-  const std::vector<std::string_view> views(arguments.begin(), arguments.end());
-  return importRig(parseImport(views)).cameras;
-}
-
-std::string fileName(const CameraCalibration& camera) {
-  auto name = camera.name;
-  name[0] = static_cast<char>(std::toupper(name[0]));
-  return name;
-}
-
-// Poses within 1 cm and 0.2 degrees; prints the worst for the record.
-void expectPoses(const std::vector<daemon::RigCamera>& imported,
-                 const std::vector<CameraCalibration>& truth, const std::string& what) {
-  ASSERT_EQ(imported.size(), truth.size()) << what;
-  double worstM = 0, worstDeg = 0;
-  for (std::size_t i = 0; i < truth.size(); ++i) {
-    const auto& got = imported[i].calibration;
-    const auto& want = truth[i];
-    EXPECT_EQ(got.name, want.name) << what << ": the rig order is front, right, back, left";
-    cv::Vec3d turn;
-    cv::Rodrigues(got.pose.rotation * want.pose.rotation.t(), turn);
-    const double metres = cv::norm(got.pose.position - want.pose.position);
-    const double degrees = cv::norm(turn) * kRadToDeg;
-    EXPECT_LT(metres, 0.01) << what << " " << want.name;
-    EXPECT_LT(degrees, 0.2) << what << " " << want.name;
-    EXPECT_EQ(got.role, want.role) << what << " " << want.name;
-    worstM = std::max(worstM, metres);
-    worstDeg = std::max(worstDeg, degrees);
-  }
-  std::cout << fmt::format("[ measured ] {}: worst position {:.2e} m, rotation {:.2e} deg\n", what,
-                           worstM, worstDeg);
-}
-
-void expectSameLens(const processing::Intrinsics& got, const processing::Intrinsics& want,
-                    const std::string& what) {
-  EXPECT_EQ(got.model, want.model) << what;
-  EXPECT_EQ(got.imageSize, want.imageSize) << what;
-  EXPECT_DOUBLE_EQ(got.fx, want.fx) << what;
-  EXPECT_DOUBLE_EQ(got.fy, want.fy) << what;
-  EXPECT_DOUBLE_EQ(got.cx, want.cx) << what;
-  EXPECT_DOUBLE_EQ(got.cy, want.cy) << what;
-  for (std::size_t i = 0; i < 5; ++i) EXPECT_DOUBLE_EQ(got.distortion[i], want.distortion[i]);
-}
-
-cv::Mat cameraMatrix(const processing::Intrinsics& lens) {
-  return (cv::Mat_<double>(3, 3) << lens.fx, 0, lens.cx, 0, lens.fy, lens.cy, 0, 0, 1);
-}
 
 TEST(Import, OpenCvYamlWithRvecTvecGivesThePaperRig) {
   const TempDir dir;
@@ -547,80 +453,6 @@ TEST(Import, BadInputIsRefusedNamingTheFileAndKey) {
               HasSubstr("left-handed"));
   EXPECT_THAT(importError({"--pjlab", dir.path().string(), "--out", "x.yaml"}),
               HasSubstr("no folder 'intrinsic'"));
-}
-
-// The shared samples, imported as config/rigs/imported/README.md says.
-std::filesystem::path sharedData() {
-  return std::filesystem::path(SURROUNDD_SOURCE_DIR) / ".." / "shared" / "data";
-}
-
-cv::Vec3d opticalAxis(const CameraCalibration& camera) {
-  return camera.pose.rotation * cv::Vec3d(0, 0, 1);
-}
-
-// Sensible: four cameras in rig order, heights in range, front ahead of back, left at +y, each
-// looking outward (its optical axis within 30 degrees of its side, seen from above).
-void expectSensibleRig(const std::vector<daemon::RigCamera>& rig, double minHeight,
-                       double maxHeight, const std::string& what) {
-  ASSERT_EQ(rig.size(), 4U) << what;
-  const std::array<std::pair<const char*, cv::Vec2d>, 4> sides{
-      {{"front", {1, 0}}, {"right", {0, -1}}, {"back", {-1, 0}}, {"left", {0, 1}}}};
-  for (std::size_t i = 0; i < 4; ++i) {
-    const auto& camera = rig[i].calibration;
-    const auto& [name, side] = sides[i];
-    EXPECT_EQ(camera.name, name) << what;
-    EXPECT_GE(camera.pose.position[2], minHeight) << what << " " << name;
-    EXPECT_LE(camera.pose.position[2], maxHeight) << what << " " << name;
-    const cv::Vec3d axis = opticalAxis(camera);
-    const cv::Vec2d flat = cv::normalize(cv::Vec2d(axis[0], axis[1]));
-    EXPECT_GT(flat.dot(side), std::cos(30 / kRadToDeg))
-        << what << " " << name << " looks along " << axis;
-    EXPECT_LT(axis[2], 0.01) << what << " " << name << " looks level or down";
-    std::cout << fmt::format(
-        "[ measured ] {} {}: ({:+.3f}, {:+.3f}, {:.3f}) m, axis ({:+.2f}, "
-        "{:+.2f}, {:+.2f})\n",
-        what, name, camera.pose.position[0], camera.pose.position[1], camera.pose.position[2],
-        axis[0], axis[1], axis[2]);
-  }
-  EXPECT_GT(rig[0].calibration.pose.position[0], rig[2].calibration.pose.position[0]) << what;
-  EXPECT_GT(rig[3].calibration.pose.position[1], 0) << what;
-  EXPECT_LT(rig[1].calibration.pose.position[1], 0) << what;
-}
-
-TEST(Import, TheSharedPjlabSamplesGiveSensibleRigs) {
-  const auto data = sharedData();
-  if (!std::filesystem::is_directory(data)) GTEST_SKIP() << "../shared/data is absent";
-  const TempDir dir;
-  const auto sample = [&](const char* name) { return (data / name).string(); };
-
-  const auto carla = runImport(
-      {"--pjlab", sample("pjlab-carla-pinhole"), "--axes", "right,back,down", "--ground-z", "5.1",
-       "--images", sample("pjlab-carla-pinhole/imgs"), "--out", (dir / "carla.yaml").string()});
-  expectSensibleRig(carla, 0.99, 1.01, "pjlab-carla-pinhole");
-  // The README's centres: front 2.5 m ahead, back 2 m behind, sides 1 m out, all 1.0 m up.
-  const std::array<cv::Vec3d, 4> centres{{{2.5, 0, 1}, {0, -1, 1}, {-2, 0, 1}, {0, 1, 1}}};
-  for (std::size_t i = 0; i < 4 && i < carla.size(); ++i) {
-    EXPECT_LT(cv::norm(carla[i].calibration.pose.position - centres[i]), 0.01)
-        << carla[i].calibration.name;
-  }
-
-  const auto fisheye = runImport(
-      {"--pjlab-yaml", sample("pjlab-fisheye-real/calibration.yaml"), "--lens", "fisheye", "--axes",
-       "right,forward,up", "--unit-m", "0.1", "--ground-z", "1", "--origin-centre", "--images",
-       sample("pjlab-fisheye-real/imgs"), "--out", (dir / "fisheye.yaml").string()});
-  // The calibration's header: about 17 units (1.7 m) up; the back camera sits higher.
-  expectSensibleRig(fisheye, 1.5, 2.0, "pjlab-fisheye-real");
-
-  const auto ocam = runImport(
-      {"--pjlab", sample("pjlab-ocam-real"), "--lens", "ocam", "--axes", "right,back,down",
-       "--ground-z", "front=6.07826,left=6.25217,back=6.31014,right=6.28116", "--origin-centre",
-       "--images", sample("pjlab-ocam-real/imgs"), "--out", (dir / "ocam.yaml").string()});
-  // The README: camera heights of 1.22-1.35 m follow from the ground heights.
-  expectSensibleRig(ocam, 1.21, 1.36, "pjlab-ocam-real");
-  for (const auto& camera : ocam) {
-    EXPECT_EQ(camera.calibration.intrinsics.model, processing::LensModel::kOcam);
-    EXPECT_EQ(camera.calibration.intrinsics.ocam.worldToImage.size(), 11U);
-  }
 }
 
 }  // namespace
