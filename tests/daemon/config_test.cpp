@@ -6,6 +6,7 @@
 #include <fstream>
 #include <string>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -225,6 +226,22 @@ TEST_F(ConfigTest, MissingFile) {
   expectOneError("{file: left.mkv}", "{file: lfet.mkv}",
                  {"rig.cameras[1].source.file: expected an existing video file",
                   (dir_ / "lfet.mkv").string(), "no such file"});
+}
+
+// A file name reaches no printf-family call (issue 18: "%s%s%s" crashed --check-config, a
+// "%999999999d" took 16 s): only one %d or %0Nd makes a sequence pattern.
+TEST_F(ConfigTest, PercentsInAFileNameAreNeverFormatted) {
+  for (const char* name : {"x%s%s%s%s%s%s%s%s.png", "x%n%n%n.png", "x%d%s.png"}) {
+    expectOneError(
+        "{file: left.mkv}", fmt::format("{{file: \"{}\"}}", name),
+        {"rig.cameras[1].source.file: expected an existing video file or picture", "no such file"});
+  }
+  expectOneError("{file: left.mkv}", "{file: x%999999999d.png}",
+                 {"rig.cameras[1].source.file: expected an image sequence pattern with %d or "
+                  "%0Nd (N up to 32)",
+                  "its number is wider than that"});
+  dir_.write("x%s%n.png", "");
+  EXPECT_NO_THROW(loadConfig(configWith("{file: left.mkv}", "{file: \"x%s%n.png\"}")));
 }
 
 // A still picture loops unless told not to, at sequence_fps; the frozen check is set per camera.
