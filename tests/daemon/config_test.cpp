@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include "tests/daemon/config_test_support.hpp"
 #include "tests/support/temp_dir.hpp"
@@ -318,6 +319,18 @@ TEST_F(ConfigTest, MissingConfigFile) {
   ASSERT_EQ(messages.size(), 1u);
   EXPECT_THAT(messages[0], HasSubstr((dir_ / "absent.yaml").string()));
   EXPECT_THAT(messages[0], HasSubstr("cannot open"));
+}
+
+// A config (or rig) path that is no file is named and refused; a FIFO does not block the reader.
+TEST_F(ConfigTest, AConfigThatIsNoFileIsRefusedUnread) {
+  std::filesystem::create_directory(dir_ / "folder.yaml");
+  ASSERT_EQ(::mkfifo((dir_ / "fifo.yaml").c_str(), 0600), 0);
+  for (const auto& [name, kind] : {std::pair{"folder.yaml", "a directory, not a file"},
+                                   std::pair{"fifo.yaml", "a FIFO, not a file"}}) {
+    const auto messages = errorsOf(dir_ / name);
+    ASSERT_EQ(messages.size(), 1u);
+    EXPECT_THAT(messages[0], AllOf(HasSubstr((dir_ / name).string()), HasSubstr(kind)));
+  }
 }
 
 TEST_F(ConfigTest, RigFileRoundTripsExactly) {
