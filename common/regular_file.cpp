@@ -2,7 +2,7 @@
 
 #include <array>
 #include <cerrno>
-#include <cstring>
+#include <system_error>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -27,12 +27,12 @@ class OpenFile {
   OpenFile(const std::filesystem::path& path, std::size_t maxBytes)
       : fd_(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC)) {
     if (fd_ < 0) {
-      problem_ = errno == ENOENT ? "it does not exist" : std::strerror(errno);
+      problem_ = errno == ENOENT ? "it does not exist" : std::system_category().message(errno);
       return;
     }
     struct stat status {};
     if (::fstat(fd_, &status) != 0) {
-      problem_ = std::strerror(errno);
+      problem_ = std::system_category().message(errno);
     } else if (!S_ISREG(status.st_mode)) {
       problem_ = kindOf(status.st_mode) + ", not a file";
     } else if (static_cast<std::size_t>(status.st_size) > maxBytes) {
@@ -75,7 +75,7 @@ std::string readRegularFile(const std::filesystem::path& path, std::size_t maxBy
   for (;;) {
     const ssize_t got = ::read(file.fd(), chunk.data(), chunk.size());
     if (got < 0 && errno == EINTR) continue;
-    if (got < 0) throw FileReadError(path.string() + ": " + std::strerror(errno));
+    if (got < 0) throw FileReadError(path.string() + ": " + std::system_category().message(errno));
     if (got == 0) return bytes;
     if (bytes.size() + static_cast<std::size_t>(got) > maxBytes) {
       throw FileReadError(path.string() + ": larger than " + std::to_string(maxBytes) + " bytes");
