@@ -119,8 +119,7 @@ void readColour(YamlObject& section, ColourCorrectionConfig& c) {
   p.solver = section.choice("solver", p.solver,
                             {{"auto", PoissonSolverKind::kAuto},
                              {"cholmod", PoissonSolverKind::kCholmod},
-                             {"iterative", PoissonSolverKind::kIterative},
-                             {"rectangle", PoissonSolverKind::kRectangle}});
+                             {"iterative", PoissonSolverKind::kIterative}});
   p.tolerance = section.number("tolerance", p.tolerance, {0.0, 0.5, true, "relative residual"});
   p.temporalSmoothing = section.number("temporal_smoothing", p.temporalSmoothing,
                                        {0.0, 0.99, false, "weight of the previous frame"});

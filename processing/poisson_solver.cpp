@@ -20,8 +20,6 @@ std::string_view poissonSolverName(PoissonSolverKind kind) {
       return "cholmod";
     case PoissonSolverKind::kIterative:
       return "iterative";
-    case PoissonSolverKind::kRectangle:
-      return "rectangle";
   }
   return "unknown";
 }
@@ -33,23 +31,16 @@ std::unique_ptr<PoissonSolver> makePoissonSolver(PoissonSolverKind kind,
       return makeCholmodSolver(system);
     case PoissonSolverKind::kIterative:
       return makeIterativeSolver(system, tolerance);
-    case PoissonSolverKind::kRectangle:
     case PoissonSolverKind::kAuto:
       break;
   }
-  // The rectangle solver where it applies (exact, and the fastest); elsewhere CHOLMOD on small
-  // regions and the iterative solver on large ones.
-  const std::string mismatch = rectangleSolverMismatch(system);
-  if (mismatch.empty()) return makeRectangleSolver(system);
+  // CHOLMOD on small regions, the iterative solver on large ones.
   const bool small = system.unknowns() < kDirectBelowUnknowns;
   std::unique_ptr<PoissonSolver> solver =
       small ? makeCholmodSolver(system) : makeIterativeSolver(system, tolerance);
-  const std::string_view choice =
-      small ? "CHOLMOD (exact, and as fast on a region this small)" : "the iterative solver";
-  solver->selectionNote_ =
-      kind == PoissonSolverKind::kRectangle
-          ? fmt::format("rectangle solver asked for, but {}: using {}", mismatch, choice)
-          : fmt::format("{}: auto uses {}", mismatch, choice);
+  solver->selectionNote_ = fmt::format(
+      "{} unknowns: auto uses {}", system.unknowns(),
+      small ? "CHOLMOD (exact, and as fast on a region this small)" : "the iterative solver");
   return solver;
 }
 

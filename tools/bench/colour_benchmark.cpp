@@ -82,11 +82,6 @@ void measure(const std::filesystem::path& folder, const ColourBenchmarkOptions& 
                region.system.size.width, region.system.size.height,
                formatPoissonTimings(region.system.size,
                                     benchmarkPoissonSolvers(region.system, solverOptions)));
-    const processing::PoissonSystem rectangle = rectanglePoissonSystem(region.system.size);
-    fmt::print(
-        "    the {}x{} rectangle that fixed-azimuth seams give:\n{}", rectangle.size.width,
-        rectangle.size.height,
-        formatPoissonTimings(rectangle.size, benchmarkPoissonSolvers(rectangle, solverOptions)));
     for (const auto field :
          {processing::CorrectionField::kMultiplicative, processing::CorrectionField::kAdditive}) {
       correctionSettings.field = field;

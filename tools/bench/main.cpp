@@ -42,7 +42,7 @@ constexpr std::string_view kUsage =
   --threads N   worker threads (default 2); stitch measures 1 thread too
   --repeats N   timed runs per candidate, median reported (default 30; pipeline 3)
   --json        stitch, pipeline: one JSON object on stdout instead of the text table
-  --solver S    pipeline: auto | cholmod | iterative | rectangle (default auto)
+  --solver S    pipeline: auto | cholmod | iterative (default auto)
   --projection P  pipeline: bowl | sphere (default bowl)
   --view V      pipeline: top | 360 | orbit | split (default orbit)
   --size WxH    pipeline: output size (default 1280x720)
@@ -111,9 +111,8 @@ int main(int argc, char** argv) {
       const auto solver =
           parseWord<PoissonSolverKind>(value, {{"auto", PoissonSolverKind::kAuto},
                                                {"cholmod", PoissonSolverKind::kCholmod},
-                                               {"iterative", PoissonSolverKind::kIterative},
-                                               {"rectangle", PoissonSolverKind::kRectangle}});
-      if (!solver) return usageError("--solver needs auto, cholmod, iterative or rectangle");
+                                               {"iterative", PoissonSolverKind::kIterative}});
+      if (!solver) return usageError("--solver needs auto, cholmod or iterative");
       pipeline.solver = *solver;
       ++i;
     } else if (command == "pipeline" && arg == "--projection") {

@@ -16,23 +16,6 @@ using processing::ChannelValues;
 using processing::PoissonSolverKind;
 using processing::PoissonSystem;
 
-PoissonSystem rectanglePoissonSystem(cv::Size size) {
-  PoissonSystem system;
-  system.size = size;
-  for (int y = 0; y < size.height; ++y) {
-    for (int x = 0; x < size.width; ++x) {
-      const int i = y * size.width + x;
-      system.pixels.emplace_back(x, y);
-      // Unknown neighbours, plus the seams beyond the left and right columns.
-      system.degree.push_back((x > 0) + (x + 1 < size.width) + (y > 0) + (y + 1 < size.height) +
-                              (x == 0) + (x + 1 == size.width));
-      if (x + 1 < size.width) system.links.emplace_back(i, i + 1);
-      if (y + 1 < size.height) system.links.emplace_back(i, i + size.width);
-    }
-  }
-  return system;
-}
-
 ChannelValues seamRightHandSides(const PoissonSystem& system, int frame) {
   const processing::PoissonMatrix matrix(system);
   std::mt19937 random(static_cast<unsigned>(frame) + 1);
@@ -56,11 +39,8 @@ ChannelValues seamRightHandSides(const PoissonSystem& system, int frame) {
 
 std::vector<PoissonSolverTiming> benchmarkPoissonSolvers(const PoissonSystem& system,
                                                          const PoissonBenchmarkOptions& options) {
-  std::vector<PoissonSolverKind> kinds = {PoissonSolverKind::kCholmod,
-                                          PoissonSolverKind::kIterative};
-  if (processing::rectangleSolverMismatch(system).empty()) {
-    kinds.push_back(PoissonSolverKind::kRectangle);
-  }
+  const std::vector<PoissonSolverKind> kinds = {PoissonSolverKind::kCholmod,
+                                                PoissonSolverKind::kIterative};
   std::vector<ChannelValues> frames;
   for (int f = 0; f <= options.repeats; ++f) frames.push_back(seamRightHandSides(system, f));
 

@@ -33,16 +33,11 @@ struct PoissonSolverTiming {
   double differenceToCholmod = 0;  // largest |x - x_cholmod| on the last frame, 8-bit levels
 };
 
-// The region that seams at fixed azimuths give: `size` unknowns, a Dirichlet neighbour left of
-// the left column and right of the right column on every row, Neumann at top and bottom.
-processing::PoissonSystem rectanglePoissonSystem(cv::Size size);
-
 // Frame f's right-hand sides: smooth seam values of 0..60 levels at every Dirichlet neighbour,
 // scaled by 1.01^f and with noise of 0.2 levels: what a slow exposure drift gives.
 processing::ChannelValues seamRightHandSides(const processing::PoissonSystem& system, int frame);
 
-// CHOLMOD, the iterative solver and (where it applies) the rectangle solver, interleaved frame by
-// frame on one thread.
+// CHOLMOD and the iterative solver, interleaved frame by frame on one thread.
 std::vector<PoissonSolverTiming> benchmarkPoissonSolvers(const processing::PoissonSystem& system,
                                                          const PoissonBenchmarkOptions& options);
 
