@@ -1,7 +1,11 @@
 # cmake --install and the .deb (cpack -G DEB): the executables, the systemd unit, the installed
-# config in /etc/surroundd/ (a conffile: upgrades keep the integrator's edits), and the docs. The
+# config in /etc/surroundd/ (a conffile: upgrades keep the integrator's edits), the docs, the
+# manual pages, the licence (Apache-2.0) as a machine-readable copyright file and the changelog.
+# The binaries are stripped; their debug symbols go into a separate surroundd-dbgsym package. The
 # service's state (the LUT cache) lives in systemd's StateDirectory=surroundd, created by systemd.
+# tests/packaging/lintian_test.sh builds the package and fails on any lintian error.
 include(GNUInstallDirs)
+include(${CMAKE_CURRENT_LIST_DIR}/Manuals.cmake)
 
 install(TARGETS surroundd surroundctl surround-synth surround-calibrate surround-bench
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
@@ -10,12 +14,37 @@ install(FILES config/surroundd.yaml DESTINATION /etc/surroundd)
 install(FILES README.md config/surroundd.reference.yaml config/demo.yaml
         DESTINATION ${CMAKE_INSTALL_DOCDIR})
 install(DIRECTORY config/rigs DESTINATION ${CMAKE_INSTALL_DOCDIR})
+install(FILES cmake/debian/copyright DESTINATION ${CMAKE_INSTALL_DOCDIR})
+# A native package's changelog, compressed as Debian policy asks (gzip -9n: reproducible).
+set(changelog ${PROJECT_BINARY_DIR}/changelog.gz)
+add_custom_command(
+  OUTPUT ${changelog}
+  COMMAND gzip -9nc ${PROJECT_SOURCE_DIR}/cmake/debian/changelog > ${changelog}
+  DEPENDS ${PROJECT_SOURCE_DIR}/cmake/debian/changelog
+  COMMENT "changelog.gz")
+add_custom_target(changelog ALL DEPENDS ${changelog})
+install(FILES ${changelog} DESTINATION ${CMAKE_INSTALL_DOCDIR})
 
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME surroundd)
 set(CPACK_PACKAGE_VENDOR "surroundd")
-set(CPACK_PACKAGE_CONTACT "surroundd maintainers <surroundd@localhost>")
-set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "live 360-degree 3D surround view from four vehicle cameras")
+set(CPACK_PACKAGE_CONTACT "surroundd maintainers <maintainers@surroundd.dev>")
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "live 360-degree 3D surround view from vehicle cameras")
+# The extended description (CPack puts the summary above it as the synopsis).
+set(CPACK_DEBIAN_PACKAGE_DESCRIPTION
+    "surroundd is a daemon that gives a vehicle a live surround view from four
+cameras (V4L2, libcamera, or recorded files replayed as virtual cameras). It
+stitches them through a precomputed look-up table onto a spherical panorama,
+corrects colour across the seams with Poisson local colour correction,
+textures the panorama onto a flat, 360 or bowl mesh around a car model, and
+renders it with EGL and OpenGL ES to video files, network streams, a web
+page, an X11 window or a DRM/KMS display. It runs as a systemd service
+configured by one YAML file, and comes with tools to calibrate the cameras,
+to render synthetic recordings with ground truth, and to benchmark it.")
+set(CPACK_RESOURCE_FILE_LICENSE ${PROJECT_SOURCE_DIR}/LICENSE)
+# The binaries' debug info (RelWithDebInfo) goes into surroundd-dbgsym (a .ddeb, by build ID), and
+# the binaries in the package are stripped.
+set(CPACK_DEBIAN_DEBUGINFO_PACKAGE ON)
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION video)
