@@ -1,8 +1,9 @@
 #include "daemon/control_server.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
-#include <cstring>
+#include <optional>
 #include <stdexcept>
 #include <system_error>
 
@@ -10,22 +11,45 @@
 #include <fmt/format.h>
 #include <poll.h>
 #include <spdlog/spdlog.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 namespace surroundd::daemon {
 namespace {
 
-// A client has this long to send its request line.
-constexpr std::chrono::seconds kRequestTimeout{1};
+using Clock = std::chrono::steady_clock;
 
 }  // namespace
+
+struct ControlServer::Client {
+  enum class Phase { kReading, kWaiting, kWriting };
+
+  Client(UnixSocket s, Clock::time_point requestDeadline)
+      : socket(std::move(s)), deadline(requestDeadline) {}
+
+  UnixSocket socket;
+  Phase phase = Phase::kReading;
+  Clock::time_point deadline;
+  std::string line;   // what came so far
+  std::string reply;  // encoded, being sent
+  std::size_t sent = 0;
+  std::uint64_t ticket = 0;
+  bool done = false;  // replied, gone, or dropped: closed at the end of the loop's turn
+
+  void answer(const ControlReply& r, Clock::time_point now) {
+    reply = encodeReply(r);
+    sent = 0;
+    phase = Phase::kWriting;
+    deadline = now + kReplyTimeout;
+  }
+};
 
 ControlServer::ControlServer(std::filesystem::path path)
     : path_(std::move(path)),
       listener_(UnixSocket::listenOn(
           path_, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write |
                      std::filesystem::perms::group_read | std::filesystem::perms::group_write)) {
-  if (::pipe2(wakeFd_, O_CLOEXEC) != 0) {
+  if (::pipe2(wakeFd_, O_CLOEXEC | O_NONBLOCK) != 0) {
     throw std::runtime_error(
         fmt::format("control socket: pipe: {}", std::system_category().message(errno)));
   }
@@ -33,80 +57,182 @@ ControlServer::ControlServer(std::filesystem::path path)
 }
 
 ControlServer::~ControlServer() {
-  const char stop = 1;
-  [[maybe_unused]] const auto written = ::write(wakeFd_[1], &stop, 1);
   {
-    // A request waiting for the pipeline thread is answered now: nobody will serve it.
     const std::lock_guard lock(mutex_);
-    if (request_ && !reply_) reply_ = ControlReply::failure("surroundd is stopping");
+    stopping_ = true;
   }
-  answered_.notify_all();
+  wake();
   if (thread_.joinable()) thread_.join();
   ::close(wakeFd_[0]);
   ::close(wakeFd_[1]);
 }
 
-void ControlServer::run() {
-  for (;;) {
-    std::array<pollfd, 2> ready{{{listener_.fd(), POLLIN, 0}, {wakeFd_[0], POLLIN, 0}}};
-    if (::poll(ready.data(), ready.size(), -1) < 0 && errno != EINTR) return;
-    if (ready[1].revents != 0) return;
-    while (auto client = listener_.accept()) {
-      const ControlReply reply = answer(*client);
-      if (!client->sendAll(encodeReply(reply))) spdlog::debug("control: a client left early");
-    }
-  }
-}
-
-ControlReply ControlServer::answer(UnixSocket& client) {
-  const auto deadline = UnixSocket::Clock::now() + kRequestTimeout;
-  std::array<char, kMaxRequestBytes> buffer{};
-  std::size_t size = 0;
-  for (;;) {
-    const auto n = client.receiveSome(std::span(buffer).subspan(size), deadline);
-    if (n < 0) return ControlReply::failure("no complete request line in time");
-    if (n == 0) return ControlReply::failure("the request ended without a newline");
-    const auto* newline = std::find(buffer.begin() + size, buffer.begin() + size + n, '\n');
-    size += static_cast<std::size_t>(n);
-    if (newline != buffer.begin() + size) {
-      size = static_cast<std::size_t>(newline - buffer.begin());
-      break;
-    }
-    if (size == buffer.size()) {
-      return ControlReply::failure(fmt::format("request longer than {} bytes", kMaxRequestBytes));
-    }
-  }
-  const ParsedRequest parsed = parseControlRequest(std::string_view(buffer.data(), size));
-  if (!parsed.error.empty()) return ControlReply::failure(parsed.error);
-
-  std::unique_lock lock(mutex_);
-  request_ = parsed.request;
-  ++requestNumber_;
-  reply_.reset();
-  const bool done = answered_.wait_for(lock, kAnswerTimeout, [this] { return reply_.has_value(); });
-  request_.reset();
-  if (!done) return ControlReply::failure("surroundd is busy (no answer in time); try again");
-  return *std::exchange(reply_, std::nullopt);
+void ControlServer::wake() {
+  const char byte = 1;
+  [[maybe_unused]] const auto written = ::write(wakeFd_[1], &byte, 1);  // full: awake already
 }
 
 void ControlServer::serve(const Handler& handle) {
-  std::optional<ControlRequest> request;
-  std::uint64_t number = 0;
+  std::deque<std::pair<std::uint64_t, ControlRequest>> requests;
   {
     const std::lock_guard lock(mutex_);
-    if (!request_ || reply_) return;
-    request = request_;
-    number = requestNumber_;
+    if (waiting_.empty()) return;
+    requests.swap(waiting_);
   }
-  // Handled without the lock: a reply may take a while (a snapshot's PNG) and the server thread
-  // only waits for it.
-  ControlReply reply = handle(*request);
+  // Handled without the lock: the server thread goes on serving other clients meanwhile.
+  std::vector<std::pair<std::uint64_t, ControlAnswer>> answers;
+  answers.reserve(requests.size());
+  for (const auto& [ticket, request] : requests) answers.emplace_back(ticket, handle(request));
   {
     const std::lock_guard lock(mutex_);
-    // Not if the client gave up meanwhile (and perhaps another one asks now).
-    if (request_ && requestNumber_ == number) reply_ = std::move(reply);
+    for (auto& answer : answers) answered_.push_back(std::move(answer));
   }
-  answered_.notify_all();
+  wake();
+}
+
+void ControlServer::run() {
+  std::vector<Client> clients;
+  std::vector<pollfd> polled;
+  std::uint64_t nextTicket = 1;
+  std::array<char, kMaxRequestBytes> buffer{};
+  for (;;) {
+    const auto now = Clock::now();
+    // The pipeline's answers, to the clients still waiting for them.
+    std::vector<std::pair<std::uint64_t, ControlAnswer>> answers;
+    bool stopping = false;
+    {
+      const std::lock_guard lock(mutex_);
+      answers.swap(answered_);
+      stopping = stopping_;
+    }
+    for (auto& [ticket, answer] : answers) {
+      const auto client = std::ranges::find_if(clients, [id = ticket](const Client& c) {
+        return c.phase == Client::Phase::kWaiting && c.ticket == id;
+      });
+      if (client == clients.end()) continue;  // it gave up or left
+      if (answer.encode) answer.reply.body = answer.encode();
+      client->answer(answer.reply, now);
+    }
+    if (stopping) {
+      // Best effort: whoever still waits hears why, without blocking.
+      for (auto& client : clients) {
+        if (client.phase == Client::Phase::kWriting) continue;
+        const std::string reply = encodeReply(ControlReply::failure("surroundd is stopping"));
+        [[maybe_unused]] const auto n =
+            ::send(client.socket.fd(), reply.data(), reply.size(), MSG_DONTWAIT | MSG_NOSIGNAL);
+      }
+      return;
+    }
+    // Deadlines.
+    for (auto& client : clients) {
+      if (now < client.deadline) continue;
+      if (client.phase == Client::Phase::kReading) {
+        client.answer(ControlReply::failure("no complete request line in time"), now);
+      } else if (client.phase == Client::Phase::kWaiting) {
+        {
+          const std::lock_guard lock(mutex_);
+          std::erase_if(waiting_, [&](const auto& w) { return w.first == client.ticket; });
+        }
+        client.answer(ControlReply::failure("surroundd is busy (no answer in time); try again"),
+                      now);
+      } else {
+        client.done = true;  // it would not read its reply
+      }
+    }
+    std::erase_if(clients, [](const Client& c) { return c.done; });
+
+    polled.assign({{listener_.fd(), POLLIN, 0}, {wakeFd_[0], POLLIN, 0}});
+    auto nextDeadline = Clock::time_point::max();
+    for (const auto& client : clients) {
+      const short events = client.phase == Client::Phase::kReading   ? POLLIN
+                           : client.phase == Client::Phase::kWriting ? POLLOUT
+                                                                     : 0;
+      polled.push_back({client.socket.fd(), events, 0});
+      nextDeadline = std::min(nextDeadline, client.deadline);
+    }
+    int timeoutMs = -1;
+    if (nextDeadline != Clock::time_point::max()) {
+      timeoutMs = static_cast<int>(std::clamp<long long>(
+          std::chrono::ceil<std::chrono::milliseconds>(nextDeadline - Clock::now()).count(), 0,
+          1000));
+    }
+    if (::poll(polled.data(), polled.size(), timeoutMs) < 0 && errno != EINTR) {
+      spdlog::error("control socket: poll: {}", std::system_category().message(errno));
+      return;
+    }
+    const auto after = Clock::now();
+    if (polled[1].revents != 0) {
+      char drain[64];
+      while (::read(wakeFd_[0], drain, sizeof drain) > 0) {
+      }
+    }
+    for (std::size_t k = 0; k < clients.size(); ++k) {
+      Client& client = clients[k];
+      const short revents = polled[k + 2].revents;
+      if (revents == 0) continue;
+      if (client.phase == Client::Phase::kReading) {
+        const auto n = ::recv(client.socket.fd(), buffer.data(), buffer.size(), MSG_DONTWAIT);
+        if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
+        if (n <= 0) {
+          client.answer(ControlReply::failure("the request ended without a newline"), after);
+          continue;
+        }
+        client.line.append(buffer.data(), static_cast<std::size_t>(n));
+        const auto newline = client.line.find('\n');
+        if (newline == std::string::npos) {
+          if (client.line.size() >= kMaxRequestBytes) {
+            client.answer(ControlReply::failure(
+                              fmt::format("request longer than {} bytes", kMaxRequestBytes)),
+                          after);
+          }
+          continue;
+        }
+        std::string_view line(client.line.data(), newline);
+        if (line.ends_with('\r')) line.remove_suffix(1);  // CRLF, as telnet and nc -C send
+        const ParsedRequest parsed = parseControlRequest(line);
+        if (!parsed.error.empty()) {
+          client.answer(ControlReply::failure(parsed.error), after);
+          continue;
+        }
+        client.phase = Client::Phase::kWaiting;
+        client.ticket = nextTicket++;
+        client.deadline = after + kAnswerTimeout;
+        const std::lock_guard lock(mutex_);
+        waiting_.emplace_back(client.ticket, parsed.request);
+      } else if (client.phase == Client::Phase::kWriting) {
+        const auto n = ::send(client.socket.fd(), client.reply.data() + client.sent,
+                              client.reply.size() - client.sent, MSG_DONTWAIT | MSG_NOSIGNAL);
+        if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
+        if (n <= 0) {
+          spdlog::debug("control: a client left before its reply");
+          client.done = true;
+          continue;
+        }
+        client.sent += static_cast<std::size_t>(n);
+        client.done = client.sent == client.reply.size();
+      } else if ((revents & (POLLHUP | POLLERR)) != 0) {
+        client.done = true;  // left while waiting: its answer goes nowhere
+      }
+    }
+    std::erase_if(clients, [](const Client& c) { return c.done; });
+    if (polled[0].revents != 0) {
+      while (auto socket = listener_.accept()) {
+        if (clients.size() >= kMaxClients) {
+          // The longest still sending its request line makes room (clients are in arrival order).
+          const auto oldest = std::ranges::find_if(
+              clients, [](const Client& c) { return c.phase == Client::Phase::kReading; });
+          const std::string reply = encodeReply(ControlReply::failure(
+              fmt::format("too many clients ({} at once); try again", kMaxClients)));
+          const int fd = oldest != clients.end() ? oldest->socket.fd() : socket->fd();
+          [[maybe_unused]] const auto n =
+              ::send(fd, reply.data(), reply.size(), MSG_DONTWAIT | MSG_NOSIGNAL);
+          if (oldest == clients.end()) continue;  // every place waits on the pipeline
+          clients.erase(oldest);
+        }
+        clients.emplace_back(std::move(*socket), after + kRequestTimeout);
+      }
+    }
+  }
 }
 
 }  // namespace surroundd::daemon

@@ -114,7 +114,7 @@ ControlReply Service::reload() {
   }
 }
 
-ControlReply Service::answer(Pipeline& pipeline, const ControlRequest& request) {
+ControlAnswer Service::answer(Pipeline& pipeline, const ControlRequest& request) {
   using Kind = ControlRequest::Kind;
   switch (request.kind) {
     case Kind::kStatus:
@@ -133,9 +133,13 @@ ControlReply Service::answer(Pipeline& pipeline, const ControlRequest& request) 
     case Kind::kSnapshot: {
       const cv::Mat picture = pipeline.latestPicture();
       if (picture.empty()) return ControlReply::failure("no picture yet");
-      std::vector<uchar> png;
-      cv::imencode(".png", picture, png);
-      return ControlReply::success(std::string(png.begin(), png.end()));
+      // A copy here (the pipeline's buffer changes with the next set); the PNG is encoded on the
+      // control server's thread, not this one.
+      return {ControlReply::success({}), [copy = picture.clone()] {
+                std::vector<uchar> png;
+                cv::imencode(".png", copy, png);
+                return std::string(png.begin(), png.end());
+              }};
     }
     case Kind::kReload:
       return reload();

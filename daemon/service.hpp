@@ -44,7 +44,7 @@ class Service final : public PipelineObserver {
   void onStopping() override;
 
  private:
-  ControlReply answer(Pipeline& pipeline, const ControlRequest& request);
+  ControlAnswer answer(Pipeline& pipeline, const ControlRequest& request);
   // Reads the config file again; a good config becomes pending and ends the run.
   ControlReply reload();
 

@@ -62,7 +62,7 @@ UnixSocket UnixSocket::listenOn(const std::filesystem::path& path, std::filesyst
   server.ownedPath_ = path;
   std::filesystem::permissions(path, mode, error);
   if (error) throw failure(path, fmt::format("cannot set its mode: {}", error.message()));
-  if (::listen(server.fd_, 8) != 0) {
+  if (::listen(server.fd_, SOMAXCONN) != 0) {
     throw failure(path, fmt::format("cannot listen: {}", std::system_category().message(errno)));
   }
   ::fcntl(server.fd_, F_SETFL, ::fcntl(server.fd_, F_GETFL) | O_NONBLOCK);

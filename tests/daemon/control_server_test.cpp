@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
@@ -76,10 +77,17 @@ class ControlServerTest : public ::testing::Test {
     // Stands in for the pipeline thread: serves between "frame sets".
     pipeline_ = std::thread([this] {
       while (!stop_) {
-        server_->serve([this](const ControlRequest& request) {
+        server_->serve([this](const ControlRequest& request) -> ControlAnswer {
           ++served_;
           if (request.kind == Kind::kView && request.argument != "top") {
             return ControlReply::failure("unknown view '" + request.argument + "'");
+          }
+          if (request.kind == Kind::kSnapshot) {
+            // Like surroundd's: 16 MB, made off the pipeline thread.
+            return {ControlReply::success({}), [this] {
+                      encodedOnPipelineThread_ = std::this_thread::get_id() == pipeline_.get_id();
+                      return std::string(16 << 20, 'p');
+                    }};
           }
           return ControlReply::success(
               fmt::format("answer to {} {}", static_cast<int>(request.kind), request.argument));
@@ -99,6 +107,7 @@ class ControlServerTest : public ::testing::Test {
   std::unique_ptr<ControlServer> server_;
   std::atomic<bool> stop_{false};
   std::atomic<int> served_{0};
+  std::atomic<bool> encodedOnPipelineThread_{true};
   std::thread pipeline_;
 };
 
@@ -129,6 +138,68 @@ TEST_F(ControlServerTest, MisbehavingClientsGetAnErrorAndTheServerGoesOn) {
   EXPECT_EQ(served_, 0);  // none of them reached the pipeline
   EXPECT_EQ(exchange(path_, "status\n", false), "ok 12\nanswer to 0 ");
   EXPECT_EQ(served_, 1);
+}
+
+// A connected raw client that has sent `bytes` (maybe nothing) and reads nothing yet.
+int connectRaw(const std::filesystem::path& path, std::string_view bytes = {}) {
+  const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  std::snprintf(address.sun_path, sizeof(address.sun_path), "%s", path.c_str());
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  if (!bytes.empty()) {
+    [[maybe_unused]] const auto sent = ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+  }
+  return fd;
+}
+
+// Whether the server has said anything to `fd` yet (without waiting).
+bool heardBack(int fd) {
+  char byte = 0;
+  return ::recv(fd, &byte, 1, MSG_DONTWAIT | MSG_PEEK) > 0;
+}
+
+// Issue 18: one client at a time with a backlog of 8 let 500 idle connections hold up a client
+// for 33.7 s, and slow ones for seconds. Now every client has its own deadline: a client asking
+// while hundreds sit idle or trickle is answered before any of them has been timed out, and the
+// idle ones beyond the limit make room for it.
+TEST_F(ControlServerTest, IdleAndSlowClientsHoldUpNobody) {
+  std::vector<int> idle;
+  for (std::size_t k = 0; k < ControlServer::kMaxClients + 44; ++k) {
+    idle.push_back(connectRaw(path_));
+    ASSERT_GE(idle.back(), 0) << k;
+  }
+  const int slow = connectRaw(path_, "sta");
+  const auto reply = sendControlRequest(path_, "status", std::chrono::seconds(5));
+  EXPECT_TRUE(reply.ok) << reply.body;
+  // Answered while the newest idle ones and the slow one are still within their second.
+  EXPECT_FALSE(heardBack(slow));
+  EXPECT_FALSE(heardBack(idle.back()));
+  // The oldest made room, and were told so.
+  EXPECT_THAT(exchange(path_, "status\r\n", false), HasSubstr("ok "));  // CRLF is a line end
+  std::string first;
+  std::array<char, 256> buffer{};
+  const auto n = ::recv(idle.front(), buffer.data(), buffer.size(), 0);
+  if (n > 0) first.assign(buffer.data(), static_cast<std::size_t>(n));
+  EXPECT_THAT(first, HasSubstr("too many clients"));
+  for (const int fd : idle) ::close(fd);
+  ::close(slow);
+}
+
+// A client that asks for a big reply and never reads it holds up no other client, and the slow
+// part of an answer runs on the server's thread, not the pipeline's.
+TEST_F(ControlServerTest, AClientThatNeverReadsHoldsUpNobody) {
+  const int stuck = connectRaw(path_, "snapshot\n");
+  // Its reply has begun: the first bytes are waiting in its socket, the rest in the server.
+  pollfd readable{stuck, POLLIN, 0};
+  ASSERT_EQ(::poll(&readable, 1, 10'000), 1);
+  const auto reply = sendControlRequest(path_, "status", std::chrono::seconds(5));
+  EXPECT_TRUE(reply.ok);
+  EXPECT_FALSE(encodedOnPipelineThread_);
+  ::close(stuck);
 }
 
 TEST_F(ControlServerTest, ASecondServerOnTheSamePathIsRefusedAndAStaleOneReplaced) {
