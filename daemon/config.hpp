@@ -123,6 +123,7 @@ struct OutputConfig {
   std::string listenAddress = "127.0.0.1";  // only this machine, unless configured otherwise
   int listenPort = 8080;
   int jpegQuality = 80;
+  std::vector<std::string> allowedHosts;  // host names it answers to besides IPs and localhost
   // window (X11)
   std::string display;  // empty: $DISPLAY
   std::string title = "surroundd";

@@ -6,7 +6,8 @@
 // otherwise), the reply drained within kReplyTimeout (else the client is dropped). No client can
 // hold up another or the pipeline: idle, slow and never-reading clients only cost their own
 // connection; at kMaxClients a new client takes the place of the one that has been sending its
-// request line longest (told "too many clients"), so idle connections cannot lock others out. Lines may end in "\n" or
+// request line longest (told "too many clients"), so idle connections cannot lock others out. Lines
+// may end in "\n" or
 // "\r\n". A good request goes to the pipeline thread, which answers it in serve() between frame
 // sets; anything slow in an answer (a snapshot's PNG encoding) is handed back as `encode` and
 // runs on the server's thread.

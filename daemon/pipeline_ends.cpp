@@ -87,6 +87,7 @@ std::unique_ptr<render::HttpStreamSink> openHttp(const OutputConfig& output, Vie
   settings.address = output.listenAddress;
   settings.port = output.listenPort;
   settings.jpegQuality = output.jpegQuality;
+  settings.allowedHosts = output.allowedHosts;
   if (output.stream == OutputStream::kSurround) {
     for (const ViewKind kind : render::kViewKinds) settings.views.emplace_back(toString(kind));
     settings.initialView = toString(view);

@@ -264,6 +264,28 @@ std::optional<std::vector<double>> YamlObject::numberList(
   return result;
 }
 
+std::vector<std::string> YamlObject::strings(std::string_view key, std::size_t maxCount) {
+  if (!has(key)) return {};
+  const std::string expected = fmt::format("a list of at most {} non-empty strings", maxCount);
+  YAML::Node list = at(key);
+  if (!list.IsSequence() || list.size() > maxCount) {
+    error(key,
+          fmt::format("expected {}, got {}", expected,
+                      list.IsSequence() ? fmt::format("{} items", list.size()) : describe(list)));
+    return {};
+  }
+  std::vector<std::string> result;
+  for (const auto& item : list) {
+    if (!item.IsScalar() || item.Scalar().empty()) {
+      diag_->error(file_, item.Mark(), childPath(key),
+                   fmt::format("expected {}, got {}", expected, describe(item)));
+      return {};
+    }
+    result.push_back(item.Scalar());
+  }
+  return result;
+}
+
 std::optional<std::vector<std::array<double, 2>>> YamlObject::points(std::string_view key,
                                                                      std::size_t minCount) {
   if (!has(key)) return std::nullopt;

@@ -1,6 +1,8 @@
 #include "render/http_server.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cstdarg>
@@ -33,6 +35,32 @@ struct RequestState {
   std::size_t bodyBytes = 0;
   bool answered = false;
 };
+
+std::string lowered(std::string_view text) {
+  std::string out(text);
+  std::transform(out.begin(), out.end(), out.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return out;
+}
+
+// "host:port" -> "host"; "[::1]:port" -> "[::1]".
+std::string_view withoutPort(std::string_view host) {
+  if (host.starts_with('[')) {
+    const auto end = host.find(']');
+    return end == std::string_view::npos ? host : host.substr(0, end + 1);
+  }
+  const auto colon = host.rfind(':');
+  return colon == std::string_view::npos ? host : host.substr(0, colon);
+}
+
+bool isIpAddress(std::string_view name) {
+  std::array<unsigned char, sizeof(in6_addr)> address{};
+  if (name.starts_with('[') && name.ends_with(']')) {
+    const std::string inner(name.substr(1, name.size() - 2));
+    return inet_pton(AF_INET6, inner.c_str(), address.data()) == 1;
+  }
+  return inet_pton(AF_INET, std::string(name).c_str(), address.data()) == 1;
+}
 
 std::string errnoText(int error) {
   return std::error_code(error, std::generic_category()).message();
@@ -92,39 +120,125 @@ std::size_t urlBytes(MHD_Connection* connection, const char* url) {
 
 }  // namespace
 
-HttpServer::HttpServer(std::string name, const std::string& address, int port, Handler handler)
-    : name_(std::move(name)), handler_(std::move(handler)) {
+bool isAllowedHost(std::string_view host, const std::vector<std::string>& allowedHosts) {
+  const std::string name = lowered(withoutPort(host));
+  if (name.empty()) return false;
+  if (name == "localhost" || isIpAddress(name)) return true;
+  return std::ranges::any_of(allowedHosts, [&](const std::string& allowed) {
+    return lowered(withoutPort(allowed)) == name;
+  });
+}
+
+HttpServer::HttpServer(std::string name, const std::string& address, int port,
+                       std::vector<std::string> allowedHosts,
+                       std::chrono::milliseconds headerTimeout, Handler handler)
+    : name_(std::move(name)),
+      allowedHosts_(std::move(allowedHosts)),
+      headerTimeout_(headerTimeout),
+      handler_(std::move(handler)) {
   const int fd = listenOn(name_, address, port, port_);
   daemon_ = MHD_start_daemon(
       MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_THREAD_PER_CONNECTION | MHD_USE_POLL | MHD_USE_ITC |
           MHD_USE_ERROR_LOG,
       0, nullptr, nullptr, &HttpServer::onRequest, this, MHD_OPTION_EXTERNAL_LOGGER, &logFromServer,
       &name_, MHD_OPTION_LISTEN_SOCKET, fd, MHD_OPTION_CONNECTION_LIMIT, kMaxHttpConnections,
+      MHD_OPTION_PER_IP_CONNECTION_LIMIT, kMaxHttpConnectionsPerAddress,
       MHD_OPTION_CONNECTION_TIMEOUT, kIdleTimeoutS, MHD_OPTION_CONNECTION_MEMORY_LIMIT,
       kConnectionMemory, MHD_OPTION_NOTIFY_COMPLETED, &HttpServer::onCompleted, this,
-      MHD_OPTION_END);
+      MHD_OPTION_NOTIFY_CONNECTION, &HttpServer::onConnection, this, MHD_OPTION_END);
   if (daemon_ == nullptr) {
     ::close(fd);
     throw std::runtime_error(
         fmt::format("{}: cannot start the HTTP server on {}:{}", name_, address, port_));
   }
+  reaper_ = std::thread([this] { cutOffSlowHeaders(); });
 }
 
 HttpServer::~HttpServer() { stop(); }
 
 void HttpServer::stop() {
+  {
+    const std::lock_guard lock(headMutex_);
+    stopping_ = true;
+  }
+  reaperWake_.notify_all();
+  if (reaper_.joinable()) reaper_.join();
   if (daemon_ != nullptr) MHD_stop_daemon(daemon_);
   daemon_ = nullptr;
+}
+
+void HttpServer::onConnection(void* cls, MHD_Connection* connection, void** /*socketContext*/,
+                              MHD_ConnectionNotificationCode code) {
+  auto* self = static_cast<HttpServer*>(cls);
+  const std::lock_guard lock(self->headMutex_);
+  if (code == MHD_CONNECTION_NOTIFY_STARTED) {
+    const MHD_ConnectionInfo* info =
+        MHD_get_connection_info(connection, MHD_CONNECTION_INFO_CONNECTION_FD);
+    if (info != nullptr) {
+      self->connections_[connection] = {info->connect_fd, std::chrono::steady_clock::now()};
+    }
+  } else {
+    // Before libmicrohttpd closes the socket, so the reaper never touches a reused descriptor.
+    self->connections_.erase(connection);
+  }
+}
+
+void HttpServer::markHead(MHD_Connection* connection, bool sending) {
+  const std::lock_guard lock(headMutex_);
+  const auto open = connections_.find(connection);
+  if (open == connections_.end()) return;
+  open->second.headSince = sending ? std::optional(std::chrono::steady_clock::now()) : std::nullopt;
+}
+
+void HttpServer::cutOffSlowHeaders() {
+  std::unique_lock lock(headMutex_);
+  while (!stopping_) {
+    reaperWake_.wait_for(
+        lock, std::min<std::chrono::milliseconds>(headerTimeout_ / 2, std::chrono::seconds(1)));
+    const auto now = std::chrono::steady_clock::now();
+    for (auto& [connection, open] : connections_) {
+      if (!open.headSince || now - *open.headSince < headerTimeout_) continue;
+      // Its connection thread sees the socket fail and closes the connection itself.
+      ::shutdown(open.fd, SHUT_RDWR);
+      open.headSince.reset();
+      spdlog::debug("{}: a client that sent no whole request head in {} ms was cut off", name_,
+                    headerTimeout_.count());
+    }
+  }
 }
 
 MHD_Result HttpServer::onRequest(void* cls, MHD_Connection* connection, const char* url,
                                  const char* method, const char* /*version*/,
                                  const char* /*uploadData*/, size_t* uploadDataSize,
                                  void** requestState) {
+  auto* self = static_cast<HttpServer*>(cls);
   auto* state = static_cast<RequestState*>(*requestState);
   if (state == nullptr) {      // first call, headers only: refuse what is too large before a body
     state = new RequestState;  // deleted by onCompleted
     *requestState = state;
+    self->markHead(connection, false);  // its head is in
+    const char* host =
+        MHD_lookup_connection_value(connection, MHD_HEADER_KIND, MHD_HTTP_HEADER_HOST);
+    // No Host at all is an HTTP/1.0 client, not a browser (browsers always send one).
+    if (host != nullptr && !isAllowedHost(host, self->allowedHosts_)) {
+      state->answered = true;
+      return reply(connection, MHD_HTTP_MISDIRECTED_REQUEST,
+                   "this server does not answer to that Host; add it to the output's "
+                   "allowed_hosts\n");
+    }
+    // Only GET and HEAD may come from a page of another origin (a browser's cross-site form or
+    // fetch says where it comes from in Origin).
+    const std::string_view verb(method);
+    const char* origin =
+        MHD_lookup_connection_value(connection, MHD_HEADER_KIND, MHD_HTTP_HEADER_ORIGIN);
+    if (verb != "GET" && verb != "HEAD" && origin != nullptr) {
+      const std::string_view from(origin);
+      const auto scheme = from.find("://");
+      if (scheme == std::string_view::npos || lowered(from.substr(scheme + 3)) != lowered(host)) {
+        state->answered = true;
+        return reply(connection, MHD_HTTP_FORBIDDEN, "cross-origin request refused\n");
+      }
+    }
     std::uint64_t declared = 0;
     const char* length =
         MHD_lookup_connection_value(connection, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
@@ -149,13 +263,15 @@ MHD_Result HttpServer::onRequest(void* cls, MHD_Connection* connection, const ch
   if (state->bodyBytes > kMaxBodyBytes) {
     return reply(connection, MHD_HTTP_CONTENT_TOO_LARGE, "request body too large\n");
   }
-  return static_cast<HttpServer*>(cls)->handler_(connection, url, method);
+  return self->handler_(connection, url, method);
 }
 
-void HttpServer::onCompleted(void* /*cls*/, MHD_Connection* /*connection*/, void** requestState,
+void HttpServer::onCompleted(void* cls, MHD_Connection* connection, void** requestState,
                              MHD_RequestTerminationCode /*reason*/) {
   delete static_cast<RequestState*>(*requestState);
   *requestState = nullptr;
+  // Kept alive, the connection's next request head is on the clock from now.
+  static_cast<HttpServer*>(cls)->markHead(connection, true);
 }
 
 MHD_Result queue(MHD_Connection* connection, unsigned status, MHD_Response* response,
@@ -163,6 +279,8 @@ MHD_Result queue(MHD_Connection* connection, unsigned status, MHD_Response* resp
   if (response == nullptr) return MHD_NO;
   MHD_add_response_header(response, MHD_HTTP_HEADER_CONTENT_TYPE, contentType);
   MHD_add_response_header(response, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
+  // Error bodies repeat what the client sent: never let a browser take them for HTML.
+  MHD_add_response_header(response, "X-Content-Type-Options", "nosniff");
   const MHD_Result result = MHD_queue_response(connection, status, response);
   MHD_destroy_response(response);
   return result;

@@ -103,7 +103,8 @@ struct HttpStreamSink::Impl {
       : settings(validated(std::move(s))),
         encoder(settings.jpegQuality),
         activeView(settings.initialView),
-        server("HTTP stream", settings.address, settings.port,
+        server("HTTP stream", settings.address, settings.port, settings.allowedHosts,
+               settings.headerTimeout,
                [this](MHD_Connection* connection, std::string_view path, std::string_view method) {
                  return route(connection, path, method);
                }) {}

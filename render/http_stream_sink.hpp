@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "render/frame_sink.hpp"
+#include "render/http_server.hpp"
 
 namespace surroundd::render {
 
@@ -39,6 +40,9 @@ struct HttpStreamSettings {
   // (they become element ids and URL arguments). Empty: no switcher, every POST /view is 400.
   std::vector<std::string> views;
   std::string initialView;  // the view shown first, marked on the page; empty or one of `views`
+  // Host names (besides IP addresses and localhost) the server answers to; see HttpServer.
+  std::vector<std::string> allowedHosts;
+  std::chrono::milliseconds headerTimeout = kHeaderTimeout;  // for a whole request head
 
   // Throws std::invalid_argument naming the field.
   void validate() const;

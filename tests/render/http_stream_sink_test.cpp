@@ -7,6 +7,7 @@
 #include <future>
 #include <thread>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -226,6 +227,60 @@ TEST(HttpStreamSink, RefusesOversizedRequestsAndGoesOn) {
   EXPECT_TRUE(endless == 0 || endless == 413) << endless;
   EXPECT_EQ(sink.takeViewRequest(), std::nullopt);
 
+  EXPECT_EQ(httpRequest(sink.port(), "GET", "/status.json").status, 200);
+}
+
+// Issue 18: the Host header was never checked, POST /view had no Origin check, and error bodies
+// that repeat the request went out without nosniff: a web page the driver's browser opened could
+// switch views and, through DNS rebinding, read the snapshot.
+TEST(HttpStreamSink, ForeignHostsAndOriginsAreRefused) {
+  HttpStreamSettings settings = testSettings();
+  settings.allowedHosts = {"surround.local"};
+  HttpStreamSink sink(settings);
+  const auto get = [&](std::string_view host) {
+    return httpExchange(sink.port(), fmt::format("GET /snapshot.jpg HTTP/1.1\r\nHost: {}\r\n"
+                                                 "Connection: close\r\n\r\n",
+                                                 host));
+  };
+  EXPECT_EQ(get("attacker.example").status, 421);
+  EXPECT_EQ(get("attacker.example:" + std::to_string(sink.port())).status, 421);
+  for (const std::string& host : {fmt::format("127.0.0.1:{}", sink.port()), std::string("localhost"),
+                                 std::string("LOCALHOST:80"), std::string("[::1]:8080"),
+                                 std::string("surround.local:8080"), std::string("192.168.1.7")}) {
+    EXPECT_EQ(get(host).status, 503) << host;  // no picture yet, but answered
+  }
+  const auto post = [&](std::string_view origin) {
+    return httpExchange(sink.port(),
+                        fmt::format("POST /view?name=top HTTP/1.1\r\nHost: 127.0.0.1:{}\r\n{}"
+                                    "Content-Length: 0\r\nConnection: close\r\n\r\n",
+                                    sink.port(), origin));
+  };
+  const auto crossSite = post("Origin: http://attacker.example\r\n");
+  EXPECT_EQ(crossSite.status, 403);
+  EXPECT_EQ(sink.takeViewRequest(), std::nullopt);
+  EXPECT_EQ(post(fmt::format("Origin: http://127.0.0.1:{}\r\n", sink.port())).status, 202);
+  EXPECT_EQ(sink.takeViewRequest(), "top");
+  EXPECT_EQ(post("").status, 202);  // not from a browser page: no Origin
+  const auto echoed = httpRequest(sink.port(), "POST", "/view?name=<script>");
+  EXPECT_EQ(echoed.status, 400);
+  EXPECT_THAT(echoed.headers, HasSubstr("X-Content-Type-Options: nosniff"));
+  EXPECT_THAT(echoed.headers, HasSubstr("Content-Type: text/plain"));
+}
+
+// Issue 18: 16 clients sending a header line every 5 s kept every other request out for as long
+// as they liked. Now a request head must be whole within the header timeout, or the connection is
+// cut off (and one address holds at most 8 connections: libmicrohttpd's per-IP limit).
+TEST(HttpStreamSink, SlowHeadersAreCutOff) {
+  HttpStreamSettings settings = testSettings();
+  settings.headerTimeout = milliseconds(500);
+  HttpStreamSink sink(settings);
+  std::vector<std::unique_ptr<HttpConnection>> slow;
+  for (unsigned k = 0; k < kMaxHttpConnectionsPerAddress; ++k) {
+    slow.push_back(std::make_unique<HttpConnection>(sink.port()));
+    slow.back()->send("GET / HTTP/1.1\r\nX-a: b\r\n");  // and never the blank line
+  }
+  // Each is cut off once its head is overdue: its connection ends without an answer.
+  for (auto& connection : slow) EXPECT_EQ(connection->readUntil("\r\n"), std::nullopt);
   EXPECT_EQ(httpRequest(sink.port(), "GET", "/status.json").status, 200);
 }
 
