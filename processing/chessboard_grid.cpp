@@ -29,6 +29,11 @@ constexpr float kMinimumContrast = 8;
 // that is still taken as labelled right; a grid that skips corners fails a whole row or column.
 constexpr double kToleratedFailures = 0.05;
 
+// Corner (column i, row j) of a grid `w` columns wide, listed row by row.
+std::size_t index(int j, int w, int i) {
+  return static_cast<std::size_t>(j) * static_cast<std::size_t>(w) + static_cast<std::size_t>(i);
+}
+
 // Brightness of `smooth` (CV_32F) at each point, bilinear.
 std::vector<float> sampleAt(const cv::Mat& smooth, const std::vector<cv::Point2f>& points) {
   cv::Mat map(1, static_cast<int>(points.size()), CV_32FC2);
@@ -47,10 +52,7 @@ struct GridScores {
 
 GridScores scoreGrid(const cv::Mat& smooth, const ChessboardGrid& grid) {
   const int w = grid.size.width, h = grid.size.height;
-  const auto at = [&](int i, int j) {
-    return grid.corners[static_cast<std::size_t>(j) * static_cast<std::size_t>(w) +
-                        static_cast<std::size_t>(i)];
-  };
+  const auto at = [&](int i, int j) { return grid.corners[index(j, w, i)]; };
   // Each corner's four diagonal neighbourhoods, the steps to its neighbours taken forward and
   // back (at the grid's edge, the one step there is, both ways).
   std::vector<cv::Point2f> points;
@@ -113,7 +115,7 @@ ChessboardGrid withoutSide(const ChessboardGrid& grid, int side) {
           (side == 3 && i == w - 1)) {
         continue;
       }
-      smaller.corners.push_back(grid.corners[static_cast<std::size_t>(j * w + i)]);
+      smaller.corners.push_back(grid.corners[index(j, w, i)]);
     }
   }
   smaller.size = side < 2 ? cv::Size(w, h - 1) : cv::Size(w - 1, h);
@@ -127,7 +129,7 @@ int worstSide(const ChessboardGrid& grid, const std::vector<char>& goodCorners) 
   std::array<double, 4> failed{};
   for (int j = 0; j < h; ++j) {
     for (int i = 0; i < w; ++i) {
-      if (goodCorners[static_cast<std::size_t>(j * w + i)]) continue;
+      if (goodCorners[index(j, w, i)]) continue;
       if (j == 0) failed[0] += 1.0 / w;
       if (j == h - 1) failed[1] += 1.0 / w;
       if (i == 0) failed[2] += 1.0 / h;

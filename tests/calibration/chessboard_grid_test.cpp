@@ -5,6 +5,8 @@
 
 #include "processing/chessboard_grid.hpp"
 
+#include <numeric>
+
 #include <gtest/gtest.h>
 
 #include "tests/calibration/board_views_support.hpp"
@@ -14,34 +16,58 @@ namespace {
 
 using processing::ChessboardGrid;
 
+// Corner (column, row) of a grid `width` columns wide, listed row by row.
+std::size_t index(int column, int row, int width) {
+  return static_cast<std::size_t>(row) * static_cast<std::size_t>(width) +
+         static_cast<std::size_t>(column);
+}
+
+struct RenderedBoard {
+  cv::Mat gray;
+  ChessboardGrid board;  // 9x6, row by row; empty when the board was not found whole
+};
+
+// One rendered board for every test (a render takes about a second).
+const RenderedBoard& renderedBoard() {
+  static const RenderedBoard kRendered = [] {
+    RenderedBoard rendered;
+    const auto lens = presetCameras("paper.yaml").front().intrinsics;
+    rendered.gray = toGray(anyBoardViews(lens, chessboard(9, 6), 1, 31).front());
+    const auto found = processing::findBoard(rendered.gray, chessboard(9, 6));
+    if (found.outcome != processing::BoardSearch::Outcome::kFound || found.corners.size() != 54) {
+      return rendered;
+    }
+    rendered.board = {found.corners, found.seenGrid};
+    if (found.seenGrid.width < found.seenGrid.height) {  // listed column by column: the same grid
+      rendered.board = {{}, {found.seenGrid.height, found.seenGrid.width}};
+      rendered.board.corners.reserve(found.corners.size());
+      for (int row = 0; row < rendered.board.size.height; ++row) {
+        for (int column = 0; column < rendered.board.size.width; ++column) {
+          rendered.board.corners.push_back(found.corners[index(row, column, found.seenGrid.width)]);
+        }
+      }
+    }
+    return rendered;
+  }();
+  return kRendered;
+}
+
 class ChessboardGridCheck : public ::testing::Test {
  protected:
   void SetUp() override {
-    const auto lens = presetCameras("paper.yaml").front().intrinsics;
-    gray_ = toGray(anyBoardViews(lens, chessboard(9, 6), 1, 31).front());
-    auto found = processing::findBoard(gray_, chessboard(9, 6));
-    ASSERT_EQ(found.outcome, processing::BoardSearch::Outcome::kFound);
-    ASSERT_EQ(found.corners.size(), 54u);
-    board_ = {found.corners, found.seenGrid};
-    if (board_.size.width < board_.size.height) {  // listed column by column: the same grid
-      ChessboardGrid turned{{}, {board_.size.height, board_.size.width}};
-      for (int row = 0; row < turned.size.height; ++row) {
-        for (int column = 0; column < turned.size.width; ++column) {
-          turned.corners.push_back(
-              board_.corners[static_cast<std::size_t>(column * board_.size.width + row)]);
-        }
-      }
-      board_ = turned;
-    }
+    gray_ = renderedBoard().gray;
+    board_ = renderedBoard().board;
+    ASSERT_EQ(board_.size, cv::Size(9, 6)) << "the rendered board was not found whole";
   }
 
   cv::Point2f at(int column, int row) const {
-    return board_.corners[static_cast<std::size_t>(row * board_.size.width + column)];
+    return board_.corners[index(column, row, board_.size.width)];
   }
 
   // The board's corners of these columns and rows, relabelled 0, 1, 2, ... each way.
   ChessboardGrid pick(const std::vector<int>& columns, const std::vector<int>& rows) const {
     ChessboardGrid grid{{}, {static_cast<int>(columns.size()), static_cast<int>(rows.size())}};
+    grid.corners.reserve(columns.size() * rows.size());
     for (const int row : rows) {
       for (const int column : columns) grid.corners.push_back(at(column, row));
     }
@@ -49,8 +75,8 @@ class ChessboardGridCheck : public ::testing::Test {
   }
 
   static std::vector<int> upTo(int count) {
-    std::vector<int> all;
-    for (int i = 0; i < count; ++i) all.push_back(i);
+    std::vector<int> all(static_cast<std::size_t>(count));
+    std::iota(all.begin(), all.end(), 0);
     return all;
   }
 

@@ -22,7 +22,7 @@ using surroundd::testing::TempDir;
 using ::testing::HasSubstr;
 
 std::filesystem::path writeViews(const TempDir& dir, const std::vector<cv::Mat>& images) {
-  const auto folder = dir / "views";
+  auto folder = dir / "views";
   std::filesystem::create_directories(folder);
   for (std::size_t i = 0; i < images.size(); ++i) {
     cv::imwrite((folder / fmt::format("view_{:02}.png", i)).string(), images[i]);
@@ -54,8 +54,8 @@ void expectRefused(const CalibrateRun& run, int status, const std::string& messa
 }
 
 const processing::Intrinsics& pinhole() {
-  static const auto lens = presetCameras("paper.yaml").front().intrinsics;
-  return lens;
+  static const auto kLens = presetCameras("paper.yaml").front().intrinsics;
+  return kLens;
 }
 
 TEST(IntrinsicsCli, ASquareBoardPassesWithItsTable) {

@@ -4,6 +4,7 @@
 // agreeing with an independent cv::calibrateCamera solve on the classic detector's corners.
 
 #include <filesystem>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <gmock/gmock.h>
@@ -24,13 +25,13 @@ using surroundd::testing::TempDir;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-const std::filesystem::path kData = "/usr/share/doc/opencv-doc/examples/data";
-const cv::Size kInner{9, 6};
+constexpr std::string_view kData = "/usr/share/doc/opencv-doc/examples/data";
+constexpr int kColumns = 9, kRows = 6;  // inner corners
 
 std::vector<std::filesystem::path> pictures(const std::string& side) {
   std::vector<std::filesystem::path> files;
   for (int i = 1; i <= 14; ++i) {  // there is no number 10
-    const auto file = kData / fmt::format("{}{:02}.jpg", side, i);
+    const auto file = std::filesystem::path(kData) / fmt::format("{}{:02}.jpg", side, i);
     if (std::filesystem::exists(file)) files.push_back(file);
   }
   return files;
@@ -42,7 +43,7 @@ std::vector<std::filesystem::path> pictures(const std::string& side) {
 // against 537 on the right camera).
 std::optional<std::vector<cv::Point2f>> classicCorners(const cv::Mat& gray) {
   std::vector<cv::Point2f> found;
-  if (!cv::findChessboardCorners(gray, kInner, found)) return std::nullopt;
+  if (!cv::findChessboardCorners(gray, {kColumns, kRows}, found)) return std::nullopt;
   cv::cornerSubPix(gray, found, {5, 5}, {-1, -1},
                    {cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 30, 0.01});
   return found;
@@ -51,7 +52,7 @@ std::optional<std::vector<cv::Point2f>> classicCorners(const cv::Mat& gray) {
 class OpencvDoc : public ::testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
-    if (!std::filesystem::exists(kData / "left01.jpg")) {
+    if (!std::filesystem::exists(std::filesystem::path(kData) / "left01.jpg")) {
       GTEST_SKIP() << "opencv-doc is not installed (" << kData << ")";
     }
   }
@@ -66,7 +67,8 @@ TEST_P(OpencvDoc, EveryPictureIsFoundWholeAndLabelledAsTheClassicDetectorLabelsI
     const cv::Mat gray = cv::imread(file.string(), cv::IMREAD_GRAYSCALE);
     const auto classic = classicCorners(gray);
     ASSERT_TRUE(classic);
-    const auto found = processing::findBoard(gray, {processing::BoardKind::kChessboard, kInner});
+    const auto found =
+        processing::findBoard(gray, {processing::BoardKind::kChessboard, {kColumns, kRows}});
     ASSERT_EQ(found.outcome, processing::BoardSearch::Outcome::kFound);
     ASSERT_EQ(found.corners.size(), classic->size());
     // Each corner's classic label: the classic corner it sits on.
@@ -79,8 +81,8 @@ TEST_P(OpencvDoc, EveryPictureIsFoundWholeAndLabelledAsTheClassicDetectorLabelsI
       // On the same corner: within a quarter of the smallest square (21 px). Where the two
       // refinements differ by more than a pixel or two, the solves judge which is better.
       EXPECT_LT(cv::norm((*classic)[nearest] - corner), 5.0);
-      labels.emplace_back(static_cast<int>(nearest) % kInner.width,
-                          static_cast<int>(nearest) / kInner.width);
+      labels.emplace_back(static_cast<int>(nearest) % kColumns,
+                          static_cast<int>(nearest) / kColumns);
     }
     // The map from our (column, row) to the classic one, from grid (0, 0) and its neighbours.
     const auto labelAt = [&](cv::Point g) {
@@ -112,8 +114,8 @@ cv::Matx33d independentSolve(const std::vector<std::filesystem::path>& files, do
     if (!found) continue;
     corners.push_back(*found);
     objects.emplace_back();
-    for (int j = 0; j < kInner.height; ++j) {
-      for (int i = 0; i < kInner.width; ++i) objects.back().emplace_back(i, j, 0);
+    for (int j = 0; j < kRows; ++j) {
+      for (int i = 0; i < kColumns; ++i) objects.back().emplace_back(i, j, 0);
     }
   }
   cv::Matx33d k;
