@@ -8,6 +8,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "processing/calibration_targets.hpp"
+#include "processing/chessboard_grid.hpp"
 #include "processing/target_detection.hpp"
 
 namespace surroundd::processing {
@@ -30,34 +31,57 @@ bool spansAPlane(const std::vector<cv::Point>& grid) {
          rows.size() >= 2;
 }
 
+// The grid a chessboard search grew from a block of `block` x `block` corners (CALIB_CB_LARGER),
+// its labels checked in the picture (chessboard_grid.hpp): as much of the board as is in view.
+// A first pass without the exhaustive search is several times faster and finds most boards.
+std::optional<ChessboardGrid> grownGrid(const cv::Mat& gray, int block) {
+  ChessboardGrid grid;
+  cv::Mat meta;
+  const int flags = cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_LARGER;
+  if (!cv::findChessboardCornersSB(gray, {block, block}, grid.corners, flags, meta) &&
+      !cv::findChessboardCornersSB(gray, {block, block}, grid.corners,
+                                   flags | cv::CALIB_CB_EXHAUSTIVE, meta)) {
+    return std::nullopt;
+  }
+  grid.size = {meta.cols, meta.rows};
+  return checkedChessboardGrid(gray, std::move(grid));
+}
+
+// The whole board, by the detectors that look for exactly its size (row by row; which end is
+// first does not matter here).
+std::optional<ChessboardGrid> wholeBoard(const cv::Mat& gray, cv::Size inner) {
+  ChessboardGrid grid{{}, inner};
+  if (cv::findChessboardCornersSB(gray, inner, grid.corners, cv::CALIB_CB_NORMALIZE_IMAGE) ||
+      cv::findChessboardCorners(gray, inner, grid.corners,
+                                cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE)) {
+    return grid;
+  }
+  return std::nullopt;
+}
+
 BoardSearch findChessboard(const cv::Mat& gray, const CalibrationBoard& board) {
   BoardSearch found;
   const cv::Size inner = board.innerCorners();
-  const int block = std::min({kPartialBlock, inner.width, inner.height});
-  // CALIB_CB_LARGER: the grid grows from the block to as much of the board as is in view, and
-  // `meta` says how large that is. A first pass without the exhaustive search is several times
-  // faster and finds most boards.
-  std::vector<cv::Point2f> corners;
-  cv::Mat meta;
-  const int flags = cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_LARGER;
-  if (!cv::findChessboardCornersSB(gray, {block, block}, corners, flags, meta) &&
-      !cv::findChessboardCornersSB(gray, {block, block}, corners, flags | cv::CALIB_CB_EXHAUSTIVE,
-                                   meta)) {
-    return found;
-  }
-  found.seenGrid = {meta.cols, meta.rows};
-  if (static_cast<int>(corners.size()) != found.seenGrid.area()) return found;
-  if (!fits(found.seenGrid, inner)) {
+  auto grid = grownGrid(gray, std::min({kPartialBlock, inner.width, inner.height}));
+  if (grid && !fits(grid->size, inner)) {
+    found.seenGrid = grid->size;
     found.outcome = BoardSearch::Outcome::kLargerThanBoard;
     return found;
   }
-  refineCheckerboardCorners(gray, corners, found.seenGrid);
-  for (int row = 0; row < found.seenGrid.height; ++row) {
-    for (int column = 0; column < found.seenGrid.width; ++column) {
+  // A grown grid that is not the whole board (or none, or one whose labels were wrong) may be a
+  // detector's miss on a board that is all there: the detectors for exactly its size find it.
+  if (!grid || grid->size.area() < inner.area()) {
+    if (auto whole = wholeBoard(gray, inner)) grid = std::move(whole);
+  }
+  if (!grid) return found;
+  found.seenGrid = grid->size;
+  refineCheckerboardCorners(gray, grid->corners, grid->size);
+  for (int row = 0; row < grid->size.height; ++row) {
+    for (int column = 0; column < grid->size.width; ++column) {
       found.grid.emplace_back(column, row);
     }
   }
-  found.corners = std::move(corners);
+  found.corners = std::move(grid->corners);
   found.outcome =
       spansAPlane(found.grid) ? BoardSearch::Outcome::kFound : BoardSearch::Outcome::kNotFound;
   return found;

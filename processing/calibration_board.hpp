@@ -51,8 +51,11 @@ struct BoardSearch {
 };
 
 // Looks for `board` in `gray` (CV_8U). A chessboard seen only in part is found when at least a
-// 4x4 block of its corners (or the whole board, if smaller) is in view. May take seconds on a
-// large picture with no board in it (searchPictures() bounds that).
+// 4x4 block of its corners (or the whole board, if smaller) is in view; a grid grown from such a
+// block is checked in the picture and cut back or dropped where it went past the board or skipped
+// corners (chessboard_grid.hpp), and when it is not the whole board, the whole board is looked
+// for as such. May take seconds on a large picture with no board in it (searchPictures() bounds
+// that).
 BoardSearch findBoard(const cv::Mat& gray, const CalibrationBoard& board);
 
 }  // namespace surroundd::processing

@@ -138,11 +138,15 @@ CoverageMap coverageOf(std::span<const BoardView> views, cv::Size imageSize, con
 
 FieldOfView fieldOfViewOf(const Intrinsics& lens, const ImageCircle& circle) {
   FieldOfView field;
-  double halfRad = widestLitFieldAngle(lens, circle.lit);
-  field.fromImageCircle = circle.seenInImage;
-  if (const auto cut = CameraModel(lens).fieldCut(); cut && halfRad >= cut->atRad - 1e-6) {
-    field.note = fmt::format("limited to {:.1f} deg, where the solved distortion stops increasing",
-                             2 * cut->atRad * kToDeg);
+  const auto lit = widestLitFieldAngle(lens, circle.lit);
+  double halfRad = lit.rad;
+  field.fromImageCircle = circle.seenInImage && !lit.pastTheLens;
+  if (const auto cut = CameraModel(lens).fieldCut();
+      lit.pastTheLens || (cut && halfRad >= cut->atRad - 1e-6)) {
+    field.note = fmt::format(
+        "limited to {:.1f} deg: short of the picture's {}, the solved distortion stops "
+        "increasing and gives no rays",
+        2 * halfRad * kToDeg, circle.seenInImage ? "image circle" : "corners");
   }
   if (!circle.seenInImage && halfRad > std::numbers::pi / 2) {
     field.note = fmt::format(

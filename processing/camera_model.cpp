@@ -212,7 +212,7 @@ std::optional<cv::Vec3d> CameraModel::unproject(const cv::Point2d& pixel) const 
   for (int i = 0; i < 50; ++i) {
     const double r2 = x * x + y * y;
     const double radial = 1 + r2 * (d[0] + r2 * (d[1] + r2 * d[4]));
-    const double dRadial = 2 * d[0] + r2 * (4 * d[1] + r2 * 6 * d[4]);  // d radial / d r2
+    const double dRadial = d[0] + r2 * (2 * d[1] + r2 * 3 * d[4]);  // d radial / d r2
     const double fx = x * radial + 2 * d[2] * x * y + d[3] * (r2 + 2 * x * x) - xd;
     const double fy = y * radial + d[2] * (r2 + 2 * y * y) + 2 * d[3] * x * y - yd;
     const double j00 = radial + 2 * x * x * dRadial + 2 * d[2] * y + 6 * d[3] * x;

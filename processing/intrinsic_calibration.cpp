@@ -128,11 +128,12 @@ IntrinsicCalibration calibrateIntrinsics(LensModel model, cv::Size imageSize,
   return result;
 }
 
-double widestLitFieldAngle(const Intrinsics& intrinsics, const cv::Mat& litMask) {
+LitFieldAngle widestLitFieldAngle(const Intrinsics& intrinsics, const cv::Mat& litMask) {
   // The field angle grows with the normalized radius, so the farthest lit pixel decides.
   const CameraModel model(intrinsics);
+  const cv::Point2d centre(intrinsics.cx, intrinsics.cy);
   double farthest = -1;
-  cv::Point2d pixel;
+  cv::Point2d pixel = centre;
   for (int y = 0; y < litMask.rows; ++y) {
     const auto* lit = litMask.ptr<std::uint8_t>(y);
     for (int x = 0; x < litMask.cols; ++x) {
@@ -145,9 +146,20 @@ double widestLitFieldAngle(const Intrinsics& intrinsics, const cv::Mat& litMask)
       }
     }
   }
-  if (farthest < 0) return model.intrinsics().maxFieldAngleRad;
-  const auto ray = model.unproject(pixel);
-  return ray ? std::acos(std::clamp((*ray)[2], -1.0, 1.0)) : model.intrinsics().maxFieldAngleRad;
+  LitFieldAngle field;
+  auto ray = model.unproject(pixel);
+  if (!ray) {
+    // Where the rays end on the line out to that pixel (the principal point always has one).
+    field.pastTheLens = true;
+    double inside = 0, outside = 1;
+    for (int i = 0; i < 40; ++i) {
+      const double middle = (inside + outside) / 2;
+      (model.unproject(centre + middle * (pixel - centre)) ? inside : outside) = middle;
+    }
+    ray = model.unproject(centre + inside * (pixel - centre));
+  }
+  field.rad = ray ? std::acos(std::clamp((*ray)[2], -1.0, 1.0)) : 0;
+  return field;
 }
 
 }  // namespace surroundd::processing

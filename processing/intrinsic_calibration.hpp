@@ -52,10 +52,18 @@ inline constexpr int kMinimumBoardViews = 5;
 IntrinsicCalibration calibrateIntrinsics(LensModel model, cv::Size imageSize,
                                          std::span<const BoardView> views);
 
-// A fisheye lens's field, as far as the images show it: the largest angle off the optical axis
-// of any pixel set in `litMask` (CV_8U, nonzero where some image was lit; a lens whose image circle
-// lies inside the sensor leaves its corners dark). Radians, within the model's monotonic range.
-double widestLitFieldAngle(const Intrinsics& intrinsics, const cv::Mat& litMask);
+struct LitFieldAngle {
+  double rad = 0;  // off the optical axis
+  // The farthest lit pixel has no ray in the solved model (its distortion turns back short of
+  // the image corners, as a pinhole fit to a wide lens often does): `rad` is where the rays end on
+  // the way out to it.
+  bool pastTheLens = false;
+};
+
+// A lens's field, as far as the images show it: the largest angle off the optical axis of any
+// pixel set in `litMask` (CV_8U, nonzero where some image was lit; a lens whose image circle lies
+// inside the sensor leaves its corners dark), within the model's monotonic range.
+LitFieldAngle widestLitFieldAngle(const Intrinsics& intrinsics, const cv::Mat& litMask);
 
 // The fisheye solve's standard deviations, which cv::fisheye::calibrate computes but does not
 // return: from the Jacobian of every residual (cv::fisheye::projectPoints) over the 8 lens and

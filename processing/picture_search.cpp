@@ -16,8 +16,8 @@ using Clock = std::chrono::steady_clock;
 
 // Everything a worker touches, shared with the caller: an abandoned worker may outlive the call.
 struct SearchState {
-  SearchState(std::size_t count, PictureLoader load, CalibrationBoard searched)
-      : loader(std::move(load)), board(std::move(searched)), results(count), finished(count) {}
+  SearchState(std::size_t count, PictureLoader load, const CalibrationBoard& searched)
+      : loader(std::move(load)), board(searched), results(count), finished(count) {}
 
   PictureLoader loader;  // only used before a picture's bound starts (see workerLoop)
   const CalibrationBoard board;

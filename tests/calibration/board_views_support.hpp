@@ -1,6 +1,7 @@
 #pragma once
 // Generated pictures of any calibration board for the intrinsics tests: chessboards and ChArUco
-// boards, seen whole or cut off at the image edge, optionally made harder (blur, more noise).
+// boards, seen whole or cut off at the image edge, optionally made harder (blur, noise,
+// vignetting).
 
 #include <opencv2/aruco.hpp>
 #include <opencv2/imgproc.hpp>
@@ -19,10 +20,20 @@ inline processing::Intrinsics widened(processing::Intrinsics lens, int margin) {
   return lens;
 }
 
+// What makes pictures harder than a sharp, evenly lit render: what a cheap wide lens and a
+// small sensor do to them.
+struct Hardship {
+  double blurSigmaPx = 0;   // Gaussian blur after the sensor (focus, motion), pixels
+  double noiseSigma = 1.5;  // sensor noise, 8-bit levels
+  double vignetting = -1;   // CameraPhotometrics::vignetting (0.7: half as bright at the edge);
+                            // < 0: the sensor's own (0.1 .. 0.4)
+};
+
 // Pictures of `board` covering the field of `lens`; with `margin` > 0, many of them cut off.
 inline std::vector<cv::Mat> anyBoardViews(const processing::Intrinsics& lens,
                                           const processing::CalibrationBoard& board, int count,
-                                          std::uint64_t seed, int margin = 0) {
+                                          std::uint64_t seed, int margin = 0,
+                                          const Hardship& hardship = {}) {
   const auto rendered = widened(lens, margin);
   constexpr double kSquareM = 0.05;
   // ChArUco inner corners sit one square in from the print's origin, a chessboard's at it: the
@@ -42,7 +53,11 @@ inline std::vector<cv::Mat> anyBoardViews(const processing::Intrinsics& lens,
                                                             board.markerToSquare, kSquareM),
                               pose));
     }
-    const cv::Mat image = renderer.render({}, scene, sensor(0), seed, frame++);
+    auto photometrics = sensor(0);
+    photometrics.noiseSigma = hardship.noiseSigma;
+    if (hardship.vignetting >= 0) photometrics.vignetting = hardship.vignetting;
+    cv::Mat image = renderer.render({}, scene, photometrics, seed, frame++);
+    if (hardship.blurSigmaPx > 0) cv::GaussianBlur(image, image, {0, 0}, hardship.blurSigmaPx);
     images.push_back(image(cv::Rect({margin, margin}, lens.imageSize)).clone());
   }
   return images;

@@ -271,7 +271,7 @@ TEST(CalibrateCli, UsageErrorsNameTheOption) {
   arguments.insert(arguments.end(), {"--field-of-view-deg", "190"});
   expectFailure(calibrate(dir, arguments), 2, "--field-of-view-deg: only a fisheye lens takes it");
   arguments = intrinsicsOn(dir, dir.path());
-  arguments.push_back("--update-rig");
+  arguments.emplace_back("--update-rig");
   expectFailure(calibrate(dir, arguments), 2, "--update-rig: missing its value");
   arguments.emplace_back((dir / "rig.yaml").string());
   expectFailure(calibrate(dir, arguments), 2, "--update-rig and --camera go together");

@@ -1,7 +1,7 @@
 // surround-calibrate intrinsics on injected failures (a wrong board size, repeated pictures, a
 // blurred picture, a solve outside its limits): each is refused with a message that names what
-// was wrong, a non-zero exit, and nothing written. And on Debian's opencv-doc photographs (skipped
-// without the package), against an independent cv::calibrateCamera solve.
+// was wrong, a non-zero exit, and nothing written. (Debian's opencv-doc photographs:
+// opencv_doc_test.cpp.)
 
 #include <chrono>
 #include <filesystem>
@@ -9,9 +9,7 @@
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <yaml-cpp/yaml.h>
 
 #include "tests/calibration/board_views_support.hpp"
 #include "tests/calibration/calibrate_run.hpp"
@@ -24,7 +22,7 @@ using surroundd::testing::TempDir;
 using ::testing::HasSubstr;
 
 std::filesystem::path writeViews(const TempDir& dir, const std::vector<cv::Mat>& images) {
-  const auto folder = dir / "views";
+  auto folder = dir / "views";
   std::filesystem::create_directories(folder);
   for (std::size_t i = 0; i < images.size(); ++i) {
     cv::imwrite((folder / fmt::format("view_{:02}.png", i)).string(), images[i]);
@@ -56,8 +54,8 @@ void expectRefused(const CalibrateRun& run, int status, const std::string& messa
 }
 
 const processing::Intrinsics& pinhole() {
-  static const auto lens = presetCameras("paper.yaml").front().intrinsics;
-  return lens;
+  static const auto kLens = presetCameras("paper.yaml").front().intrinsics;
+  return kLens;
 }
 
 TEST(IntrinsicsCli, ASquareBoardPassesWithItsTable) {
@@ -120,70 +118,6 @@ TEST(IntrinsicsCli, ASolveOutsideItsLimitsWritesNothingAndNamesViews) {
   EXPECT_THAT(run.output, HasSubstr("verdict: FAIL"));
   EXPECT_THAT(run.output, HasSubstr("views to drop first (--exclude view_"));
   EXPECT_THAT(run.output, HasSubstr("<- above the limit"));
-}
-
-// Debian's opencv-doc: 13 photographs of a 9x6 board from each camera of a stereo pair.
-const std::filesystem::path kOpencvDocData = "/usr/share/doc/opencv-doc/examples/data";
-
-cv::Matx33d independentSolve(const std::vector<std::filesystem::path>& files, double& rms) {
-  std::vector<std::vector<cv::Point3f>> objects;
-  std::vector<std::vector<cv::Point2f>> corners;
-  cv::Size size;
-  for (const auto& file : files) {
-    const cv::Mat gray = cv::imread(file.string(), cv::IMREAD_GRAYSCALE);
-    size = gray.size();
-    std::vector<cv::Point2f> found;
-    if (!cv::findChessboardCorners(gray, {9, 6}, found)) continue;
-    cv::cornerSubPix(gray, found, {11, 11}, {-1, -1},
-                     {cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 30, 0.01});
-    corners.push_back(found);
-    objects.emplace_back();
-    for (int j = 0; j < 6; ++j) {
-      for (int i = 0; i < 9; ++i) objects.back().emplace_back(i, j, 0);
-    }
-  }
-  cv::Matx33d k;
-  cv::Mat d;
-  std::vector<cv::Mat> r, t;
-  rms = cv::calibrateCamera(objects, corners, size, k, d, r, t);
-  return k;
-}
-
-TEST(IntrinsicsCli, OpencvDocPhotographsAgreeWithAnIndependentSolve) {
-  if (!std::filesystem::exists(kOpencvDocData / "left01.jpg")) {
-    GTEST_SKIP() << "opencv-doc is not installed (" << kOpencvDocData << ")";
-  }
-  for (const std::string side : {"left", "right"}) {
-    const TempDir dir;
-    std::filesystem::create_directories(dir / "views");
-    std::vector<std::filesystem::path> files;
-    for (int i = 1; i <= 14; ++i) {
-      const auto file = kOpencvDocData / fmt::format("{}{:02}.jpg", side, i);
-      if (!std::filesystem::exists(file)) continue;
-      files.push_back(file);
-      std::filesystem::copy_file(file, dir / "views" / file.filename());
-    }
-    const auto run =
-        calibrate(dir, {"intrinsics", "--images", (dir / "views").string(), "--board", "9x6",
-                        "--model", "pinhole", "--out", (dir / "lens.yaml").string()});
-    ASSERT_EQ(run.status, 0) << run.output;
-    const YAML::Node lens = YAML::LoadFile((dir / "lens.yaml").string())["lens"];
-    double rms = 0;
-    const auto k = independentSolve(files, rms);
-    const double fx = lens["fx_px"].as<double>(), fy = lens["fy_px"].as<double>();
-    const double cx = lens["cx_px"].as<double>(), cy = lens["cy_px"].as<double>();
-    const auto figures = fmt::format(
-        "{}: fx {:.2f} ({:+.2f} %), fy {:.2f} ({:+.2f} %), cx {:.2f} ({:+.2f} px), cy {:.2f} "
-        "({:+.2f} px); independent RMS {:.3f} px",
-        side, fx, 100 * (fx / k(0, 0) - 1), fy, 100 * (fy / k(1, 1) - 1), cx, cx - k(0, 2), cy,
-        cy - k(1, 2), rms);
-    std::cout << figures << "\n" << run.output.substr(run.output.find("RMS ")) << "\n";
-    RecordProperty(side, figures);
-    EXPECT_NEAR(fx / k(0, 0), 1, 0.01);
-    EXPECT_NEAR(fy / k(1, 1), 1, 0.01);
-    EXPECT_NEAR(cx, k(0, 2), 3);
-    EXPECT_NEAR(cy, k(1, 2), 3);
-  }
 }
 
 }  // namespace

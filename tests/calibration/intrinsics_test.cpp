@@ -4,8 +4,10 @@
 
 #include <numbers>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "processing/calibration_coverage.hpp"
 #include "processing/intrinsic_calibration.hpp"
 #include "processing/target_detection.hpp"
 #include "tests/calibration/calibration_test_support.hpp"
@@ -81,8 +83,37 @@ TEST(IntrinsicCalibration, FisheyeOfTheProductionRig) {
   cv::Mat lit = cv::Mat::zeros(truth.imageSize, CV_8U);
   for (const auto& image : images) lit |= toGray(image) > 16;
   const double toDeg = 360 / std::numbers::pi;  // half-angle in radians to full field in degrees
-  EXPECT_NEAR(processing::widestLitFieldAngle(truth, lit) * toDeg, 190, 0.5);
-  EXPECT_NEAR(processing::widestLitFieldAngle(result.intrinsics, lit) * toDeg, 190, 5);
+  EXPECT_NEAR(processing::widestLitFieldAngle(truth, lit).rad * toDeg, 190, 0.5);
+  EXPECT_NEAR(processing::widestLitFieldAngle(result.intrinsics, lit).rad * toDeg, 190, 5);
+}
+
+// A pinhole fit to a wide lens (Debian's opencv-doc right camera gave one) whose distortion turns
+// back short of the image corners: those corners have no ray, and the field ends where the rays
+// do, at the turn (k1 = -0.3: r (1 - 0.3 r^2) stops increasing at r = 1 / sqrt(0.9), 46.5 deg
+// off the axis, 372 px out; the image corners are 400 px out). It was reported as 0.0 deg.
+TEST(IntrinsicCalibration, APinholeWhoseDistortionTurnsShortOfTheCornersHasTheFieldToTheTurn) {
+  processing::Intrinsics lens;
+  lens.model = processing::LensModel::kPinhole;
+  lens.imageSize = {640, 480};
+  lens.fx = lens.fy = 530;
+  lens.cx = 320, lens.cy = 240;
+  lens.distortion = {-0.3, 0, 0, 0, 0};
+  const processing::ImageCircle wholePicture{cv::Mat(lens.imageSize, CV_8U, cv::Scalar(255)),
+                                             false};
+  const double turnDeg = std::atan(1 / std::sqrt(0.9)) * 180 / std::numbers::pi;
+  const auto lit = processing::widestLitFieldAngle(lens, wholePicture.lit);
+  EXPECT_TRUE(lit.pastTheLens);
+  EXPECT_NEAR(lit.rad * 180 / std::numbers::pi, turnDeg, 1.0);
+  const auto field = processing::fieldOfViewOf(lens, wholePicture);
+  EXPECT_NEAR(field.fullDeg, 2 * turnDeg, 2.0);
+  EXPECT_FALSE(field.fromImageCircle);
+  EXPECT_THAT(field.note, ::testing::HasSubstr("short of the picture's corners, the solved "
+                                               "distortion stops increasing"));
+  // Without the turn, the field runs to the image corners: atan(400 / 530) each way.
+  lens.distortion = {};
+  const auto straight = processing::fieldOfViewOf(lens, wholePicture);
+  EXPECT_NEAR(straight.fullDeg, 2 * std::atan(400.0 / 530) * 180 / std::numbers::pi, 0.2);
+  EXPECT_EQ(straight.note, "");
 }
 
 TEST(IntrinsicCalibration, TooFewViewsSaySoAndHowManyAreNeeded) {

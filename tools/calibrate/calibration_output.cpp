@@ -28,7 +28,10 @@ void writeAtomically(const std::filesystem::path& file, const std::string& text,
     std::ofstream stream(partial, std::ios::trunc | std::ios::binary);
     stream << text;
     if (!stream.flush()) {
-      throw std::runtime_error(fmt::format("{}: cannot write the file", partial.string()));
+      stream.close();
+      std::error_code ignored;
+      std::filesystem::remove(partial, ignored);  // a full disk leaves no half file behind
+      throw std::runtime_error(fmt::format("{}: cannot write the file", file.string()));
     }
   }
   if (check) {
@@ -39,7 +42,14 @@ void writeAtomically(const std::filesystem::path& file, const std::string& text,
       throw;
     }
   }
-  std::filesystem::rename(partial, file);
+  std::error_code renamed;
+  std::filesystem::rename(partial, file, renamed);
+  if (renamed) {
+    std::error_code ignored;
+    std::filesystem::remove(partial, ignored);
+    throw std::runtime_error(
+        fmt::format("{}: cannot replace the file ({})", file.string(), renamed.message()));
+  }
 }
 
 using Fields = std::function<void(YAML::Emitter&)>;

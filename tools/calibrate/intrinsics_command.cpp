@@ -172,6 +172,7 @@ void dropDuplicates(Detections& found) {
 
 std::string viewNames(const std::vector<processing::BoardView>& views) {
   std::vector<std::string> names;
+  names.reserve(views.size());
   for (const auto& view : views) names.push_back(view.name);
   return fmt::format("{}", fmt::join(names, ", "));
 }
@@ -269,9 +270,11 @@ void runIntrinsics(const IntrinsicsOptions& options, std::ostream& log) {
       "RMS reprojection error {:.3f} px.",
       result.views.size(), files.size(), options.images.string(), options.board.describe(),
       result.rmsPx);
+  // The pictures first: a picture that cannot be written then leaves no lens block behind that
+  // looks like a finished run.
+  writePictures(options, result, coverage, circle, used, log);
   writeLensBlock(options.out, lens, comment);
   log << "wrote " << options.out.string() << "\n";
-  writePictures(options, result, coverage, circle, used, log);
   if (options.updateRig) {
     updateRigLens(*options.updateRig, options.camera, lens, comment);
     log << fmt::format("updated camera '{}' in {}\n", options.camera, options.updateRig->string());

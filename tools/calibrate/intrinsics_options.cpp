@@ -27,8 +27,8 @@ shows a larger chessboard grid than --board names means the size is wrong: it is
 Pictures that are too blurred (--max-edge-width-px) or repeat an earlier view (the board where
 it already was) are skipped with a note.
 
-  --images DIR               folder of images (.png .jpg .jpeg .bmp .tif .tiff .pgm .ppm), one
-                             camera, one resolution
+  --images DIR               folder of images (.png .jpg .jpeg .bmp .tif .tiff .pgm .ppm .pnm),
+                             one camera, one resolution
   --board COLSxROWS          a chessboard's inner corners (where four squares meet), each 2 to
                              64: a board of 10x7 squares has 9x6
   --charuco COLSxROWS        a ChArUco board's squares (not corners), each 3 to 64

@@ -92,11 +92,12 @@ void writeCoveragePlot(const std::filesystem::path& file, const processing::Cove
   const double scale = std::max(1.0, static_cast<double>(kMinimumWidth) / size.width);
   cv::resize(canvas, canvas, {}, scale, scale, cv::INTER_NEAREST);
   for (int row = 0; row <= coverage.cells.height; ++row) {
-    const int y = static_cast<int>(row * size.height / coverage.cells.height * scale);
+    // On the cells' own (whole-pixel) edges, scaled.
+    const int y = static_cast<int>(coverage.cellRect(0, row).y * scale);
     cv::line(canvas, {0, y}, {canvas.cols, y}, cv::Scalar(90, 90, 90), 1);
   }
   for (int column = 0; column <= coverage.cells.width; ++column) {
-    const int x = static_cast<int>(column * size.width / coverage.cells.width * scale);
+    const int x = static_cast<int>(coverage.cellRect(column, 0).x * scale);
     cv::line(canvas, {x, 0}, {x, canvas.rows}, cv::Scalar(90, 90, 90), 1);
   }
   for (std::size_t v = 0; v < views.size(); ++v) {

@@ -2,6 +2,7 @@
 // other tools' calibrations imported into a rig file, and the body masks drawn for checking (see
 // --help).
 
+#include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <string_view>
@@ -59,8 +60,10 @@ int main(int argc, char** argv) {
   const int status = run({argv + 1, argv + argc});
   // The intrinsics' board search may have left a detection thread running past its time bound
   // (processing/picture_search.hpp): static destructors must not run under it, so the process
-  // ends here, with its output flushed, without them.
+  // ends here, with its output flushed, without them. Every file was written whole before this
+  // (calibration_output.cpp writes a .part and renames it), so none is left half-written.
   std::cout.flush();
   std::cerr.flush();
+  std::fflush(nullptr);  // whatever a library wrote through C's stdio
   std::_Exit(status);
 }
