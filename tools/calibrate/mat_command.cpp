@@ -84,7 +84,7 @@ void runMatExtrinsics(const ExtrinsicsOptions& options, std::ostream& log) {
     std::size_t failed = 0;
     for (const auto& camera : result.cameras) failed += camera.passed() ? 0 : 1;
     throw processing::CalibrationError(fmt::format(
-        "{} of {} cameras and {} seam checks failed (see the table above); nothing was written",
+        "{} of {} cameras failed, {} seam problems (see the table above); nothing was written",
         failed, result.cameras.size(), result.problems.size()));
   }
   std::vector<std::pair<std::string, processing::Pose>> mounts;

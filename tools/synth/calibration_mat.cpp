@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
 
 #include "tools/synth/calibration_scenes.hpp"
 
@@ -59,7 +60,9 @@ std::optional<processing::GroundMarker> placeBoard(
     for (const double sideways : {0.0, 0.2, -0.2, 0.4, -0.4}) {
       // Square to the car first, then turned to face along the heading.
       for (const double yawDeg : {0.0, 90.0, heading / kDegToRad - 90}) {
-        const cv::Point2d centre = from + distance * direction + sideways * distance * across;
+        // To the centimetre, as a mat's places are measured.
+        const cv::Point2d exact = from + distance * direction + sideways * distance * across;
+        const cv::Point2d centre(std::round(exact.x * 100) / 100, std::round(exact.y * 100) / 100);
         const bool onCar = centre.x + radius > car.low.x && centre.x - radius < car.high.x &&
                            centre.y + radius > car.low.y && centre.y - radius < car.high.y;
         if (onCar) continue;
@@ -132,6 +135,28 @@ processing::MarkerLayout printsOf(const processing::MatLayout& mat) {
   processing::MarkerLayout layout;
   for (const auto& board : mat.boards) layout.markers.push_back(board.print);
   return layout;
+}
+
+std::string matYaml(const processing::MatLayout& mat, std::string_view comment) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(12);
+  if (!comment.empty()) out << YAML::Comment(std::string(comment));
+  out << YAML::BeginMap << YAML::Key << "boards" << YAML::Value << YAML::BeginSeq;
+  for (const auto& board : mat.boards) {
+    const auto& print = board.print;
+    out << YAML::BeginMap << YAML::Key << "name" << YAML::Value << print.name;
+    out << YAML::Key << "inner_corners" << YAML::Value << YAML::Flow << YAML::BeginSeq
+        << print.board.innerCorners.width << print.board.innerCorners.height << YAML::EndSeq;
+    out << YAML::Key << "square_m" << YAML::Value << print.board.squareM;
+    out << YAML::Key << "x_m" << YAML::Value << print.centre[0];
+    out << YAML::Key << "y_m" << YAML::Value << print.centre[1];
+    if (print.centre[2] != 0) out << YAML::Key << "z_m" << YAML::Value << print.centre[2];
+    out << YAML::Key << "yaw_deg" << YAML::Value << print.yawDeg;
+    out << YAML::Key << "seen_by" << YAML::Value << YAML::Flow << board.seenBy;
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
 }
 
 }  // namespace surroundd::synth

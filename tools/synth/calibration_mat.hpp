@@ -6,6 +6,7 @@
 
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "processing/ground_mat.hpp"
@@ -27,5 +28,9 @@ processing::MatLayout groundMatAroundRig(std::span<const processing::CameraCalib
 
 // The mat's prints as ground markers, for the renderer.
 processing::MarkerLayout printsOf(const processing::MatLayout& mat);
+
+// The layout as surround-calibrate extrinsics --mat reads it (tools/calibrate/marker_file.hpp),
+// `comment` on top.
+std::string matYaml(const processing::MatLayout& mat, std::string_view comment);
 
 }  // namespace surroundd::synth
