@@ -11,6 +11,8 @@
 #include "tests/calibration/calibrate_run.hpp"
 #include "tests/calibration/calibration_test_support.hpp"
 #include "tests/support/test_support.hpp"
+#include "tools/calibrate/marker_file.hpp"
+#include "tools/synth/calibration_mat.hpp"
 
 namespace surroundd::calibration::testing {
 namespace {
@@ -195,6 +197,25 @@ TEST(MatCli, MissingPicturesAndOptionsThatDoNotGoTogether) {
   expectBadInput(dir, arguments,
                  "--mat: calibrates every camera the mat names from --images; --camera, --image, "
                  "--markers, --points and --residuals do not go with it");
+}
+
+// The README's example is the mat the generator lays around the fisheye preset, and reads back.
+TEST(MatCli, TheExampleMatIsTheGeneratorsForTheFisheyeRig) {
+  const auto example = calibrate::loadMatFile(std::string(SURROUNDD_SOURCE_DIR) +
+                                              "/config/mats/four-corner-mat.yaml");
+  const auto cameras = presetCameras("fisheye.yaml", {1280, 720});
+  const auto laid = synth::groundMatAroundRig(cameras, {{{7, 6}, 0.2}, {}});
+  ASSERT_EQ(example.boards.size(), laid.boards.size());
+  for (std::size_t b = 0; b < laid.boards.size(); ++b) {
+    const auto& a = example.boards[b];
+    const auto& e = laid.boards[b];
+    EXPECT_EQ(a.print.name, e.print.name);
+    EXPECT_EQ(a.seenBy, e.seenBy);
+    EXPECT_EQ(a.print.board.innerCorners, e.print.board.innerCorners);
+    EXPECT_DOUBLE_EQ(a.print.board.squareM, e.print.board.squareM);
+    EXPECT_NEAR(cv::norm(a.print.centre - e.print.centre), 0, 1e-9);
+    EXPECT_DOUBLE_EQ(a.print.yawDeg, e.print.yawDeg);
+  }
 }
 
 }  // namespace
