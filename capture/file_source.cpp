@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "capture/sequence_pattern.hpp"
 #include "common/ffmpeg_util.hpp"
 
 extern "C" {
@@ -24,17 +25,6 @@ constexpr int kSwsFlags = SWS_BICUBIC | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT;
 // A file cannot heal: after this many faults in a row without a frame, report the end instead of
 // letting a caller that retries on kFault spin forever.
 constexpr int kMaxConsecutiveFaults = 100;
-
-// A printf integer conversion ("%d", "%06d"): FFmpeg's image2 pattern. A lone '%' in a file name
-// is not one.
-bool isImageSequence(const std::string& path) {
-  for (auto at = path.find('%'); at != std::string::npos; at = path.find('%', at + 1)) {
-    auto end = at + 1;
-    while (end < path.size() && std::isdigit(static_cast<unsigned char>(path[end])) != 0) ++end;
-    if (end < path.size() && path[end] == 'd') return true;
-  }
-  return false;
-}
 
 // FFmpeg's demuxers for pictures: image2 (a pattern, or one named file) and the per-format pipes
 // (png_pipe, jpeg_pipe, ...). Their frame rate is a made-up default, not the file's.
@@ -113,7 +103,12 @@ struct FileSource::Impl {
 };
 
 void FileSource::Impl::open() {
-  const bool sequence = isImageSequence(settings.path.string());
+  const FileNameKind kind = classifyFileName(settings.path.string());
+  if (kind == FileNameKind::kTooWide) {
+    fail(fmt::format("is an image sequence pattern with a number wider than {} digits",
+                     kMaxSequenceDigits));
+  }
+  const bool sequence = kind == FileNameKind::kSequence;
   if (sequence && !(settings.sequenceFps > 0 && std::isfinite(settings.sequenceFps))) {
     fail(fmt::format("needs a positive frame rate, got {}", settings.sequenceFps));
   }
@@ -309,7 +304,7 @@ void FileSource::Impl::pace(Timestamp timestamp) {
 }
 
 bool isStillPicturePath(const std::filesystem::path& path) {
-  if (isImageSequence(path.string())) return false;
+  if (classifyFileName(path.string()) != FileNameKind::kPlainFile) return false;
   std::string extension = path.extension().string();
   std::ranges::transform(extension, extension.begin(),
                          [](unsigned char c) { return static_cast<char>(std::tolower(c)); });

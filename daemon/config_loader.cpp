@@ -2,17 +2,21 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <set>
 #include <span>
 
 #include <arpa/inet.h>
 #include <fmt/format.h>
+#include <sys/un.h>
 
 #include "daemon/config.hpp"
 #include "daemon/logging.hpp"
+#include "daemon/output_files.hpp"
 
 namespace surroundd::daemon {
 namespace {
+
+// A Unix socket's path, as sockaddr_un holds it with its terminating NUL.
+constexpr std::size_t kMaxSocketPathBytes = sizeof(sockaddr_un{}.sun_path) - 1;
 
 void readRig(YamlObject& root, Config& config) {
   auto rig = root.object("rig");
@@ -395,13 +399,29 @@ Config loadConfig(const std::filesystem::path& file) {
   }
   readSection("control", [&](YamlObject& s) {
     config.control.socket = s.outputPath("socket").value_or("");
+    if (config.control.socket.string().size() > kMaxSocketPathBytes) {
+      s.error("socket", fmt::format("expected a path of at most {} bytes (a Unix socket's limit), "
+                                    "got {} bytes",
+                                    kMaxSocketPathBytes, config.control.socket.string().size()));
+    }
     s.finish();
   });
-  std::set<std::filesystem::path> paths;
   for (auto& item : root.objectList("outputs", 1, 32)) {
     auto output = readOutput(item);
-    if (!output.path.empty() && !paths.insert(output.path.lexically_normal()).second) {
-      item.error("path", fmt::format("two outputs write '{}'", output.path.string()));
+    for (std::size_t earlier = 0; earlier < config.outputs.size(); ++earlier) {
+      const OutputConfig& other = config.outputs[earlier];
+      if (auto clash = outputFileClash(other, output)) {
+        item.error("path", fmt::format("{} (outputs[{}] too)", *clash, earlier));
+      }
+      const auto sharesAddress = [](const std::string& x, const std::string& y) {
+        return x == y || x == "0.0.0.0" || y == "0.0.0.0";
+      };
+      if (output.kind == OutputKind::kHttp && other.kind == OutputKind::kHttp &&
+          output.listenPort == other.listenPort && output.listenPort != 0 &&
+          sharesAddress(output.listenAddress, other.listenAddress)) {
+        item.error("listen", fmt::format("outputs[{}] listens on port {} already", earlier,
+                                         output.listenPort));
+      }
     }
     config.outputs.push_back(std::move(output));
   }

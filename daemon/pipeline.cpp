@@ -5,6 +5,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "daemon/output_files.hpp"
 #include "daemon/panorama_setup.hpp"
 #include "daemon/pipeline_ends.hpp"
 
@@ -53,7 +54,12 @@ Pipeline::Pipeline(const Config& config)
   }
   if (configured(OutputStream::kSurround)) setUpSurround(config);
   const double nominalFps = 1e9 / static_cast<double>(cameras_.front()->nominalPeriod().count());
-  for (const auto& output : config.outputs) {
+  for (OutputConfig output : config.outputs) {
+    if (auto path = unusedOutputPath(output); path != output.path) {
+      spdlog::info("{} holds what an earlier run wrote: this run writes {}", output.path.string(),
+                   path.string());
+      output.path = std::move(path);
+    }
     if (output.kind == OutputKind::kRecording) {
       recorders_.push_back(std::make_unique<RigRecorder>(
           RecordingSettings{output.path, output.lossless, output.crf, output.preset},

@@ -5,6 +5,7 @@
 #include "capture/file_source.hpp"
 #include "capture/libcamera_source.hpp"
 #include "capture/v4l2_source.hpp"
+#include "daemon/output_files.hpp"
 #include "render/drm_display_sink.hpp"
 #include "render/queued_sink.hpp"
 #include "render/x11_window_sink.hpp"
@@ -105,7 +106,7 @@ std::unique_ptr<render::FrameSink> openSink(const OutputConfig& output, cv::Size
     return std::make_unique<render::DrmDisplaySink>(
         render::DrmDisplaySettings{output.device, output.connector});
   }
-  if (output.path.has_parent_path()) std::filesystem::create_directories(output.path.parent_path());
+  if (output.path.has_parent_path()) createOutputFolder(output.path.parent_path(), output.path);
   if (output.kind == OutputKind::kSnapshot) {
     return std::make_unique<render::SnapshotSink>(
         output.path, std::chrono::duration_cast<std::chrono::nanoseconds>(

@@ -3,11 +3,13 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "daemon/output_files.hpp"
+
 namespace surroundd::daemon {
 
 RigRecorder::RigRecorder(RecordingSettings settings, std::vector<RigCamera> rig, double nominalFps)
     : settings_(std::move(settings)), rig_(std::move(rig)) {
-  std::filesystem::create_directories(settings_.folder);
+  createOutputFolder(settings_.folder, settings_.folder);
   for (auto& camera : rig_) {
     render::VideoEncoderSettings video;
     video.path = settings_.folder / (camera.calibration.name + ".mp4");

@@ -11,6 +11,8 @@
 
 #include <fmt/format.h>
 
+#include "capture/sequence_pattern.hpp"
+
 namespace surroundd::daemon {
 namespace {
 
@@ -22,9 +24,8 @@ constexpr double kDegToRad = std::numbers::pi / 180.0;
 // exists, with FFmpeg's image2 default start numbers.
 bool sequenceExists(const std::filesystem::path& pattern) {
   for (int index = 0; index <= 4; ++index) {
-    std::string name(pattern.string().size() + 32, '\0');
-    const int length = std::snprintf(name.data(), name.size(), pattern.c_str(), index);
-    if (length > 0 && std::filesystem::exists(name.substr(0, static_cast<std::size_t>(length)))) {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(capture::sequenceFrameName(pattern.string(), index), ec)) {
       return true;
     }
   }
@@ -44,7 +45,12 @@ capture::FileSourceSettings readSource(YamlObject& source) {
   if (!path) return settings;
   settings.path = *path;
   std::error_code ec;
-  if (path->string().find('%') != std::string::npos) {
+  const capture::FileNameKind kind = capture::classifyFileName(path->string());
+  if (kind == capture::FileNameKind::kTooWide) {
+    source.error("file", fmt::format("expected an image sequence pattern with %d or %0Nd (N up to "
+                                     "{}), got '{}' (its number is wider than that)",
+                                     capture::kMaxSequenceDigits, path->string()));
+  } else if (kind == capture::FileNameKind::kSequence) {
     if (!sequenceExists(*path)) {
       source.error(
           "file",

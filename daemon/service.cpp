@@ -32,22 +32,7 @@ void logSummary(const RunSummary& summary) {
   for (const auto& output : summary.outputs) spdlog::info("wrote {}", output);
 }
 
-std::filesystem::path numbered(const std::filesystem::path& path, int n) {
-  std::filesystem::path result = path;
-  result.replace_filename(
-      fmt::format("{}-{}{}", path.stem().string(), n, path.extension().string()));
-  return result;
-}
-
 }  // namespace
-
-Config afterReloads(Config config, int reloads) {
-  if (reloads == 0) return config;
-  for (auto& output : config.outputs) {
-    if (!output.path.empty()) output.path = numbered(output.path, reloads);
-  }
-  return config;
-}
 
 Service::Service(Config config, ServiceSignals& signals, ServiceNotifier notifier)
     : config_(std::move(config)), signals_(signals), notifier_(std::move(notifier)) {
@@ -66,7 +51,7 @@ int Service::run() {
   for (;;) {
     std::unique_ptr<Pipeline> pipeline;
     try {
-      pipeline = std::make_unique<Pipeline>(afterReloads(config_, reloads_));
+      pipeline = std::make_unique<Pipeline>(config_);
     } catch (const std::exception& e) {
       if (!previous) {
         spdlog::critical("{}", e.what());
@@ -85,7 +70,7 @@ int Service::run() {
     if (!pending_ || signals_.stop) return summary.failedOutputs == 0 ? 0 : 1;
     previous = std::exchange(config_, *std::exchange(pending_, std::nullopt));
     ++reloads_;
-    spdlog::info("reload: starting the pipeline for the new config (outputs get '-{}')", reloads_);
+    spdlog::info("reload: starting the pipeline for the new config (reload {})", reloads_);
   }
 }
 

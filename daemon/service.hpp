@@ -6,9 +6,9 @@
 // Reload (SIGHUP or `surroundctl reload`): the config file is read again on the pipeline thread.
 // A bad one is rejected with its messages and the running pipeline goes on untouched. A good one
 // ends the run (every output finalized) and a pipeline for it starts; if that cannot start (a
-// camera or output cannot be opened), the previous config is started again. Files written after
-// a reload get "-N" before their extension (N = reload count), so no finished file is
-// overwritten. The control socket stays where it was.
+// camera or output cannot be opened), the previous config is started again; its outputs take
+// new names where the files hold the last run's data (daemon/output_files.hpp). The control
+// socket stays where it was.
 //
 // Threads: everything here runs on the pipeline thread, but for the signal flags (atomics set by
 // the signal handlers) and the control server's own thread (see ControlServer).
@@ -56,8 +56,5 @@ class Service final : public PipelineObserver {
   std::unique_ptr<ControlServer> control_;
   std::atomic<bool> endRun_{false};  // read by Pipeline::run; set on this same thread
 };
-
-// The config as run after `reloads` reloads: files get "-N" before the extension (folders: after).
-Config afterReloads(Config config, int reloads);
 
 }  // namespace surroundd::daemon

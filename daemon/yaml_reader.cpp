@@ -2,13 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
 #include <fmt/format.h>
 
+#include "common/regular_file.hpp"
+
 namespace surroundd::daemon {
 namespace {
+
+// A config or rig file is a page of text; far more is no config of ours.
+constexpr std::size_t kMaxYamlBytes = std::size_t{16} << 20;
 
 std::string joinLines(const std::vector<std::string>& lines) {
   std::string all;
@@ -82,14 +86,14 @@ void Diagnostics::throwIfAny() const {
 }
 
 YAML::Node parseYamlFile(const std::filesystem::path& file) {
-  std::ifstream stream(file);
-  if (!stream) {
-    throw ConfigError(
-        {fmt::format("{}: cannot open the file ({})", file.string(),
-                     std::filesystem::exists(file) ? "not readable" : "it does not exist")});
+  std::string text;
+  try {
+    text = readRegularFile(file, kMaxYamlBytes);
+  } catch (const FileReadError& e) {
+    throw ConfigError({fmt::format("cannot open the file {}", e.what())});
   }
   try {
-    return YAML::Load(stream);
+    return YAML::Load(text);
   } catch (const YAML::Exception& e) {
     Diagnostics diag;
     diag.error(file, e.mark, "", fmt::format("not valid YAML: {}", e.msg));

@@ -73,6 +73,13 @@ std::optional<int> arucoDictionaryByName(std::string_view name) {
   return std::nullopt;
 }
 
+std::string_view arucoDictionaryName(int dictionary) {
+  for (const auto& [known, id] : kArucoDictionaries) {
+    if (id == dictionary) return known;
+  }
+  return "?";
+}
+
 std::string arucoDictionaryNames() {
   std::string names;
   for (const auto& [known, id] : kArucoDictionaries) {

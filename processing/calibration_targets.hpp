@@ -66,5 +66,7 @@ struct MarkerLayout {
 std::optional<int> arucoDictionaryByName(std::string_view name);
 // The names arucoDictionaryByName() knows, comma-separated, for messages.
 std::string arucoDictionaryNames();
+// The short name of a dictionary arucoDictionaryByName() knows; "?" for another.
+std::string_view arucoDictionaryName(int dictionary);
 
 }  // namespace surroundd::processing

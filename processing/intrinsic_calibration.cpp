@@ -18,6 +18,14 @@ cv::TermCriteria solverCriteria() {
           std::numeric_limits<double>::epsilon()};
 }
 
+std::vector<cv::Point3f> gridPoints(const BoardView& view) {
+  std::vector<cv::Point3f> points;
+  points.reserve(view.grid.size());
+  for (const auto& g : view.grid)
+    points.emplace_back(static_cast<float>(g.x), static_cast<float>(g.y), 0.0f);
+  return points;
+}
+
 ViewResiduals residualsOf(const CameraModel& model, const BoardView& view,
                           const std::vector<cv::Point3f>& pattern, const cv::Vec3d& rvec,
                           const cv::Vec3d& tvec) {
@@ -40,10 +48,18 @@ ViewResiduals residualsOf(const CameraModel& model, const BoardView& view,
   return out;
 }
 
+double widestAngle(const ViewResiduals& view, const std::vector<cv::Point3f>& pattern) {
+  double widest = 0;
+  for (const auto& p : pattern) {
+    const cv::Vec3d x = view.boardInCamera.toVehicle({p.x, p.y, p.z});
+    widest = std::max(widest, std::atan2(std::hypot(x[0], x[1]), x[2]));
+  }
+  return widest;
+}
+
 }  // namespace
 
 IntrinsicCalibration calibrateIntrinsics(LensModel model, cv::Size imageSize,
-                                         const Checkerboard& board,
                                          std::span<const BoardView> views) {
   if (static_cast<int>(views.size()) < kMinimumBoardViews) {
     throw CalibrationError(
@@ -51,24 +67,38 @@ IntrinsicCalibration calibrateIntrinsics(LensModel model, cv::Size imageSize,
                     "{} are needed (from different angles and field positions)",
                     views.size(), views.size() == 1 ? "" : "s", kMinimumBoardViews));
   }
-  const auto pattern = board.patternCorners();
-  const std::vector<std::vector<cv::Point3f>> objectPoints(views.size(), pattern);
+  std::vector<std::vector<cv::Point3f>> objectPoints;
   std::vector<std::vector<cv::Point2f>> imagePoints;
-  for (const auto& view : views) imagePoints.push_back(view.corners);
+  for (const auto& view : views) {
+    objectPoints.push_back(gridPoints(view));
+    imagePoints.push_back(view.corners);
+  }
 
+  IntrinsicCalibration result;
   Intrinsics in;
   in.model = model;
   in.imageSize = imageSize;
   std::vector<cv::Vec3d> rvecs, tvecs;
   try {
     if (model == LensModel::kPinhole) {
+      // What calibrateCamera starts from (it calls the same function).
+      result.startingFocalPx =
+          cv::initCameraMatrix2D(objectPoints, imagePoints, imageSize).at<double>(0, 0);
       cv::Matx33d k;
-      cv::Mat d;
-      cv::calibrateCamera(objectPoints, imagePoints, imageSize, k, d, rvecs, tvecs, 0,
+      cv::Mat d, deviationsIntrinsics, deviationsExtrinsics, perViewErrors;
+      cv::calibrateCamera(objectPoints, imagePoints, imageSize, k, d, rvecs, tvecs,
+                          deviationsIntrinsics, deviationsExtrinsics, perViewErrors, 0,
                           solverCriteria());
       for (int i = 0; i < 5; ++i) in.distortion[static_cast<std::size_t>(i)] = d.at<double>(i);
       in.fx = k(0, 0), in.fy = k(1, 1), in.cx = k(0, 2), in.cy = k(1, 2);
+      // Order: fx fy cx cy k1 k2 p1 p2 k3 ...
+      const auto deviation = [&](int i) { return deviationsIntrinsics.at<double>(i); };
+      auto& u = result.uncertainty;
+      u.fx = deviation(0), u.fy = deviation(1), u.cx = deviation(2), u.cy = deviation(3);
+      for (int i = 0; i < 5; ++i) u.distortion[static_cast<std::size_t>(i)] = deviation(4 + i);
     } else {
+      // cv::fisheye::calibrate starts every solve from f = the larger image side / pi.
+      result.startingFocalPx = std::max(imageSize.width, imageSize.height) / std::numbers::pi;
       cv::Matx33d k;
       cv::Vec4d d;
       cv::fisheye::calibrate(objectPoints, imagePoints, imageSize, k, d, rvecs, tvecs,
@@ -76,29 +106,25 @@ IntrinsicCalibration calibrateIntrinsics(LensModel model, cv::Size imageSize,
                              solverCriteria());
       for (int i = 0; i < 4; ++i) in.distortion[static_cast<std::size_t>(i)] = d[i];
       in.fx = k(0, 0), in.fy = k(1, 1), in.cx = k(0, 2), in.cy = k(1, 2);
-      // As wide as the polynomial stays monotonic; widestLitFieldAngle() narrows it to the lens.
+      // As wide as the polynomial stays monotonic; fieldOfViewOf() narrows it to the lens.
       in.maxFieldAngleRad = std::numbers::pi;
+      result.uncertainty = fisheyeUncertainty(in, objectPoints, imagePoints, rvecs, tvecs);
     }
   } catch (const cv::Exception& error) {
     throw CalibrationError(fmt::format("the solver failed: {}", error.err));
   }
   const CameraModel camera(in);
-  IntrinsicCalibration result;
   result.intrinsics = camera.intrinsics();
   double sumSquares = 0;
   std::size_t count = 0;
   for (std::size_t v = 0; v < views.size(); ++v) {
-    result.views.push_back(residualsOf(camera, views[v], pattern, rvecs[v], tvecs[v]));
+    result.views.push_back(residualsOf(camera, views[v], objectPoints[v], rvecs[v], tvecs[v]));
+    result.widestCornerAngleRad =
+        std::max(result.widestCornerAngleRad, widestAngle(result.views.back(), objectPoints[v]));
     for (const auto& r : result.views.back().residuals) sumSquares += r.dot(r);
-    count += pattern.size();
+    count += objectPoints[v].size();
   }
   result.rmsPx = std::sqrt(sumSquares / static_cast<double>(count));
-  if (!std::isfinite(result.rmsPx) || in.fx <= 0 || in.fy <= 0) {
-    throw CalibrationError(fmt::format(
-        "the solver did not converge (RMS {:.3g} px, fx {:.4g}, fy {:.4g}); give more views "
-        "with the board tilted and spread over the whole image",
-        result.rmsPx, in.fx, in.fy));
-  }
   return result;
 }
 

@@ -4,12 +4,13 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <stdexcept>
 #include <type_traits>
 
 #include <fmt/format.h>
 #include <zlib.h>
+
+#include "common/regular_file.hpp"
 
 namespace surroundd::processing {
 namespace {
@@ -17,6 +18,9 @@ namespace {
 constexpr char kMagic[8] = {'S', 'R', 'N', 'D', 'L', 'U', 'T', '\n'};
 // Bump when the layout of the file or the way the LUT is built changes.
 constexpr std::uint32_t kFormatVersion = 1;
+// Above any LUT a panorama the config allows makes (16384 x 8192 pixels of 8-byte taps: 1 GiB,
+// plus the blend taps): a larger file is no LUT of ours.
+constexpr std::size_t kMaxFileBytes = std::size_t{3} << 30;
 
 std::uint32_t crc(const void* data, std::size_t bytes) {
   return static_cast<std::uint32_t>(
@@ -162,9 +166,16 @@ std::filesystem::path PanoramaLutCache::fileFor(const std::string& key) const {
 
 PanoramaLutCache::Lookup PanoramaLutCache::load(const std::string& key) const {
   const auto path = fileFor(key);
-  std::ifstream file(path, std::ios::binary);
-  if (!file) return {std::nullopt, "absent"};
-  const std::string bytes{std::istreambuf_iterator<char>(file), {}};
+  std::error_code ec;
+  if (!std::filesystem::exists(std::filesystem::symlink_status(path, ec))) {
+    return {std::nullopt, "absent"};
+  }
+  std::string bytes;
+  try {
+    bytes = readRegularFile(path, kMaxFileBytes);
+  } catch (const FileReadError& e) {
+    return {std::nullopt, fmt::format("{} is not usable ({})", path.string(), e.what())};
+  }
   const auto corrupt = [&](std::string_view what) {
     return Lookup{std::nullopt, fmt::format("{} is corrupt ({})", path.string(), what)};
   };
@@ -221,6 +232,8 @@ void PanoramaLutCache::store(const std::string& key, const PanoramaLut& lut) con
   const auto part = std::filesystem::path(path.string() + ".part");
   std::error_code error;
   std::filesystem::create_directories(folder_, error);
+  // Whatever has the temporary name goes first: writing into a FIFO left there would block.
+  std::filesystem::remove(part, error);
   {
     std::ofstream file(part, std::ios::binary | std::ios::trunc);
     file.write(writer.bytes().data(), static_cast<std::streamsize>(writer.bytes().size()));

@@ -110,11 +110,16 @@ std::optional<std::vector<cv::Point2f>> findCheckerboard(const cv::Mat& gray, cv
                                  cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE)) {
     return std::nullopt;
   }
-  // The largest window that stays inside one square: 0.4 of the smallest square.
-  const int half = std::clamp(static_cast<int>(smallestGridStep(corners, inner) * 0.4), 2, 11);
-  cv::cornerSubPix(gray, corners, {half, half}, {-1, -1}, subPixCriteria());
+  refineCheckerboardCorners(gray, corners, inner);
   orientBoard(corners, inner, gray);
   return corners;
+}
+
+void refineCheckerboardCorners(const cv::Mat& gray, std::vector<cv::Point2f>& corners,
+                               cv::Size grid) {
+  // The largest window that stays inside one square: 0.4 of the smallest square.
+  const int half = std::clamp(static_cast<int>(smallestGridStep(corners, grid) * 0.4), 2, 11);
+  cv::cornerSubPix(gray, corners, {half, half}, {-1, -1}, subPixCriteria());
 }
 
 std::vector<std::vector<cv::Point2f>> findCheckerboards(const cv::Mat& gray, cv::Size inner,

@@ -19,6 +19,11 @@ namespace surroundd::processing {
 std::optional<std::vector<cv::Point2f>> findCheckerboard(const cv::Mat& gray,
                                                          cv::Size innerCorners);
 
+// Sub-pixel corners of a grid of `grid` columns x rows (row by row), with the largest window that
+// stays inside one square.
+void refineCheckerboardCorners(const cv::Mat& gray, std::vector<cv::Point2f>& corners,
+                               cv::Size grid);
+
 // Every board of this pattern in the image, up to `maxCount` (each found one is painted over
 // before looking again).
 std::vector<std::vector<cv::Point2f>> findCheckerboards(const cv::Mat& gray, cv::Size innerCorners,

@@ -53,15 +53,15 @@ class VideoSink final : public FrameSink {
   std::string describe() const override;
 
  private:
-  std::filesystem::path segmentPath(int number) const;
+  std::filesystem::path segmentPath(std::int64_t number) const;
   void openSegment();
 
   VideoEncoderSettings settings_;
   std::chrono::nanoseconds segmentLength_;  // 0: one file
   std::optional<VideoEncoder> encoder_;
   std::optional<std::int64_t> window_;  // which multiple of segmentLength_ is being written
-  int firstSegment_ = 1;
-  int segment_ = 0;  // the one being written
+  std::int64_t firstSegment_ = 1;
+  std::int64_t segment_ = 0;  // the one being written
   std::uint64_t frames_ = 0;
 };
 

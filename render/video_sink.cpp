@@ -8,19 +8,22 @@
 namespace surroundd::render {
 namespace {
 
+// Numbers above this are refused rather than let to wrap (a stray "seg-9223372036854775807").
+constexpr std::int64_t kMaxSegment = 999'999'999'999;
+
 // The highest N of the <stem>-N<ext> files next to `path`, or 0.
-int lastSegmentIn(const std::filesystem::path& path) {
+std::int64_t lastSegmentIn(const std::filesystem::path& path) {
   const auto folder = path.parent_path().empty() ? std::filesystem::path(".") : path.parent_path();
   const std::string stem = path.stem().string();
   const std::string extension = path.extension().string();
-  int last = 0;
+  std::int64_t last = 0;
   std::error_code error;
   for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
     const std::string name = entry.path().filename().string();
     if (!name.starts_with(stem + "-") || !name.ends_with(extension)) continue;
     const std::string_view digits(name.data() + stem.size() + 1,
                                   name.size() - stem.size() - 1 - extension.size());
-    int number = 0;
+    std::int64_t number = 0;
     const auto [end, failed] =
         std::from_chars(digits.data(), digits.data() + digits.size(), number);
     if (failed == std::errc() && end == digits.data() + digits.size())
@@ -35,12 +38,18 @@ VideoSink::VideoSink(VideoEncoderSettings settings, std::chrono::nanoseconds seg
     : settings_(std::move(settings)), segmentLength_(segmentLength) {
   if (segmentLength_.count() > 0) {
     firstSegment_ = lastSegmentIn(settings_.path) + 1;
+    if (firstSegment_ > kMaxSegment) {
+      throw EncoderError(
+          fmt::format("{}: the segments beside it are numbered up to {}, the most "
+                      "there can be: move them away",
+                      segmentPath(firstSegment_ - 1).string(), kMaxSegment));
+    }
     segment_ = firstSegment_ - 1;
   }
   openSegment();
 }
 
-std::filesystem::path VideoSink::segmentPath(int number) const {
+std::filesystem::path VideoSink::segmentPath(std::int64_t number) const {
   auto path = settings_.path;
   path.replace_filename(fmt::format("{}-{:05}{}", settings_.path.stem().string(), number,
                                     settings_.path.extension().string()));

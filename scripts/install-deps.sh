@@ -11,7 +11,7 @@ PACKAGES="
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
   libx11-dev libxext-dev xvfb libdrm-dev libgbm-dev
   libturbojpeg0-dev libcamera-dev libsystemd-dev
-  libgtest-dev libgmock-dev
+  libgtest-dev libgmock-dev opencv-doc
   libmicrohttpd-dev chromium
 "
 

@@ -20,13 +20,16 @@ processing::IntrinsicCalibration calibrate(const processing::Intrinsics& truth,
                                            const std::vector<cv::Mat>& images) {
   std::vector<processing::BoardView> views;
   for (std::size_t i = 0; i < images.size(); ++i) {
-    if (auto corners = processing::findCheckerboard(toGray(images[i]), kBoard.innerCorners)) {
-      views.push_back({"view " + std::to_string(i), std::move(*corners)});
+    auto found = processing::findBoard(toGray(images[i]),
+                                       {processing::BoardKind::kChessboard, kBoard.innerCorners});
+    if (found.outcome == processing::BoardSearch::Outcome::kFound) {
+      views.push_back(
+          {"view " + std::to_string(i), std::move(found.corners), std::move(found.grid)});
     }
   }
   // The generator only makes views whose whole board is in the image and large enough.
   EXPECT_GE(views.size(), images.size() - 1);
-  return processing::calibrateIntrinsics(truth.model, truth.imageSize, kBoard, views);
+  return processing::calibrateIntrinsics(truth.model, truth.imageSize, views);
 }
 
 void expectCloseToTruth(const processing::IntrinsicCalibration& result,
@@ -84,9 +87,10 @@ TEST(IntrinsicCalibration, FisheyeOfTheProductionRig) {
 
 TEST(IntrinsicCalibration, TooFewViewsSaySoAndHowManyAreNeeded) {
   const auto truth = presetCameras("paper.yaml").front().intrinsics;
-  const std::vector<processing::BoardView> views(3, {"a.png", std::vector<cv::Point2f>(54)});
+  const std::vector<processing::BoardView> views(
+      3, {"a.png", std::vector<cv::Point2f>(54), std::vector<cv::Point>(54)});
   expectCalibrationError(
-      [&] { processing::calibrateIntrinsics(truth.model, truth.imageSize, kBoard, views); },
+      [&] { processing::calibrateIntrinsics(truth.model, truth.imageSize, views); },
       "too few views: a board was found in 3 images, at least 5 are needed (from different angles "
       "and field positions)");
 }

@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "capture/sequence_pattern.hpp"
 #include "render/video_encoder.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/support/test_support.hpp"
@@ -23,6 +24,7 @@ using std::chrono::microseconds;
 using std::chrono::milliseconds;
 using ::testing::AllOf;
 using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 const cv::Size kSize(160, 120);
 constexpr int kMaxReads = 10'000;  // bounds every read loop: a source that never ends fails
@@ -274,6 +276,48 @@ TEST(FileSource, ImageSequenceReplaysExactly) {
     EXPECT_EQ(frame.sequence, static_cast<std::uint64_t>(i));
   }
   EXPECT_EQ(source.read(frame), ReadStatus::kEndOfStream);
+}
+
+// Only one %d or %0Nd makes a file name a pattern (FFmpeg's image2 rule); any other '%' leaves it
+// a plain name, which nothing formats (issue 18: "%s%s%s" was a crash, "%999999999d" 16 s).
+TEST(SequencePattern, OnlyOneIntegerConversionMakesAPattern) {
+  EXPECT_EQ(classifyFileName("front_%06d.png"), FileNameKind::kSequence);
+  EXPECT_EQ(classifyFileName("front_%d.png"), FileNameKind::kSequence);
+  EXPECT_EQ(classifyFileName("100%%_%03d.png"), FileNameKind::kSequence);
+  for (const char* plain : {"front.png", "100%.png", "x%s%s%s%s.png", "x%n%n%n.png", "x%d_%d.png",
+                            "x%d%s.png", "x%", "x%%d.png"}) {
+    EXPECT_EQ(classifyFileName(plain), FileNameKind::kPlainFile) << plain;
+  }
+  EXPECT_EQ(classifyFileName("x%999999999d.png"), FileNameKind::kTooWide);
+  EXPECT_EQ(classifyFileName("x%33d.png"), FileNameKind::kTooWide);
+  EXPECT_EQ(classifyFileName("x%032d.png"), FileNameKind::kSequence);
+  EXPECT_EQ(sequenceFrameName("front_%06d.png", 42), "front_000042.png");
+  EXPECT_EQ(sequenceFrameName("100%%_%d.png", 7), "100%_7.png");
+  EXPECT_THROW(sequenceFrameName("x%s%d.png", 1), std::invalid_argument);
+  EXPECT_THROW(sequenceFrameName("x%999999999d.png", 1), std::invalid_argument);
+}
+
+TEST(FileSource, APictureWithPercentsInItsNameIsAStill) {
+  const testing::TempDir dir;
+  const auto path = dir / "x%s%s%n%d%d.png";
+  cv::imwrite(path.string(), picture(2));
+  EXPECT_TRUE(isStillPicturePath(path));
+  FileSource source("front", {path, 10.0, true, Pacing::kAsFastAsPossible});
+  EXPECT_TRUE(source.repeatsOnePicture());
+  Frame frame;
+  frame.image.create(source.frameSize(), CV_8UC3);
+  ASSERT_EQ(source.read(frame), ReadStatus::kFrame) << source.lastError();
+  EXPECT_EQ(cv::norm(frame.image, picture(2), cv::NORM_INF), 0.0);
+}
+
+TEST(FileSource, ATooWideSequenceNumberIsRefused) {
+  const testing::TempDir dir;
+  EXPECT_THAT(
+      [&] {
+        FileSource("front", {dir / "x%999999999d.png", 10.0});
+      },
+      ThrowsMessage<CaptureError>(
+          AllOf(HasSubstr("camera 'front'"), HasSubstr("wider than 32 digits"))));
 }
 
 // A still picture as a camera: played at sequence_fps, looped with timestamps one period apart.

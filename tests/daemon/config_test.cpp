@@ -6,8 +6,10 @@
 #include <fstream>
 #include <string>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include "tests/daemon/config_test_support.hpp"
 #include "tests/support/temp_dir.hpp"
@@ -227,6 +229,22 @@ TEST_F(ConfigTest, MissingFile) {
                   (dir_ / "lfet.mkv").string(), "no such file"});
 }
 
+// A file name reaches no printf-family call (issue 18: "%s%s%s" crashed --check-config, a
+// "%999999999d" took 16 s): only one %d or %0Nd makes a sequence pattern.
+TEST_F(ConfigTest, PercentsInAFileNameAreNeverFormatted) {
+  for (const char* name : {"x%s%s%s%s%s%s%s%s.png", "x%n%n%n.png", "x%d%s.png"}) {
+    expectOneError(
+        "{file: left.mkv}", fmt::format("{{file: \"{}\"}}", name),
+        {"rig.cameras[1].source.file: expected an existing video file or picture", "no such file"});
+  }
+  expectOneError("{file: left.mkv}", "{file: x%999999999d.png}",
+                 {"rig.cameras[1].source.file: expected an image sequence pattern with %d or "
+                  "%0Nd (N up to 32)",
+                  "its number is wider than that"});
+  dir_.write("x%s%n.png", "");
+  EXPECT_NO_THROW(loadConfig(configWith("{file: left.mkv}", "{file: \"x%s%n.png\"}")));
+}
+
 // A still picture loops unless told not to, at sequence_fps; the frozen check is set per camera.
 TEST_F(ConfigTest, StillPicturesLoopAndTheFrozenCheckIsPerCamera) {
   dir_.write("front.png", "");
@@ -301,6 +319,18 @@ TEST_F(ConfigTest, MissingConfigFile) {
   ASSERT_EQ(messages.size(), 1u);
   EXPECT_THAT(messages[0], HasSubstr((dir_ / "absent.yaml").string()));
   EXPECT_THAT(messages[0], HasSubstr("cannot open"));
+}
+
+// A config (or rig) path that is no file is named and refused; a FIFO does not block the reader.
+TEST_F(ConfigTest, AConfigThatIsNoFileIsRefusedUnread) {
+  std::filesystem::create_directory(dir_ / "folder.yaml");
+  ASSERT_EQ(::mkfifo((dir_ / "fifo.yaml").c_str(), 0600), 0);
+  for (const auto& [name, kind] : {std::pair{"folder.yaml", "a directory, not a file"},
+                                   std::pair{"fifo.yaml", "a FIFO, not a file"}}) {
+    const auto messages = errorsOf(dir_ / name);
+    ASSERT_EQ(messages.size(), 1u);
+    EXPECT_THAT(messages[0], AllOf(HasSubstr((dir_ / name).string()), HasSubstr(kind)));
+  }
 }
 
 TEST_F(ConfigTest, RigFileRoundTripsExactly) {

@@ -1,5 +1,6 @@
 // The LUT cache: what is stored comes back identical; a file for other inputs or another format
-// is stale, a damaged or truncated one corrupt, and neither is ever used.
+// is stale, a damaged or truncated one corrupt, an entry that is no file (a FIFO, a device, a
+// directory) refused unread, and none of them is ever used.
 
 #include "processing/panorama_lut_cache.hpp"
 
@@ -7,6 +8,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include "common/work_pool.hpp"
 #include "tests/processing/panorama_test_support.hpp"
@@ -16,6 +18,7 @@
 namespace surroundd::processing {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 
 class PanoramaLutCacheTest : public ::testing::Test {
@@ -99,6 +102,36 @@ TEST_F(PanoramaLutCacheTest, DamagedOrTruncatedFilesAreCorrupt) {
   // Rebuilt and stored again, it loads.
   cache_.store(key_, lut_);
   EXPECT_TRUE(cache_.load(key_).lut.has_value());
+}
+
+// Issue 18: a FIFO in the cache hung start-up in open(), a symlink to /dev/zero was read without
+// bound (3 GB), a directory stopped the daemon with no file named. Each is now refused, named,
+// and replaced by the rebuilt LUT where a file can take its place.
+TEST_F(PanoramaLutCacheTest, AnEntryThatIsNoFileIsRefusedWithoutReadingIt) {
+  const auto path = cache_.fileFor(key_);
+  std::filesystem::create_directories(path.parent_path());
+  const auto expectRefused = [&](std::string_view kind) {
+    const auto lookup = cache_.load(key_);
+    EXPECT_FALSE(lookup.lut.has_value());
+    EXPECT_THAT(lookup.problem, AllOf(HasSubstr(path.string()), HasSubstr(kind)));
+  };
+  ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0);
+  expectRefused("a FIFO, not a file");
+  ASSERT_EQ(::mkfifo((path.string() + ".part").c_str(), 0600), 0);
+  cache_.store(key_, lut_);  // neither the FIFO nor one under the temporary name blocks it
+  EXPECT_TRUE(cache_.load(key_).lut.has_value());
+
+  std::filesystem::remove(path);
+  std::filesystem::create_symlink("/dev/zero", path);
+  expectRefused("a character device, not a file");
+  cache_.store(key_, lut_);
+  EXPECT_TRUE(cache_.load(key_).lut.has_value());
+
+  std::filesystem::remove(path);
+  std::filesystem::create_directory(path);
+  expectRefused("a directory, not a file");
+  EXPECT_THAT([&] { cache_.store(key_, lut_); },
+              ::testing::ThrowsMessage<std::runtime_error>(HasSubstr(path.string())));
 }
 
 TEST_F(PanoramaLutCacheTest, AnUnwritableFolderIsAClearError) {

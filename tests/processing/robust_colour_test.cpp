@@ -4,6 +4,8 @@
 // temporal smoothing); gain compensation keeps the rig's brightness; and on the shared real rigs
 // (skipped without ../shared/data) no near-ground seam gets worse.
 
+#include <tuple>
+
 #include <gtest/gtest.h>
 
 #include "common/work_pool.hpp"
@@ -196,9 +198,47 @@ TEST_F(RobustColourTest, GainCompensationKeepsTheRigsBrightness) {
   EXPECT_NEAR(bench::meanLevel(gained, lut_) / bench::meanLevel(raw, lut_), 1.0, 0.1);
 }
 
+// The view step compares both cameras' views of the same ground on the seam: a camera made darker
+// shows as a step there, and a correction that undoes it (read off the panoramas) takes the step
+// back to what it was.
+class ViewStepTest : public RobustColourTest {
+ protected:
+  ViewStepTest() : RobustColourTest("synth_small_identity") {}
+};
+
+TEST_F(ViewStepTest, MeasuresTheCamerasNotTheContent) {
+  const PanoramaProjector projector(truth_.rig, settings_);
+  Stitcher stitcher(lut_, pool_);
+  cv::Mat matched;
+  stitcher.stitch(frames_, matched);
+  std::vector<cv::Mat> darker = frames_;
+  darker[1] = scaled(frames_[1], 0.6);
+  cv::Mat raw;
+  stitcher.stitch(darker, raw);
+  int measured = 0;
+  for (const auto& seam : bench::seamLines(truth_.rig, settings_)) {
+    if (seam.left != 1 && seam.right != 1) continue;
+    const auto before = bench::seamViewStep(matched, matched, projector, lut_, frames_, seam);
+    const auto dark = bench::seamViewStep(raw, raw, projector, lut_, darker, seam);
+    // `matched` is `raw` with camera 1's own pixels brought back: a perfect correction.
+    const auto undone = bench::seamViewStep(raw, matched, projector, lut_, darker, seam);
+    // Near ground: on the bowl's floor, where both cameras see the same ground (farther out the
+    // wall's parallax leaves each camera its own view of the scene).
+    const auto b = before.nearLevels;
+    const auto d = dark.nearLevels;
+    const auto u = undone.nearLevels;
+    ASSERT_TRUE(b && d && u) << seam.name;
+    ++measured;
+    EXPECT_GT(*d, *b + 6) << seam.name;
+    EXPECT_NEAR(*u, *b, 1.0) << seam.name;
+  }
+  EXPECT_GE(measured, 2);
+}
+
 // The shared real rigs (../shared/data, with the configs of config/real/: their vehicles masked):
 // on the near ground, where the seam data is, Poisson never leaves a seam worse than none, and
-// leaves every one within 5 levels; the panorama keeps its mean level within 10 %.
+// leaves every one within 5 levels; on the seam itself (both cameras' views), near and far, never
+// worse either; the panorama keeps its mean level within 10 %.
 class RealRigTest : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(RealRigTest, PoissonNeverMakesANearGroundSeamWorseAndKeepsTheLevel) {
@@ -223,6 +263,18 @@ TEST_P(RealRigTest, PoissonNeverMakesANearGroundSeamWorseAndKeepsTheLevel) {
     if (!before || !after) continue;
     EXPECT_LE(*after, *before + 0.5) << GetParam() << " " << seam.name;
     EXPECT_LE(*after, 5.0) << GetParam() << " " << seam.name;
+  }
+  // On the seam itself, both cameras' views of one piece of ground, near and far: never worse.
+  const PanoramaProjector projector(input.rig, input.panorama);
+  for (const auto& seam : bench::seamLines(input.rig, input.panorama)) {
+    const auto before = bench::seamViewStep(raw, raw, projector, lut, input.frames, seam);
+    const auto after = bench::seamViewStep(raw, corrected, projector, lut, input.frames, seam);
+    for (const auto& [b, a] : {std::pair{before.nearLevels, after.nearLevels},
+                               std::pair{before.farLevels, after.farLevels}}) {
+      if (b && a) {
+        EXPECT_LE(*a, *b + 0.5) << GetParam() << " " << seam.name;
+      }
+    }
   }
   EXPECT_NEAR(bench::meanLevel(corrected, lut) / bench::meanLevel(raw, lut), 1.0, 0.1);
 }

@@ -72,19 +72,33 @@ void reportRigColour(const RigColourInput& input, WorkPool& pool,
       "{}: {} cameras, panorama {}x{}, {} with a body mask, Poisson {} field at scale {:g}\n",
       input.name, rig.cameras.size(), lut.size.width, lut.size.height, masked,
       processing::correctionFieldName(colour.field), colour.scale);
+  const processing::PanoramaProjector projector(rig, settings);
+  const auto seams = seamLines(rig, settings);
+  const auto stepRow = [](const std::array<SeamColourStep, 3>& steps) {
+    return fmt::format("{}  {}  {}     {}  {}  {}", levels(steps[0].nearLevels),
+                       levels(steps[1].nearLevels), levels(steps[2].nearLevels),
+                       levels(steps[0].farLevels), levels(steps[1].farLevels),
+                       levels(steps[2].farLevels));
+  };
   fmt::print("  {:<14} {:>24}   {:^23}   {:^23}\n", "seam", "misalignment",
              "step near: none gain PLCC", "step far: none gain PLCC");
-  for (const auto& seam : seamLines(rig, settings)) {
+  for (const auto& seam : seams) {
     const auto alignment = seamAlignment(rig, frames, settings, seam);
-    const auto none = seamColourStep(raw, lut, settings, seam);
-    const auto gain = seamColourStep(gained, lut, settings, seam);
-    const auto plcc = seamColourStep(poisson, lut, settings, seam);
-    fmt::print("  {:<14} {:>24}   {}  {}  {}     {}  {}  {}\n", seam.name,
+    fmt::print("  {:<14} {:>24}   {}\n", seam.name,
                alignment ? fmt::format("{:.1f} cm at {:.1f} m ({:.2f})", alignment->shiftCm,
                                        alignment->distanceM, alignment->response)
                          : std::string("n/a"),
-               levels(none.nearLevels), levels(gain.nearLevels), levels(plcc.nearLevels),
-               levels(none.farLevels), levels(gain.farLevels), levels(plcc.farLevels));
+               stepRow({seamColourStep(raw, lut, settings, seam),
+                        seamColourStep(gained, lut, settings, seam),
+                        seamColourStep(poisson, lut, settings, seam)}));
+  }
+  fmt::print("  {:<14} {:>24}   {:^23}   {:^23}\n", "seam", "(both cameras' views)",
+             "view near: none gain PLCC", "view far: none gain PLCC");
+  for (const auto& seam : seams) {
+    fmt::print("  {:<14} {:>24}   {}\n", seam.name, "",
+               stepRow({seamViewStep(raw, raw, projector, lut, frames, seam),
+                        seamViewStep(raw, gained, projector, lut, frames, seam),
+                        seamViewStep(raw, poisson, projector, lut, frames, seam)}));
   }
   const double before = meanLevel(raw, lut);
   fmt::print("  mean level: none {:.1f}, gain {:.1f} ({:+.1f} %), Poisson {:.1f} ({:+.1f} %)\n",

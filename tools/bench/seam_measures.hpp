@@ -3,7 +3,13 @@
 // no ground truth needed; issue 15's figures):
 //   colour step   the median colour of a 1.5 degree strip just past the blend band on each side
 //                 of the seam, compared (mean over channels of the absolute difference, levels),
-//                 on near ground (elevation -15..-35 deg) and far ground (-2..-12 deg);
+//                 on near ground (elevation -15..-35 deg) and far ground (-2..-12 deg): what a
+//                 driver sees, content on either side included;
+//   view step     the ground from one strip to the other (the blend band between them) seen by
+//                 both cameras, each as its correction leaves it: the colour difference of one
+//                 piece of ground between the two views (per 1 degree of elevation, median
+//                 colours compared; averaged over the range), so the photometric step alone,
+//                 without the content's change across the seam;
 //   misalignment  phase correlation of the two cameras' own pictures of a 1.6 m ground patch
 //                 under the seam (1 cm a pixel; the nearest of 25, 18, 12, 8 and 5 degrees below
 //                 the panorama's centre that both see past the body), as their calibration projects
@@ -38,6 +44,14 @@ struct SeamColourStep {
 
 SeamColourStep seamColourStep(const cv::Mat& panorama, const processing::PanoramaLut& lut,
                               const processing::PanoramaSettings& settings, const SeamLine& seam);
+
+// `raw` is the uncorrected panorama of `frames`, `corrected` the same with a correction applied
+// (the raw one again for none). Each camera's correction is read off the panoramas as the ratio
+// corrected / raw in its own strip, band by band, and applied to its own view of the ground.
+SeamColourStep seamViewStep(const cv::Mat& raw, const cv::Mat& corrected,
+                            const processing::PanoramaProjector& projector,
+                            const processing::PanoramaLut& lut, std::span<const cv::Mat> frames,
+                            const SeamLine& seam);
 
 struct SeamAlignment {
   double distanceM = 0;  // of the patch from the vehicle's centre

@@ -8,26 +8,6 @@
 namespace surroundd::calibrate {
 namespace {
 
-constexpr std::string_view kIntrinsicsUsage =
-    R"(usage: surround-calibrate intrinsics --images DIR --board COLSxROWS --model pinhole|fisheye
-                                  --out FILE [options]
-
-Intrinsics of one camera from a folder of checkerboard images (the board at many angles and all
-over the image). Prints the RMS and every image's reprojection error; writes the camera's lens:
-block in the rig schema (daemon/rig_yaml.hpp).
-
-  --images DIR               folder of images (.png .jpg .jpeg .bmp .tif .tiff .pgm .ppm), one
-                             camera, one resolution
-  --board COLSxROWS          the board's inner corners (where four squares meet), e.g. 9x6
-  --model MODEL              pinhole (radial-tangential, k1 k2 p1 p2 k3) or fisheye
-                             (Kannala-Brandt, k1..k4)
-  --out FILE                 the lens: block (YAML)
-  --residuals FILE           a PNG of every detected corner with its residual magnified
-  --field-of-view-deg D      fisheye: the lens's full field; default: as far as the images are lit
-  --update-rig FILE          also write the lens into this rig file (see "--update-rig" below)
-  --camera NAME              with --update-rig: the camera to update
-)";
-
 constexpr std::string_view kExtrinsicsUsage =
     R"(usage: surround-calibrate extrinsics --rig FILE --camera NAME --image FILE
                                   (--markers FILE | --points FILE)... --out FILE [options]
@@ -99,72 +79,6 @@ inside the document are lost (the YAML library keeps none); a one-line note besi
 says where it came from. The result must read back to the new calibration, or the rig is left as
 it was and the command fails.
 )";
-
-cv::Size parseBoard(std::string_view option, std::string_view text) {
-  const auto fail = [&] {
-    return UsageError(fmt::format(
-        "{}: expected COLSxROWS inner corners, each 2 to 64, one odd and one even so that the "
-        "board's two ends differ (e.g. 9x6), got '{}'",
-        option, text));
-  };
-  const auto x = text.find('x');
-  if (x == std::string_view::npos) throw fail();
-  int cols = 0, rows = 0;
-  const auto colsText = text.substr(0, x), rowsText = text.substr(x + 1);
-  const auto a = std::from_chars(colsText.data(), colsText.data() + colsText.size(), cols);
-  const auto b = std::from_chars(rowsText.data(), rowsText.data() + rowsText.size(), rows);
-  if (a.ec != std::errc() || a.ptr != colsText.data() + colsText.size() || b.ec != std::errc() ||
-      b.ptr != rowsText.data() + rowsText.size() || cols < 2 || rows < 2 || cols > 64 ||
-      rows > 64 || (cols + rows) % 2 == 0) {
-    throw fail();
-  }
-  return {cols, rows};
-}
-
-IntrinsicsOptions parseIntrinsics(std::span<const std::string_view> arguments) {
-  IntrinsicsOptions o;
-  bool model = false;
-  // The rig takes OCamCalib lenses, but this tool does not solve them: say where one comes from.
-  const auto wrongModel = [](std::string_view v) {
-    return UsageError(fmt::format("--model: expected 'pinhole' or 'fisheye', got '{}'{}", v,
-                                  v == "ocam" ? " (calibrate an OCamCalib lens with OCamCalib and "
-                                                "write its polynomials into the rig's lens block)"
-                                              : ""));
-  };
-  parseOptions(arguments,
-               {{"--images", [&](auto v) { o.images = std::string(v); }},
-                {"--board", [&](auto v) { o.board = parseBoard("--board", v); }},
-                {"--model",
-                 [&](auto v) {
-                   if (v != "pinhole" && v != "fisheye") {
-                     throw wrongModel(v);
-                   }
-                   o.model = v == "pinhole" ? processing::LensModel::kPinhole
-                                            : processing::LensModel::kFisheye;
-                   model = true;
-                 }},
-                {"--out", [&](auto v) { o.out = std::string(v); }},
-                {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
-                {"--field-of-view-deg",
-                 [&](auto v) {
-                   o.fieldOfViewDeg =
-                       parseDouble("--field-of-view-deg", v, 1, 360, "degrees from 1 to 360");
-                 }},
-                {"--update-rig", [&](auto v) { o.updateRig = std::string(v); }},
-                {"--camera", [&](auto v) { o.camera = std::string(v); }}},
-               {});
-  if (o.images.empty()) throw UsageError("--images: missing (the folder of checkerboard images)");
-  if (o.board.area() == 0) throw UsageError("--board: missing (inner corners, e.g. 9x6)");
-  if (!model) throw UsageError("--model: missing (pinhole or fisheye)");
-  if (o.out.empty()) throw UsageError("--out: missing (the file to write the lens: block to)");
-  if (o.fieldOfViewDeg && o.model != processing::LensModel::kFisheye) {
-    throw UsageError("--field-of-view-deg: only a fisheye lens takes it");
-  }
-  if (o.updateRig.has_value() != !o.camera.empty()) {
-    throw UsageError("--update-rig and --camera go together (the rig file and its camera)");
-  }
-  return o;
-}
 
 ExtrinsicsOptions parseExtrinsics(std::span<const std::string_view> arguments) {
   ExtrinsicsOptions o;

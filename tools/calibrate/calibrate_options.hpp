@@ -12,12 +12,14 @@
 #include <string>
 #include <string_view>
 #include <variant>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "processing/camera_model.hpp"
 #include "processing/mat_calibration.hpp"
 #include "tools/calibrate/import_options.hpp"
+#include "tools/calibrate/intrinsics_options.hpp"
 
 namespace surroundd::calibrate {
 
@@ -25,17 +27,6 @@ namespace surroundd::calibrate {
 class UsageError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
-};
-
-struct IntrinsicsOptions {
-  std::filesystem::path images;  // folder of checkerboard images from one camera
-  cv::Size board;                // inner corners, columns x rows
-  processing::LensModel model = processing::LensModel::kPinhole;
-  std::filesystem::path out;                       // the lens: block
-  std::optional<std::filesystem::path> residuals;  // PNG
-  std::optional<double> fieldOfViewDeg;            // fisheye only; default: what the images show
-  std::optional<std::filesystem::path> updateRig;  // rig file whose camera gets the new lens
-  std::string camera;                              // with updateRig
 };
 
 struct ExtrinsicsOptions {

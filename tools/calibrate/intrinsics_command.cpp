@@ -3,30 +3,29 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <mutex>
 #include <numbers>
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "processing/intrinsic_calibration.hpp"
-#include "processing/target_detection.hpp"
+#include "processing/calibration_coverage.hpp"
+#include "processing/picture_search.hpp"
+#include "processing/view_acceptance.hpp"
 #include "tools/calibrate/calibration_output.hpp"
+#include "tools/calibrate/intrinsics_report.hpp"
 #include "tools/calibrate/residual_plot.hpp"
 
 namespace surroundd::calibrate {
 namespace {
 
+using processing::PictureSearch;
+
 constexpr std::array<std::string_view, 9> kImageExtensions{".png",  ".jpg", ".jpeg", ".bmp", ".tif",
                                                            ".tiff", ".pgm", ".ppm",  ".pnm"};
 
-// A pixel brighter than this in some image lies inside the lens's image circle; outside it a
-// fisheye sensor sees only dark noise.
-constexpr int kLitLevel = 16;
-
-// A view whose error is this many times the median is worth a look (a blurred or bent board).
-constexpr double kSuspectFactor = 3;
-
-std::vector<std::filesystem::path> listImages(const std::filesystem::path& folder) {
+std::vector<std::filesystem::path> listImages(const IntrinsicsOptions& options) {
+  const auto& folder = options.images;
   std::error_code ec;
   if (!std::filesystem::is_directory(folder, ec)) {
     throw UsageError(
@@ -47,6 +46,14 @@ std::vector<std::filesystem::path> listImages(const std::filesystem::path& folde
     throw UsageError(fmt::format("--images: '{}' holds no images (looked for {})", folder.string(),
                                  fmt::join(kImageExtensions, " ")));
   }
+  for (const auto& name : options.exclude) {
+    const auto excluded = std::remove_if(images.begin(), images.end(),
+                                         [&](const auto& p) { return p.filename() == name; });
+    if (excluded == images.end()) {
+      throw UsageError(fmt::format("--exclude: no image '{}' in '{}'", name, folder.string()));
+    }
+    images.erase(excluded, images.end());
+  }
   std::sort(images.begin(), images.end());
   return images;
 }
@@ -54,116 +61,131 @@ std::vector<std::filesystem::path> listImages(const std::filesystem::path& folde
 struct Detections {
   cv::Size imageSize;
   std::vector<processing::BoardView> views;
-  std::vector<std::string> withoutBoard;
-  cv::Mat lit;  // CV_8U, nonzero where some image is brighter than kLitLevel
+  std::vector<std::string> notes;  // pictures not used, and why
+  cv::Mat brightest;               // CV_8U, per pixel the brightest value over the pictures
 };
 
-// One image in memory at a time: a calibration set can be hundreds of large images.
-Detections detectBoards(const std::vector<std::filesystem::path>& files, cv::Size board) {
+std::string outcomeText(const PictureSearch& result) {
+  switch (result.outcome) {
+    case PictureSearch::Outcome::kFound:
+      return fmt::format("{} corners, edges {:.1f} px wide", result.corners.size(),
+                         result.edgeWidthPx);
+    case PictureSearch::Outcome::kNotFound:
+      return "no board";
+    case PictureSearch::Outcome::kLargerThanBoard:
+      return fmt::format("a {}x{} grid, larger than the board", result.seenGrid.width,
+                         result.seenGrid.height);
+    case PictureSearch::Outcome::kTimedOut:
+      return "search given up (time bound)";
+    case PictureSearch::Outcome::kNotSearched:
+      return "not searched";
+    case PictureSearch::Outcome::kUnreadable:
+      return "cannot read the image";
+  }
+  return "?";
+}
+
+// Searches every picture in parallel, printing each as it is done; refuses unreadable pictures,
+// mixed sizes and a board size the pictures contradict.
+Detections detectBoards(const std::vector<std::filesystem::path>& files,
+                        const IntrinsicsOptions& options, std::ostream& log) {
   Detections found;
-  for (const auto& file : files) {
-    const cv::Mat gray = cv::imread(file.string(), cv::IMREAD_GRAYSCALE);
-    if (gray.empty()) {
-      throw UsageError(
-          fmt::format("{}: cannot read the image (not an image, or damaged)", file.string()));
+  std::mutex brightestMutex;
+  const auto load = [&](std::size_t index) {
+    cv::Mat gray = cv::imread(files[index].string(), cv::IMREAD_GRAYSCALE);
+    std::lock_guard lock(brightestMutex);
+    if (!gray.empty() && found.brightest.empty()) found.brightest = gray.clone();
+    if (!gray.empty() && gray.size() == found.brightest.size()) {
+      cv::max(found.brightest, gray, found.brightest);
     }
-    if (found.lit.empty()) {
-      found.imageSize = gray.size();
-      found.lit = cv::Mat::zeros(gray.size(), CV_8U);
-    } else if (gray.size() != found.imageSize) {
+    return gray;
+  };
+  processing::SearchOptions search;
+  search.perPicture =
+      std::chrono::milliseconds(static_cast<long long>(options.detectTimeoutS * 1000));
+  log << fmt::format("looking for a {} in {} pictures\n", options.board.describe(), files.size());
+  const auto results = processing::searchPictures(
+      files.size(), load, options.board, search,
+      [&](std::size_t index, const PictureSearch& result, std::size_t done) {
+        log << fmt::format("  [{:>3}/{}] {}: {} ({:.1f} s)\n", done, files.size(),
+                           files[index].filename().string(), outcomeText(result), result.seconds)
+            << std::flush;
+      });
+  std::vector<std::string> largerGrids;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const auto& result = results[i];
+    const std::string name = files[i].filename().string();
+    if (result.outcome == PictureSearch::Outcome::kUnreadable) {
+      throw UsageError(
+          fmt::format("{}: cannot read the image (not an image, or damaged)", files[i].string()));
+    }
+    if (result.outcome == PictureSearch::Outcome::kNotSearched) continue;
+    if (found.imageSize.area() == 0) {
+      found.imageSize = result.imageSize;
+    } else if (result.imageSize != found.imageSize && result.imageSize.area() > 0) {
       throw UsageError(fmt::format(
-          "{}: the image is {}x{}, {} is {}x{}; the images must all come from one camera at one "
-          "resolution",
-          file.string(), gray.cols, gray.rows, files.front().string(), found.imageSize.width,
+          "{}: the image is {}x{}, the others are {}x{}; the images must all come from one camera "
+          "at one resolution",
+          files[i].string(), result.imageSize.width, result.imageSize.height, found.imageSize.width,
           found.imageSize.height));
     }
-    found.lit |= gray > kLitLevel;
-    if (auto corners = processing::findCheckerboard(gray, board)) {
-      found.views.push_back({file.filename().string(), std::move(*corners)});
+    if (result.outcome == PictureSearch::Outcome::kLargerThanBoard) {
+      largerGrids.push_back(
+          fmt::format("{}x{} in {}", result.seenGrid.width, result.seenGrid.height, name));
+    } else if (result.outcome == PictureSearch::Outcome::kTimedOut) {
+      found.notes.push_back(fmt::format("{}: no board found within {:g} s (--detect-timeout-s)",
+                                        name, options.detectTimeoutS));
+    } else if (result.outcome == PictureSearch::Outcome::kFound) {
+      if (result.edgeWidthPx > options.limits.maxEdgeWidthPx) {
+        found.notes.push_back(
+            fmt::format("{}: too blurred: its edges are {:.1f} px wide, the limit is {:g} px "
+                        "(--max-edge-width-px)",
+                        name, result.edgeWidthPx, options.limits.maxEdgeWidthPx));
+      } else {
+        found.views.push_back({name, result.corners, result.grid});
+      }
     } else {
-      found.withoutBoard.push_back(file.filename().string());
+      found.notes.push_back(fmt::format("{}: no board", name));
     }
+  }
+  if (found.views.empty() && !largerGrids.empty()) {
+    throw UsageError(fmt::format(
+        "--board {}x{}: the pictures show a larger chessboard grid ({}); --board counts the "
+        "inner corners, where four squares meet",
+        options.board.size.width, options.board.size.height, fmt::join(largerGrids, ", ")));
   }
   return found;
 }
 
+// Duplicates leave the list, each with a note.
+void dropDuplicates(Detections& found) {
+  const auto duplicates = processing::findDuplicateViews(found.views);
+  for (const auto& d : duplicates) {
+    found.notes.push_back(fmt::format("{}: repeats {} (the board outlines overlap {:.0f} %)",
+                                      found.views[d.view].name, found.views[d.of].name,
+                                      100 * d.overlap));
+  }
+  for (auto d = duplicates.rbegin(); d != duplicates.rend(); ++d) {
+    found.views.erase(found.views.begin() + static_cast<std::ptrdiff_t>(d->view));
+  }
+}
+
 std::string viewNames(const std::vector<processing::BoardView>& views) {
   std::vector<std::string> names;
-  names.reserve(views.size());
   for (const auto& view : views) names.push_back(view.name);
   return fmt::format("{}", fmt::join(names, ", "));
 }
 
-void report(const processing::IntrinsicCalibration& result, const Detections& found,
-            std::size_t imageCount, std::ostream& log) {
-  std::vector<double> errors;
-  for (const auto& view : result.views) errors.push_back(view.rmsPx);
-  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
-  const double median = errors[errors.size() / 2];
-  log << fmt::format("board found in {} of {} images; reprojection error per image (RMS):\n",
-                     found.views.size(), imageCount);
-  for (const auto& view : result.views) {
-    log << fmt::format("  {:<32} {:7.3f} px{}\n", view.name, view.rmsPx,
-                       view.rmsPx > kSuspectFactor * median ? "  <- well above the others" : "");
+void writePictures(const IntrinsicsOptions& options, const processing::IntrinsicCalibration& result,
+                   const processing::CoverageMap& coverage, const processing::ImageCircle& circle,
+                   std::span<const processing::BoardView> views, std::ostream& log) {
+  if (options.coverage) {
+    writeCoveragePlot(*options.coverage, coverage, circle, views);
+    log << "wrote " << options.coverage->string() << "\n";
   }
-  for (const auto& name : found.withoutBoard) log << fmt::format("  {:<32} no board\n", name);
-  const auto& in = result.intrinsics;
-  const bool fisheye = in.model == processing::LensModel::kFisheye;
-  log << fmt::format("RMS {:.3f} px over {} corners\n", result.rmsPx,
-                     result.views.size() * result.views.front().corners.size());
-  log << fmt::format(
-      "{}: fx {:.3f} fy {:.3f} cx {:.3f} cy {:.3f} px, distortion [{:.6g}]",
-      fisheye ? "fisheye" : "pinhole", in.fx, in.fy, in.cx, in.cy,
-      fmt::join(in.distortion.begin(), in.distortion.begin() + (fisheye ? 4 : 5), ", "));
-  if (fisheye) {
-    log << fmt::format(", field of view {:.1f} deg", in.maxFieldAngleRad * 360 / std::numbers::pi);
-  }
-  log << "\n";
-}
-
-}  // namespace
-
-void runIntrinsics(const IntrinsicsOptions& options, std::ostream& log) {
-  if (options.updateRig) rigCamera(*options.updateRig, options.camera);  // before the long part
-  const auto files = listImages(options.images);
-  const Detections found = detectBoards(files, options.board);
-  if (found.views.empty()) {
-    throw processing::CalibrationError(fmt::format(
-        "no {}x{} checkerboard found in any of the {} images in '{}' (--board counts inner "
-        "corners, where four squares meet: a board of 10x7 squares has 9x6)",
-        options.board.width, options.board.height, files.size(), options.images.string()));
-  }
-  processing::IntrinsicCalibration result;
-  try {
-    result = processing::calibrateIntrinsics(options.model, found.imageSize, {options.board, 1.0},
-                                             found.views);
-  } catch (const processing::CalibrationError& error) {
-    if (static_cast<int>(found.views.size()) >= processing::kMinimumBoardViews) throw;
-    throw processing::CalibrationError(fmt::format(
-        "{} (found in {}; not in {} other image{})", error.what(), viewNames(found.views),
-        found.withoutBoard.size(), found.withoutBoard.size() == 1 ? "" : "s"));
-  }
-  auto& lens = result.intrinsics;
-  if (lens.model == processing::LensModel::kFisheye) {
-    // Within the polynomial's monotonic range, which calibrateIntrinsics() left in the field.
-    lens.maxFieldAngleRad =
-        std::min(lens.maxFieldAngleRad, options.fieldOfViewDeg
-                                            ? *options.fieldOfViewDeg * std::numbers::pi / 360
-                                            : processing::widestLitFieldAngle(lens, found.lit));
-  }
-  report(result, found, files.size(), log);
-
-  const std::string comment = fmt::format(
-      "Written by surround-calibrate intrinsics from {} of {} images in {} ({}x{} board):\n"
-      "RMS reprojection error {:.3f} px.",
-      found.views.size(), files.size(), options.images.string(), options.board.width,
-      options.board.height, result.rmsPx);
-  writeLensBlock(options.out, lens, comment);
-  log << "wrote " << options.out.string() << "\n";
   if (options.residuals) {
-    // The lens's lit area as a faint background shows where the corners did not reach.
-    cv::Mat background(found.imageSize, CV_8UC3, cv::Scalar(0, 0, 0));
-    background.setTo(cv::Scalar(48, 48, 48), found.lit);
+    cv::Mat background(coverage.imageSize, CV_8UC3, cv::Scalar(0, 0, 0));
+    background.setTo(cv::Scalar(48, 48, 48), circle.lit);
     std::vector<ResidualSet> sets;
     for (std::size_t v = 0; v < result.views.size(); ++v) {
       const auto& view = result.views[v];
@@ -172,9 +194,84 @@ void runIntrinsics(const IntrinsicsOptions& options, std::ostream& log) {
                       setColour(v)});
     }
     writeResidualPlot(*options.residuals, background, sets,
-                      fmt::format("{} views, RMS {:.3f} px", sets.size(), result.rmsPx));
+                      fmt::format("{} views, RMS {:.3f} px", sets.size(), result.rmsPx),
+                      options.residualScale);
     log << "wrote " << options.residuals->string() << "\n";
   }
+}
+
+}  // namespace
+
+void runIntrinsics(const IntrinsicsOptions& options, std::ostream& log) {
+  if (options.updateRig) rigCamera(*options.updateRig, options.camera);  // before the long part
+  const auto files = listImages(options);
+  Detections found = detectBoards(files, options, log);
+  dropDuplicates(found);
+  for (const auto& note : found.notes) log << "  skipped " << note << "\n";
+  if (found.views.empty()) {
+    throw processing::CalibrationError(fmt::format(
+        "no {} found in any of the {} images in '{}' (--board counts inner corners, where four "
+        "squares meet: a board of 10x7 squares has 9x6)",
+        options.board.describe(), files.size(), options.images.string()));
+  }
+  if (static_cast<int>(found.views.size()) < options.limits.minViews) {
+    throw processing::CalibrationError(fmt::format(
+        "too few views: {} usable (found in {}), at least {} are needed (from different angles "
+        "and field positions){}",
+        found.views.size(), viewNames(found.views), options.limits.minViews,
+        found.notes.empty() ? "" : fmt::format("; skipped: {}", fmt::join(found.notes, "; "))));
+  }
+  const auto robust = processing::calibrateLeavingOutBadViews(options.model, found.imageSize,
+                                                              found.views, options.limits);
+  auto result = robust.result;
+  for (const auto& left : robust.leftOut) log << "  left out " << left << " (--max-view-rms-px)\n";
+  std::vector<processing::BoardView> used;
+  for (const auto& view : found.views) {
+    if (std::any_of(result.views.begin(), result.views.end(),
+                    [&](const auto& r) { return r.name == view.name; })) {
+      used.push_back(view);
+    }
+  }
+  auto circle = processing::findImageCircle(found.brightest);
+  if (options.model == processing::LensModel::kPinhole) {
+    // A pinhole lens's image fills the sensor; dark corners there are vignetting or the scene.
+    circle = {cv::Mat(found.imageSize, CV_8U, cv::Scalar(255)), false};
+  }
+  const auto coverage = processing::coverageOf(used, found.imageSize, circle.lit);
+  auto& lens = result.intrinsics;
+  processing::FieldOfView field;
+  if (lens.model == processing::LensModel::kFisheye) {
+    field = processing::fieldOfViewOf(lens, circle);
+    if (options.fieldOfViewDeg)
+      field = {*options.fieldOfViewDeg, false, "given by --field-of-view-deg"};
+    // Within the polynomial's monotonic range, which calibrateIntrinsics() left in the field.
+    lens.maxFieldAngleRad = std::min(lens.maxFieldAngleRad, field.fullDeg * std::numbers::pi / 360);
+  } else {
+    field = processing::fieldOfViewOf(lens, circle);
+  }
+  printViewTable(result, options.squareMm, options.limits.maxViewRmsPx, log);
+  printLens(result, field, log);
+  log << fmt::format("coverage {:.0f} % of the lens's cells", 100 * coverage.coveredShare);
+  if (const auto parts = coverage.uncoveredParts(); !parts.empty()) {
+    log << fmt::format("; no corners in {}", fmt::join(parts, ", "));
+  }
+  log << "\n";
+  const auto verdict = processing::judgeCalibration(result, coverage.coveredShare, options.limits);
+  printVerdict(verdict, log);
+  if (!verdict.passed) {
+    throw processing::CalibrationError(
+        fmt::format("the solve failed its limits ({}); nothing was written",
+                    fmt::join(verdict.failures, "; ")));
+  }
+
+  const std::string comment = fmt::format(
+      "Written by surround-calibrate intrinsics from {} of {} images in {} ({}):\n"
+      "RMS reprojection error {:.3f} px.",
+      result.views.size(), files.size(), options.images.string(), options.board.describe(),
+      result.rmsPx);
+  writeLensBlock(options.out, lens, comment);
+  log << "wrote " << options.out.string() << "\n";
+  writePictures(options, result, coverage, circle, used, log);
   if (options.updateRig) {
     updateRigLens(*options.updateRig, options.camera, lens, comment);
     log << fmt::format("updated camera '{}' in {}\n", options.camera, options.updateRig->string());

@@ -2,6 +2,7 @@
 // other tools' calibrations imported into a rig file, and the body masks drawn for checking (see
 // --help).
 
+#include <cstdlib>
 #include <iostream>
 #include <string_view>
 #include <vector>
@@ -14,9 +15,10 @@
 #include "tools/calibrate/intrinsics_command.hpp"
 #include "tools/calibrate/mask_command.hpp"
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(const std::vector<std::string_view>& arguments) {
   using namespace surroundd::calibrate;
-  const std::vector<std::string_view> arguments(argv + 1, argv + argc);
   std::string_view subcommand = arguments.empty() ? "" : arguments.front();
   const std::string prefix = subcommand == "intrinsics" || subcommand == "extrinsics" ||
                                      subcommand == "import" || subcommand == "mask"
@@ -49,4 +51,16 @@ int main(int argc, char** argv) {
     std::cerr << prefix << "failed: " << error.what() << "\n";
     return 1;
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int status = run({argv + 1, argv + argc});
+  // The intrinsics' board search may have left a detection thread running past its time bound
+  // (processing/picture_search.hpp): static destructors must not run under it, so the process
+  // ends here, with its output flushed, without them.
+  std::cout.flush();
+  std::cerr.flush();
+  std::_Exit(status);
 }

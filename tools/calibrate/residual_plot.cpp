@@ -35,6 +35,12 @@ double magnificationFor(std::span<const ResidualSet> sets, double width) {
 
 }  // namespace
 
+void drawLabel(cv::Mat& canvas, const std::string& text, cv::Point at) {
+  cv::putText(canvas, text, at, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
+  cv::putText(canvas, text, at, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1,
+              cv::LINE_AA);
+}
+
 cv::Scalar setColour(std::size_t index) {
   // Hues spaced by the golden angle: neighbours in the list get far-apart colours.
   const double hue = std::fmod(static_cast<double>(index) * 137.508, 360.0) / 2;  // OpenCV: 0..180
@@ -45,11 +51,13 @@ cv::Scalar setColour(std::size_t index) {
 }
 
 void writeResidualPlot(const std::filesystem::path& file, const cv::Mat& background,
-                       std::span<const ResidualSet> sets, const std::string& title) {
+                       std::span<const ResidualSet> sets, const std::string& title,
+                       std::optional<double> fixedMagnification) {
   const double scale = std::max(1.0, static_cast<double>(kMinimumWidth) / background.cols);
   cv::Mat canvas;
   cv::resize(background, canvas, {}, scale, scale, cv::INTER_LINEAR);
-  const double magnification = magnificationFor(sets, canvas.cols) / scale;
+  const double magnification =
+      fixedMagnification ? *fixedMagnification : magnificationFor(sets, canvas.cols) / scale;
   for (const auto& set : sets) {
     for (std::size_t i = 0; i < set.detected.size(); ++i) {
       const cv::Point2d at = set.detected[i] * scale;
@@ -60,15 +68,20 @@ void writeResidualPlot(const std::filesystem::path& file, const cv::Mat& backgro
       cv::circle(canvas, at, 2, set.colour, cv::FILLED, cv::LINE_AA);
     }
   }
-  const std::string legend = fmt::format("residuals x{:g}", magnification);
+  const std::string legend =
+      fmt::format("residuals x{:g}; this bar is a 1 px residual:", magnification);
   int y = 24;
   for (const auto& line : {title, legend}) {
-    cv::putText(canvas, line, {12, y}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(0, 0, 0), 3,
-                cv::LINE_AA);
-    cv::putText(canvas, line, {12, y}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1,
-                cv::LINE_AA);
+    drawLabel(canvas, line, {12, y});
     y += 24;
   }
+  // The scale bar, after the legend's last line, as long as a 1 px residual is drawn.
+  const int barStart =
+      12 + cv::getTextSize(legend, cv::FONT_HERSHEY_SIMPLEX, 0.6, 1, nullptr).width + 8;
+  const int barLength = static_cast<int>(std::lround(magnification * scale));
+  cv::line(canvas, {barStart, y - 30}, {barStart + barLength, y - 30}, cv::Scalar(0, 0, 0), 4);
+  cv::line(canvas, {barStart, y - 30}, {barStart + barLength, y - 30}, cv::Scalar(255, 255, 255),
+           2);
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
   if (!cv::imwrite(file.string(), canvas)) {
     throw std::runtime_error(fmt::format("{}: cannot write the image", file.string()));

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include <opencv2/aruco/charuco.hpp>
 #include <opencv2/aruco/dictionary.hpp>
 
 namespace surroundd::synth {
@@ -74,11 +75,38 @@ PlacedTarget placeGroundMarker(const processing::GroundMarker& marker, int aruco
 
 PlacedTarget placeBoard(const processing::Checkerboard& board,
                         const processing::Pose& boardInCamera) {
-  const cv::Matx33d& r = boardInCamera.rotation;
-  return {TargetPattern::checkerboard(board),
-          boardInCamera.position,
+  return placePattern(TargetPattern::checkerboard(board), boardInCamera);
+}
+
+PlacedTarget placePattern(TargetPattern pattern, const processing::Pose& patternInCamera) {
+  const cv::Matx33d& r = patternInCamera.rotation;
+  return {std::move(pattern),
+          patternInCamera.position,
           {r(0, 0), r(1, 0), r(2, 0)},
           {r(0, 1), r(1, 1), r(2, 1)}};
+}
+
+TargetPattern TargetPattern::charuco(cv::Size squares, int dictionary, double markerToSquare,
+                                     double squareM) {
+  // Drawn at this many modules a square: the markers' cells land on whole modules for the
+  // usual ratios, and the square edges exactly on module edges.
+  constexpr int kModulesPerSquare = 40;
+  const auto board = cv::aruco::CharucoBoard::create(
+      squares.width, squares.height, 1.0f, static_cast<float>(markerToSquare),
+      cv::aruco::getPredefinedDictionary(dictionary));
+  cv::Mat drawn;
+  board->draw({squares.width * kModulesPerSquare, squares.height * kModulesPerSquare}, drawn, 0, 1);
+  TargetPattern pattern;
+  pattern.modules_.create(drawn.rows + 2 * kModulesPerSquare, drawn.cols + 2 * kModulesPerSquare,
+                          CV_8U);
+  pattern.modules_.setTo(1);
+  cv::Mat inside =
+      pattern.modules_(cv::Rect(kModulesPerSquare, kModulesPerSquare, drawn.cols, drawn.rows));
+  inside.setTo(0);
+  inside.setTo(1, drawn > 127);
+  pattern.moduleM_ = squareM / kModulesPerSquare;
+  pattern.moduleOrigin_ = {-squareM, -squareM};
+  return pattern;
 }
 
 TargetRenderer::TargetRenderer(const processing::Intrinsics& intrinsics, int supersampling)

@@ -28,6 +28,11 @@ class TargetPattern {
  public:
   static TargetPattern checkerboard(const processing::Checkerboard& board);
   static TargetPattern aruco(int dictionary, int id, double sideM);
+  // A ChArUco board of `squares` (columns x rows) as OpenCV draws it, its top-left square's
+  // outer corner at the pattern origin, then a white margin of one square. Its inner corner
+  // (i, j) lies at ((i + 1), (j + 1)) * squareM, as a chessboard's lies at (i, j) * squareM.
+  static TargetPattern charuco(cv::Size squares, int dictionary, double markerToSquare,
+                               double squareM);
 
   // Reflectance, 0..1, at a pattern point; nullopt off the print.
   std::optional<float> albedo(double u, double v) const;
@@ -53,6 +58,7 @@ struct PlacedTarget {
 PlacedTarget placeGroundMarker(const processing::GroundMarker& marker, int arucoDictionary);
 PlacedTarget placeBoard(const processing::Checkerboard& board,
                         const processing::Pose& boardInCamera);
+PlacedTarget placePattern(TargetPattern pattern, const processing::Pose& patternInCamera);
 
 struct TargetScene {
   std::vector<PlacedTarget> targets;

@@ -1,0 +1,129 @@
+// No run destroys another's data (issue 18): two outputs of one config that would write the same
+// file are refused at load, and a run that finds an earlier run's file, .part or recording
+// writes the next free name instead. The last test runs the pipeline three times on one config.
+
+#include "daemon/output_files.hpp"
+
+#include <fstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include "daemon/pipeline.hpp"
+#include "daemon/rig_yaml.hpp"
+#include "tests/daemon/config_test_support.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace surroundd::daemon {
+namespace {
+
+using ::testing::HasSubstr;
+
+TEST_F(ConfigTest, OutputsThatWouldWriteOneFileAreRefused) {
+  std::filesystem::create_directories(dir_ / "out");
+  std::filesystem::create_directory_symlink(dir_ / "out", dir_ / "link");
+  const std::string_view snapshot = "{type: snapshot, path: out/mosaic.png, at_s: 0.5}";
+  // outputs[0] is the video out/mosaic.mp4.
+  expectOneError(snapshot, "{type: video, path: link/mosaic.mp4}",
+                 {"outputs[1].path: two outputs write", "(as '", "(outputs[0] too)"});
+  const std::string_view both =
+      "  - {type: video, path: out/mosaic.mp4, crf: 18}\n"
+      "  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}";
+  expectOneError(both,
+                 "  - {type: video, path: out/mosaic.mp4, segment_s: 2}\n"
+                 "  - {type: video, path: out/mosaic-00001.mp4}",
+                 {"outputs[1].path: '",
+                  "out/mosaic-00001.mp4' would be named like the segments "
+                  "of '",
+                  "out/mosaic.mp4' (outputs[0] too)"});
+  // Through the symlink, and a plain video's later runs would be mosaic-1.mp4, ...
+  expectOneError(both,
+                 "  - {type: video, path: out/mosaic.mp4, segment_s: 2}\n"
+                 "  - {type: video, path: link/mosaic.mp4}",
+                 {"outputs[1].path: two outputs write"});
+}
+
+TEST_F(ConfigTest, AVideoInsideARecordingAndTwoHttpOutputsOnOnePortAreRefused) {
+  expectOneError("{type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "{type: recording, path: out}",
+                 {"outputs[1].path: '", "out/mosaic.mp4' is inside the recording folder '"});
+  expectOneError("{type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "{type: http, listen: \"127.0.0.1:8081\"}\n"
+                 "  - {type: http, listen: \"0.0.0.0:8081\"}",
+                 {"outputs[2].listen: outputs[1] listens on port 8081 already"});
+  const std::string socket(120, 's');
+  std::string text(kGoodConfig);
+  text += "control: {socket: /tmp/" + socket + "}\n";
+  const auto messages = errorsOf(dir_.write("config.yaml", text));
+  ASSERT_EQ(messages.size(), 1u) << ::testing::PrintToString(messages);
+  EXPECT_THAT(messages[0], HasSubstr("control.socket: expected a path of at most 107 bytes"));
+}
+
+TEST(OutputFiles, AnEarlierRunsFilesAreKeptAndTheNextFreeNameTaken) {
+  const testing::TempDir dir;
+  OutputConfig video;
+  video.path = dir / "whole.mkv";
+  EXPECT_EQ(unusedOutputPath(video), dir / "whole.mkv");
+  dir.write("whole.mkv.part", "frames of a killed run");
+  EXPECT_EQ(unusedOutputPath(video), dir / "whole-1.mkv");
+  dir.write("whole-1.mkv", "a finished run");
+  EXPECT_EQ(unusedOutputPath(video), dir / "whole-2.mkv");
+  // A FIFO is no data (a test stalls a writer with one): it is written into.
+  ASSERT_EQ(::mkfifo((dir / "whole-2.mkv.part").c_str(), 0600), 0);
+  EXPECT_EQ(unusedOutputPath(video), dir / "whole-2.mkv");
+
+  OutputConfig recording;
+  recording.kind = OutputKind::kRecording;
+  recording.path = dir / "drive";
+  std::filesystem::create_directory(dir / "drive");
+  EXPECT_EQ(unusedOutputPath(recording), dir / "drive");  // empty: nothing to keep
+  dir.write("drive/front.mp4", "x");
+  EXPECT_EQ(unusedOutputPath(recording), dir / "drive-1");
+
+  OutputConfig snapshot;
+  snapshot.kind = OutputKind::kSnapshot;
+  snapshot.path = dir / "whole.mkv";  // the newest picture replaces the last
+  EXPECT_EQ(unusedOutputPath(snapshot), dir / "whole.mkv");
+}
+
+TEST(OutputFiles, AFolderThatCannotBeMadeNamesItsOutput) {
+  const testing::TempDir dir;
+  dir.write("file", "x");
+  EXPECT_THAT([&] { createOutputFolder(dir / "file" / "out", dir / "file/out/top.png"); },
+              ::testing::ThrowsMessage<std::runtime_error>(
+                  HasSubstr("output " + (dir / "file/out/top.png").string() +
+                            ": cannot create the folder " + (dir / "file/out").string() + ": ")));
+}
+
+// Three runs of one config, the first killed before it finished (its .part left behind): nothing
+// any run wrote is lost, truncated or overwritten.
+TEST(OutputFiles, RestartsKeepEveryRunsVideo) {
+  const testing::TempDir dir;
+  const auto rig = std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small" / "rig.yaml";
+  Config config;
+  config.file = rig;
+  config.cameras = loadRigFile(rig);
+  config.capture.pacing = capture::Pacing::kAsFastAsPossible;
+  config.render.widthPx = 320;
+  config.render.heightPx = 180;
+  OutputConfig video;
+  video.path = dir / "whole.mkv";
+  config.outputs = {video};
+  const std::string killed = "the frames of a run that was killed";
+  dir.write("whole.mkv.part", killed);
+  const std::atomic<bool> stop{false};
+  for (int run = 0; run < 2; ++run) {
+    Pipeline pipeline(config);
+    EXPECT_EQ(pipeline.run(stop).failedOutputs, 0u);
+  }
+  EXPECT_EQ(surroundd::testing::fileBytes(dir / "whole.mkv.part"), killed);
+  const auto first = surroundd::testing::decodeAll(dir / "whole-1.mkv");
+  const auto second = surroundd::testing::decodeAll(dir / "whole-2.mkv");
+  EXPECT_GT(first.images.size(), 5u);
+  EXPECT_EQ(second.images.size(), first.images.size());
+  EXPECT_FALSE(std::filesystem::exists(dir / "whole.mkv"));
+}
+
+}  // namespace
+}  // namespace surroundd::daemon
