@@ -75,14 +75,11 @@ std::vector<cv::Point2f> turned(const std::vector<cv::Point2f>& corners, cv::Siz
     std::reverse(result.begin(), result.end());
     return result;
   }
-  const int n = inner.width;  // square
+  const auto n = static_cast<std::size_t>(inner.width);  // square
   for (int q = 0; q < quarters; ++q) {
     std::vector<cv::Point2f> next(result.size());
-    for (int j = 0; j < n; ++j) {
-      for (int i = 0; i < n; ++i) {
-        next[static_cast<std::size_t>(j * n + i)] =
-            result[static_cast<std::size_t>(i * n + n - 1 - j)];
-      }
+    for (std::size_t j = 0; j < n; ++j) {
+      for (std::size_t i = 0; i < n; ++i) next[j * n + i] = result[i * n + n - 1 - j];
     }
     result = std::move(next);
   }

@@ -56,8 +56,8 @@ void expectEveryCameraPosed(const MatScene& scene, bool symmetric) {
 
 // 7x6 boards of 20 cm squares, one at each corner of the car.
 const MatScene& fisheyeScene() {
-  static const MatScene scene = matScene("fisheye.yaml", {{{7, 6}, 0.2}, {}});
-  return scene;
+  static const MatScene kScene = matScene("fisheye.yaml", {{{7, 6}, 0.2}, {}});
+  return kScene;
 }
 
 TEST(MatCalibration, EveryCameraOfTheFisheyeRigFromFourCornerBoards) {

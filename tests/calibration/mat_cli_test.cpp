@@ -47,7 +47,7 @@ const Session& session() {
 std::filesystem::path nominalRig(const TempDir& dir) {
   auto cameras = session().truth;
   for (auto& camera : cameras) camera.calibration.pose = nominal(camera.calibration.pose);
-  const auto rig = dir / "rig.yaml";
+  auto rig = dir / "rig.yaml";
   daemon::writeRigFile(rig, cameras, "The rig as measured by hand.");
   return rig;
 }
@@ -69,7 +69,7 @@ TEST(MatCli, EveryCameraOfTheFisheyeRigWrittenAndTheRigUpdated) {
   const TempDir dir;
   const auto rig = nominalRig(dir);
   auto arguments = matArguments(rig, session().pictures / "mat.yaml", dir);
-  arguments.push_back("--update-rig");
+  arguments.emplace_back("--update-rig");
   const CalibrateRun run = calibrate(dir, arguments);
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_THAT(run.output, HasSubstr("camera      boards  corners   RMS px   moved cm  turn deg  "
@@ -102,7 +102,7 @@ TEST(MatCli, EveryCameraOfTheFisheyeRigWrittenAndTheRigUpdated) {
 void expectRefused(const TempDir& dir, const std::filesystem::path& rig,
                    std::vector<std::string> arguments, const std::string& problem) {
   const std::string before = surroundd::testing::fileBytes(rig);
-  arguments.push_back("--update-rig");
+  arguments.emplace_back("--update-rig");
   const CalibrateRun run = calibrate(dir, arguments);
   EXPECT_EQ(run.status, 1) << run.output;
   EXPECT_THAT(run.output, HasSubstr(problem));

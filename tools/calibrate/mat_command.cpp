@@ -21,6 +21,7 @@ std::vector<processing::CameraCalibration> matCameras(const ExtrinsicsOptions& o
                                                       const processing::MatLayout& mat) {
   const auto rig = daemon::loadRigFile(options.rig);
   std::vector<std::string> names;
+  names.reserve(rig.size());
   for (const auto& camera : rig) names.push_back(camera.calibration.name);
   for (std::size_t b = 0; b < mat.boards.size(); ++b) {
     for (const auto& camera : mat.boards[b].seenBy) {
@@ -51,7 +52,7 @@ cv::Mat readPicture(const ExtrinsicsOptions& options, const processing::CameraCa
                     ".jpg, .jpeg, .bmp, .tif, .tiff)",
                     options.images->string(), camera.name, camera.name));
   }
-  const cv::Mat picture = cv::imread(file->string(), cv::IMREAD_GRAYSCALE);
+  cv::Mat picture = cv::imread(file->string(), cv::IMREAD_GRAYSCALE);
   if (picture.empty()) {
     throw UsageError(fmt::format("--images: {}: cannot read the picture (not an image, or damaged)",
                                  file->string()));

@@ -56,7 +56,9 @@ std::optional<processing::GroundMarker> placeBoard(
   const double radius = printRadius(print.board);
   const cv::Point2d direction(std::cos(heading), std::sin(heading));
   const cv::Point2d across(-direction.y, direction.x);
-  for (double distance = 0.5; distance < 10; distance += 0.05) {
+  // Outwards in 5 cm steps from 0.5 m to 10 m.
+  for (int step = 10; step < 200; ++step) {
+    const double distance = step * 0.05;
     for (const double sideways : {0.0, 0.2, -0.2, 0.4, -0.4}) {
       // Square to the car first, then turned to face along the heading.
       for (const double yawDeg : {0.0, 90.0, heading / kDegToRad - 90}) {
