@@ -263,7 +263,7 @@ OutputConfig readOutput(YamlObject& item) {
   } else if (o.kind == OutputKind::kHttp) {
     readListen(item, o);
     o.jpegQuality = item.integer("quality", o.jpegQuality, 1, 100);
-    o.allowedHosts = item.strings("allowed_hosts", 32);
+    o.allowedHosts = item.strings("allowed_hosts", 0, 32).value_or(std::vector<std::string>{});
   } else if (o.kind == OutputKind::kWindow) {
     o.display = item.string("display", o.display);
     o.title = item.string("title", o.title);

@@ -239,6 +239,30 @@ std::optional<std::vector<double>> YamlObject::numbers(std::string_view key, std
                     [&](std::size_t size) { return size >= minSize && size <= maxSize; });
 }
 
+std::optional<std::vector<std::string>> YamlObject::strings(std::string_view key,
+                                                            std::size_t minSize,
+                                                            std::size_t maxSize) {
+  if (!has(key)) return std::nullopt;
+  const std::string expected = fmt::format("a list of {} to {} names", minSize, maxSize);
+  YAML::Node list = at(key);
+  if (!list.IsSequence() || list.size() < minSize || list.size() > maxSize) {
+    error(key,
+          fmt::format("expected {}, got {}", expected,
+                      list.IsSequence() ? fmt::format("{} items", list.size()) : describe(list)));
+    return std::nullopt;
+  }
+  std::vector<std::string> result;
+  for (const auto& item : list) {
+    if (!item.IsScalar() || item.Scalar().empty()) {
+      diag_->error(file_, item.Mark(), childPath(key),
+                   fmt::format("expected {}, got {}", expected, describe(item)));
+      return std::nullopt;
+    }
+    result.push_back(item.Scalar());
+  }
+  return result;
+}
+
 std::optional<std::vector<double>> YamlObject::numberList(
     std::string_view key, const std::string& expected,
     const std::function<bool(std::size_t)>& sizeFits) {
@@ -260,28 +284,6 @@ std::optional<std::vector<double>> YamlObject::numberList(
       return std::nullopt;
     }
     result.push_back(number);
-  }
-  return result;
-}
-
-std::vector<std::string> YamlObject::strings(std::string_view key, std::size_t maxCount) {
-  if (!has(key)) return {};
-  const std::string expected = fmt::format("a list of at most {} non-empty strings", maxCount);
-  YAML::Node list = at(key);
-  if (!list.IsSequence() || list.size() > maxCount) {
-    error(key,
-          fmt::format("expected {}, got {}", expected,
-                      list.IsSequence() ? fmt::format("{} items", list.size()) : describe(list)));
-    return {};
-  }
-  std::vector<std::string> result;
-  for (const auto& item : list) {
-    if (!item.IsScalar() || item.Scalar().empty()) {
-      diag_->error(file_, item.Mark(), childPath(key),
-                   fmt::format("expected {}, got {}", expected, describe(item)));
-      return {};
-    }
-    result.push_back(item.Scalar());
   }
   return result;
 }

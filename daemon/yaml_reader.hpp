@@ -76,11 +76,12 @@ class YamlObject {
   // A list of minSize to maxSize numbers.
   std::optional<std::vector<double>> numbers(std::string_view key, std::size_t minSize,
                                              std::size_t maxSize);
+  // A list of minSize to maxSize non-empty strings.
+  std::optional<std::vector<std::string>> strings(std::string_view key, std::size_t minSize,
+                                                  std::size_t maxSize);
   // A list of [x, y] pairs, at least `minCount` of them (a polygon).
   std::optional<std::vector<std::array<double, 2>>> points(std::string_view key,
                                                            std::size_t minCount);
-  // A list of at most `maxCount` non-empty strings; empty when the key is absent.
-  std::vector<std::string> strings(std::string_view key, std::size_t maxCount);
 
   template <class E>
   E choice(std::string_view key, E fallback,

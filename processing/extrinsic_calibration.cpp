@@ -134,6 +134,18 @@ class PoseRefiner {
     return *pixel - points_[i].pixel;
   }
 
+  double totalCost(const CameraFromVehicle& pose, const std::vector<bool>& active) const {
+    // A point that leaves the lens's field costs as much as a far outlier.
+    const double lost = huberCost(1e3, huber_);
+    double cost = 0;
+    for (std::size_t i = 0; i < points_.size(); ++i) {
+      if (!active[i]) continue;
+      const auto r = residual(pose, i);
+      cost += r ? huberCost(std::hypot(r->x, r->y), huber_) : lost;
+    }
+    return cost;
+  }
+
  private:
   // delta[0..2]: a rotation vector about the camera's own centre (radians), so that turning the
   // camera does not move it; delta[3..5]: a translation in the camera frame (metres).
@@ -148,18 +160,6 @@ class PoseRefiner {
     cv::Vec6d delta(0, 0, 0, 0, 0, 0);
     delta[parameter] = amount;
     return apply(pose, delta);
-  }
-
-  double totalCost(const CameraFromVehicle& pose, const std::vector<bool>& active) const {
-    // A point that leaves the lens's field costs as much as a far outlier.
-    const double lost = huberCost(1e3, huber_);
-    double cost = 0;
-    for (std::size_t i = 0; i < points_.size(); ++i) {
-      if (!active[i]) continue;
-      const auto r = residual(pose, i);
-      cost += r ? huberCost(std::hypot(r->x, r->y), huber_) : lost;
-    }
-    return cost;
   }
 
   const CameraModel& model_;
@@ -189,9 +189,14 @@ ExtrinsicCalibration calibrateExtrinsics(const Intrinsics& intrinsics,
     rays.push_back(*ray);
   }
   const PoseRefiner refiner(model, points, settings.huberPx);
-  CameraFromVehicle pose = initialPose(intrinsics, rays, points, settings);
   std::vector<bool> active(points.size(), true);
-  pose = refiner.refine(pose, active);
+  CameraFromVehicle pose = refiner.refine(initialPose(intrinsics, rays, points, settings), active);
+  if (settings.prior) {
+    const Pose& prior = *settings.prior;
+    const CameraFromVehicle fromPrior =
+        refiner.refine({prior.rotation.t(), -(prior.rotation.t() * prior.position)}, active);
+    if (refiner.totalCost(fromPrior, active) < refiner.totalCost(pose, active)) pose = fromPrior;
+  }
 
   ExtrinsicCalibration result;
   const auto classify = [&] {

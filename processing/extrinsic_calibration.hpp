@@ -9,6 +9,7 @@
 // every point (those past 90 degrees off axis included). Points that still miss by more than the
 // inlier threshold are left out and the pose refined once more.
 
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -31,6 +32,10 @@ struct ExtrinsicSettings {
   double inlierThresholdPx = 3.0;  // a point whose reprojection misses by more is an outlier
   double huberPx = 0.5;            // residuals beyond this weigh linearly, not quadratically
   int ransacIterations = 1000;
+  // The pose assumed so far (T_vehicle_camera), e.g. the rig's mount. When given, the refinement
+  // also starts from it and the start that ends with the lower cost wins: RANSAC over one planar
+  // board seen at a grazing angle can settle on the board's mirror-image pose.
+  std::optional<Pose> prior;
 };
 
 struct ExtrinsicCalibration {

@@ -39,7 +39,7 @@ float squareBrightness(const cv::Mat& gray, cv::Point2f a, cv::Point2f b, cv::Po
 // W x H grid can be listed in, two are mirror images, which a board seen from its printed side
 // never produces: the row direction turned towards the column direction must be clockwise in the
 // image (y down). Of the other two, a half turn apart, the one whose square (1, 1), the first
-// inner square, is black is right; every inner square votes, for robustness against glare.
+// inner square, is black is right (see blackFirstScore()).
 void orientBoard(std::vector<cv::Point2f>& corners, cv::Size inner, const cv::Mat& gray) {
   const std::ptrdiff_t w = inner.width;
   const cv::Point2f along = corners[1] - corners[0];
@@ -47,18 +47,7 @@ void orientBoard(std::vector<cv::Point2f>& corners, cv::Size inner, const cv::Ma
   if (along.cross(across) < 0) {
     for (auto row = corners.begin(); row != corners.end(); row += w) std::reverse(row, row + w);
   }
-  const auto at = [&](std::ptrdiff_t i, std::ptrdiff_t j) {
-    return corners[static_cast<std::size_t>(j * w + i)];
-  };
-  float evenMinusOdd = 0;
-  for (int j = 0; j + 1 < inner.height; ++j) {
-    for (int i = 0; i + 1 < inner.width; ++i) {
-      const float b =
-          squareBrightness(gray, at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-      evenMinusOdd += (i + j) % 2 == 0 ? b : -b;
-    }
-  }
-  if (evenMinusOdd > 0) std::reverse(corners.begin(), corners.end());
+  if (blackFirstScore(gray, corners, inner) < 0) std::reverse(corners.begin(), corners.end());
 }
 
 // The board's outline two squares beyond its outer inner corners (its outer squares and white
@@ -79,6 +68,23 @@ std::vector<cv::Point> boardOutline(const std::vector<cv::Point2f>& corners, cv:
 }
 
 }  // namespace
+
+float blackFirstScore(const cv::Mat& gray, std::span<const cv::Point2f> corners, cv::Size inner) {
+  const auto at = [&](int i, int j) {
+    return corners[static_cast<std::size_t>(j) * static_cast<std::size_t>(inner.width) +
+                   static_cast<std::size_t>(i)];
+  };
+  // Every inner square votes, for robustness against glare.
+  float oddMinusEven = 0;
+  for (int j = 0; j + 1 < inner.height; ++j) {
+    for (int i = 0; i + 1 < inner.width; ++i) {
+      const float b =
+          squareBrightness(gray, at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+      oddMinusEven += (i + j) % 2 == 0 ? -b : b;
+    }
+  }
+  return oddMinusEven / static_cast<float>((inner.width - 1) * (inner.height - 1));
+}
 
 double smallestGridStep(std::span<const cv::Point2f> corners, cv::Size inner) {
   const auto w = static_cast<std::size_t>(inner.width);

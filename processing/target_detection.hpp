@@ -33,6 +33,12 @@ std::vector<std::vector<cv::Point2f>> findCheckerboards(const cv::Mat& gray, cv:
 // `inner` columns x rows): its smallest square as the image shows it, pixels.
 double smallestGridStep(std::span<const cv::Point2f> corners, cv::Size inner);
 
+// How much brighter a board's odd inner squares are than its even ones (square (i, j) between
+// inner corners (i, j) and (i + 1, j + 1)), in grey levels: positive when the listing starts on a
+// black square as the board's own order does, negative when it starts on a white one, and
+// near zero for corners that are not a board.
+float blackFirstScore(const cv::Mat& gray, std::span<const cv::Point2f> corners, cv::Size inner);
+
 struct ArucoDetection {
   int id = 0;
   std::array<cv::Point2f, 4> corners;

@@ -11,6 +11,7 @@ namespace {
 constexpr std::string_view kExtrinsicsUsage =
     R"(usage: surround-calibrate extrinsics --rig FILE --camera NAME --image FILE
                                   (--markers FILE | --points FILE)... --out FILE [options]
+       surround-calibrate extrinsics --rig FILE --mat FILE --images DIR --out FILE [options]
 
 The pose of one camera on the vehicle from ground markers (checkerboards, ArUco) at known
 vehicle-frame positions, or from listed points with their pixels. Prints the reprojection error
@@ -33,6 +34,22 @@ and the change from the rig's current mount; writes the camera's mount: block.
   --residuals FILE           a PNG of the image with each point's residual magnified
   --inlier-px X              points missing by more are outliers (default 3)
   --update-rig               also write the mount into the rig file (see "--update-rig" below)
+
+With --mat, every camera the mat names at once, from one picture each of a calibration mat:
+checkerboards of known size and place on the ground, each seen by one camera or by two
+neighbours (see config/mats/four-corner-mat.yaml). Prints a table per camera (boards found,
+corners, reprojection RMS, change from the rig) and the seam error on the ground between cameras
+that share a board; writes only when every camera and seam passes, and exits 1 otherwise.
+
+  --mat FILE                 the mat's layout (YAML; see tools/calibrate/marker_file.hpp)
+  --images DIR               one picture per camera, named after it (front.png, left.jpg, ...)
+  --out FILE                 every camera's mount: block, under cameras: (YAML)
+  --min-corners N            per camera (default 20)
+  --max-rms-px X             reprojection RMS per camera (default 1)
+  --max-shift-m M            solved position against the rig's mount (default 0.5)
+  --max-turn-deg D           solved rotation against the rig's mount (default 15)
+  --max-seam-cm C            RMS ground distance of a shared board's corners (default 3)
+  --inlier-px X, --update-rig  as above
 )";
 
 constexpr std::string_view kMaskUsage =
@@ -65,20 +82,57 @@ it was and the command fails.
 
 ExtrinsicsOptions parseExtrinsics(std::span<const std::string_view> arguments) {
   ExtrinsicsOptions o;
-  parseOptions(arguments,
-               {{"--rig", [&](auto v) { o.rig = std::string(v); }},
-                {"--camera", [&](auto v) { o.camera = std::string(v); }},
-                {"--image", [&](auto v) { o.image = std::string(v); }},
-                {"--markers", [&](auto v) { o.markers = std::string(v); }},
-                {"--points", [&](auto v) { o.points = std::string(v); }},
-                {"--out", [&](auto v) { o.out = std::string(v); }},
-                {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
-                {"--inlier-px",
-                 [&](auto v) {
-                   o.inlierPx = parseDouble("--inlier-px", v, 0.1, 100, "pixels from 0.1 to 100");
-                 }}},
-               {{"--update-rig", [&](auto) { o.updateRig = true; }}});
+  parseOptions(
+      arguments,
+      {{"--rig", [&](auto v) { o.rig = std::string(v); }},
+       {"--camera", [&](auto v) { o.camera = std::string(v); }},
+       {"--image", [&](auto v) { o.image = std::string(v); }},
+       {"--markers", [&](auto v) { o.markers = std::string(v); }},
+       {"--points", [&](auto v) { o.points = std::string(v); }},
+       {"--out", [&](auto v) { o.out = std::string(v); }},
+       {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
+       {"--inlier-px",
+        [&](auto v) {
+          o.inlierPx = parseDouble("--inlier-px", v, 0.1, 100, "pixels from 0.1 to 100");
+        }},
+       {"--mat", [&](auto v) { o.mat = std::string(v); }},
+       {"--images", [&](auto v) { o.images = std::string(v); }},
+       {"--min-corners",
+        [&](auto v) {
+          o.limits.minCorners =
+              static_cast<int>(parseDouble("--min-corners", v, 6, 100000, "a count from 6"));
+        }},
+       {"--max-rms-px",
+        [&](auto v) {
+          o.limits.maxRmsPx = parseDouble("--max-rms-px", v, 0.01, 100, "pixels from 0.01 to 100");
+        }},
+       {"--max-shift-m",
+        [&](auto v) {
+          o.limits.maxShiftM =
+              parseDouble("--max-shift-m", v, 0.001, 100, "metres from 0.001 to 100");
+        }},
+       {"--max-turn-deg",
+        [&](auto v) {
+          o.limits.maxTurnDeg =
+              parseDouble("--max-turn-deg", v, 0.01, 180, "degrees from 0.01 to 180");
+        }},
+       {"--max-seam-cm",
+        [&](auto v) {
+          o.limits.maxSeamCm = parseDouble("--max-seam-cm", v, 0.01, 1000, "centimetres from 0.01");
+        }}},
+      {{"--update-rig", [&](auto) { o.updateRig = true; }}});
   if (o.rig.empty()) throw UsageError("--rig: missing (the rig file with the camera's lens)");
+  if (o.mat) {
+    if (!o.camera.empty() || !o.image.empty() || o.markers || o.points || o.residuals) {
+      throw UsageError(
+          "--mat: calibrates every camera the mat names from --images; --camera, "
+          "--image, --markers, --points and --residuals do not go with it");
+    }
+    if (!o.images) throw UsageError("--images: missing (the folder with one picture per camera)");
+    if (o.out.empty()) throw UsageError("--out: missing (the file to write the mount: blocks to)");
+    return o;
+  }
+  if (o.images) throw UsageError("--images: only with --mat (one picture per camera of a mat)");
   if (o.camera.empty()) throw UsageError("--camera: missing (the camera in the rig to calibrate)");
   if (o.image.empty()) throw UsageError("--image: missing (the camera's image of the markers)");
   if (!o.markers && !o.points) {

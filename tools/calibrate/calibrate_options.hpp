@@ -17,6 +17,7 @@
 #include <opencv2/core.hpp>
 
 #include "processing/camera_model.hpp"
+#include "processing/mat_calibration.hpp"
 #include "tools/calibrate/import_options.hpp"
 #include "tools/calibrate/intrinsics_options.hpp"
 
@@ -37,7 +38,11 @@ struct ExtrinsicsOptions {
   std::filesystem::path out;                       // the mount: block
   std::optional<std::filesystem::path> residuals;  // PNG
   double inlierPx = 3.0;
-  bool updateRig = false;  // write the new mount into the rig file
+  bool updateRig = false;  // write the new mount into the rig file (every camera's, with --mat)
+  // A calibration mat instead: every camera of the mat from its picture in `images`.
+  std::optional<std::filesystem::path> mat;     // the mat's layout (YAML)
+  std::optional<std::filesystem::path> images;  // folder with one picture per camera, NAME.png
+  processing::MatLimits limits;
 };
 
 struct MaskOptions {

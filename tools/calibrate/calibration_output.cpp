@@ -236,6 +236,23 @@ void writeMountBlock(const std::filesystem::path& file, const processing::Pose& 
   writeAtomically(file, block("mount", comment, mountFields(pose)));
 }
 
+void writeMountBlocks(const std::filesystem::path& file,
+                      std::span<const std::pair<std::string, processing::Pose>> mounts,
+                      std::string_view comment) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(12);
+  if (!comment.empty()) out << YAML::Comment(std::string(comment));
+  out << YAML::BeginMap << YAML::Key << "cameras" << YAML::Value << YAML::BeginSeq;
+  for (const auto& [name, pose] : mounts) {
+    out << YAML::BeginMap << YAML::Key << "name" << YAML::Value << name << YAML::Key << "mount"
+        << YAML::Value << YAML::Flow << YAML::BeginMap;
+    mountFields(pose)(out);
+    out << YAML::EndMap << YAML::EndMap;
+  }
+  out << YAML::EndSeq << YAML::EndMap;
+  writeAtomically(file, std::string(out.c_str()) + "\n");
+}
+
 void updateRigLens(const std::filesystem::path& rig, const std::string& camera,
                    const processing::Intrinsics& lens, std::string_view comment) {
   updateRig(

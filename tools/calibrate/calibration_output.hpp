@@ -5,8 +5,10 @@
 // sees half of one.
 
 #include <filesystem>
+#include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include <opencv2/core.hpp>
 
@@ -19,6 +21,11 @@ void writeLensBlock(const std::filesystem::path& file, const processing::Intrins
                     std::string_view comment);
 void writeMountBlock(const std::filesystem::path& file, const processing::Pose& pose,
                      std::string_view comment);
+
+// Several cameras' mount: blocks, each under its name in a cameras: list (the rig's own layout).
+void writeMountBlocks(const std::filesystem::path& file,
+                      std::span<const std::pair<std::string, processing::Pose>> mounts,
+                      std::string_view comment);
 
 // A PNG of `picture` (8-bit, 1 or 3 channels).
 void writePng(const std::filesystem::path& file, const cv::Mat& picture);

@@ -12,6 +12,7 @@
 #include "processing/ground_marker_detection.hpp"
 #include "tools/calibrate/calibration_output.hpp"
 #include "tools/calibrate/marker_file.hpp"
+#include "tools/calibrate/mat_command.hpp"
 #include "tools/calibrate/residual_plot.hpp"
 
 namespace surroundd::calibrate {
@@ -62,6 +63,7 @@ void reportPose(const processing::Pose& pose, const processing::Pose& before, st
 }  // namespace
 
 void runExtrinsics(const ExtrinsicsOptions& options, std::ostream& log) {
+  if (options.mat) return runMatExtrinsics(options, log);
   const processing::CameraCalibration camera = rigCamera(options.rig, options.camera);
   const processing::MarkerLayout layout =
       options.markers ? loadMarkerFile(*options.markers) : processing::MarkerLayout{};

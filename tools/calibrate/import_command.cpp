@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "tools/calibrate/calibrate_options.hpp"
+#include "tools/calibrate/camera_pictures.hpp"
 #include "tools/calibrate/foreign_lens.hpp"
 #include "tools/calibrate/ground_homography.hpp"
 #include "tools/calibrate/ocam_results.hpp"
@@ -46,31 +47,6 @@ std::vector<NamedCalibration> readInputs(const ImportOptions& options) {
     cameras.push_back(std::move(camera));
   }
   return cameras;
-}
-
-// The still picture of a camera in the --images folder: a picture file whose name (without its
-// extension, any case) is the camera's.
-std::optional<std::filesystem::path> findPicture(const std::filesystem::path& folder,
-                                                 const std::string& sourceName) {
-  std::error_code ec;
-  if (!std::filesystem::is_directory(folder, ec)) {
-    throw UsageError(fmt::format("--images: {} is not a folder", folder.string()));
-  }
-  std::vector<std::filesystem::path> matches;
-  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
-    const auto extension = lower(entry.path().extension().string());
-    const bool picture = extension == ".png" || extension == ".jpg" || extension == ".jpeg" ||
-                         extension == ".bmp" || extension == ".tif" || extension == ".tiff";
-    if (picture && lower(entry.path().stem().string()) == lower(sourceName)) {
-      matches.push_back(entry.path());
-    }
-  }
-  if (matches.size() > 1) {
-    throw UsageError(fmt::format("--images: {} has more than one picture for camera '{}'",
-                                 folder.string(), sourceName));
-  }
-  if (matches.empty()) return std::nullopt;
-  return matches.front();
 }
 
 processing::Pose poseOf(const std::string& camera, const ForeignCalibration& found,

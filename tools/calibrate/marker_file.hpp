@@ -17,6 +17,19 @@
 //
 // The print lies face up; its geometry is processing/calibration_targets.hpp's.
 //
+// A calibration mat (--mat): checkerboards on the ground, each seen whole by the cameras named
+// (one, or two neighbours for the seam between them); the board's two ends may look alike (see
+// processing/ground_mat.hpp). Same frame and placement keys as the markers:
+//
+//   boards:
+//     - name: front_left             # required, unique
+//       inner_corners: [7, 6]        # columns, rows of inner corners
+//       square_m: 0.2                # side of a square
+//       x_m: 3.4                     # centre of the inner-corner grid
+//       y_m: 1.9
+//       yaw_deg: 0                   # direction of the print's first row; default 0
+//       seen_by: [front, left]       # the cameras that must find it
+//
 // Points with known pixels (--points), for one camera's image:
 //
 //   points:
@@ -27,11 +40,13 @@
 
 #include "processing/calibration_targets.hpp"
 #include "processing/extrinsic_calibration.hpp"
+#include "processing/ground_mat.hpp"
 
 namespace surroundd::calibrate {
 
 // Both throw daemon::ConfigError with every problem, each as file:line:column: key: message.
 processing::MarkerLayout loadMarkerFile(const std::filesystem::path& file);
+processing::MatLayout loadMatFile(const std::filesystem::path& file);
 std::vector<processing::PointCorrespondence> loadPointFile(const std::filesystem::path& file);
 
 }  // namespace surroundd::calibrate

@@ -191,6 +191,23 @@ std::vector<processing::Pose> boardPosesCoveringField(const processing::Intrinsi
   return poses;
 }
 
+bool markerFitsView(const processing::CameraCalibration& camera,
+                    const processing::GroundMarker& marker, int arucoDictionary,
+                    const ViewFit& fit) {
+  const processing::CameraModel model(camera.intrinsics);
+  const int modules = arucoModules(arucoDictionary);
+  std::vector<cv::Vec3d> points;
+  for (const auto& p : markerCheckPoints(marker, modules)) {
+    points.push_back(camera.pose.toCamera(marker.toVehicle(p)));
+  }
+  const auto pixels = pixelsIfSeen(model, points, std::numbers::pi);
+  const bool isBoard = marker.kind == processing::MarkerKind::kCheckerboard;
+  return pixels &&
+         smallestFeaturePx(marker, *pixels, modules) >=
+             (isBoard ? fit.minBoardSquarePx : fit.minArucoModulePx) &&
+         (!fit.limitShear || notTooSheared(marker, *pixels));
+}
+
 processing::MarkerLayout groundMarkersInView(const processing::CameraCalibration& camera,
                                              const GroundMarkerRequest& request) {
   const processing::CameraModel model(camera.intrinsics);
@@ -236,16 +253,7 @@ processing::MarkerLayout groundMarkersInView(const processing::CameraCalibration
                    printRadius(other, modules) + printRadius(marker, modules) + 0.1;
           });
       if (!apart) continue;
-      std::vector<cv::Vec3d> points;
-      for (const auto& p : markerCheckPoints(marker, modules)) {
-        points.push_back(pose.toCamera(marker.toVehicle(p)));
-      }
-      const auto pixels = pixelsIfSeen(model, points, std::numbers::pi);
-      // Big enough to be found: a square at least 9 px, an ArUco module at least 4 px.
-      if (!pixels || smallestFeaturePx(marker, *pixels, modules) < (isBoard ? 9 : 4) ||
-          !notTooSheared(marker, *pixels)) {
-        continue;
-      }
+      if (!markerFitsView(camera, marker, request.arucoDictionary)) continue;
       layout.markers.push_back(marker);
       break;
     }

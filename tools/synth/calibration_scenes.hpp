@@ -34,6 +34,20 @@ struct GroundMarkerRequest {
   std::uint64_t seed = 1;
 };
 
+// What a marker must look like in a picture for its detector. The defaults are the raw-picture
+// detectors' (target_detection.hpp): squares of 9 px, modules of 4 px, and no strong shear, on
+// which cornerSubPix drifts (1.6 px on the acute corners of a far ArUco marker).
+struct ViewFit {
+  double minBoardSquarePx = 9;
+  double minArucoModulePx = 4;
+  bool limitShear = true;  // every angle of the outline within 55..125 degrees
+};
+
+// Whether `camera` sees the whole print of a ground marker, margin included, as `fit` asks.
+bool markerFitsView(const processing::CameraCalibration& camera,
+                    const processing::GroundMarker& marker, int arucoDictionary,
+                    const ViewFit& fit = {});
+
 // Markers on the ground (z = 0) that `camera` sees whole, apart from each other, roughly facing it;
 // as many as the request asks for where they fit (fewer when the view has no room).
 processing::MarkerLayout groundMarkersInView(const processing::CameraCalibration& camera,

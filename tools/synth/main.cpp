@@ -8,6 +8,7 @@ extern "C" {
 #include <libavutil/log.h>
 }
 
+#include "tools/synth/mat_scene_writer.hpp"
 #include "tools/synth/recording_writer.hpp"
 #include "tools/synth/synth_options.hpp"
 
@@ -21,7 +22,11 @@ int main(int argc, char** argv) {
   av_log_set_level(AV_LOG_ERROR);  // x264's per-stream statistics would bury our one-line summary
   try {
     const SynthOptions options = parseSynthArguments(arguments);
-    writeRecording(options, std::cout);
+    if (options.calibrationMat) {
+      writeMatScene(options, std::cout);
+    } else {
+      writeRecording(options, std::cout);
+    }
     return 0;
   } catch (const UsageError& error) {
     std::cerr << "surround-synth: " << error.what() << "\n";

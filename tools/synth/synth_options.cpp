@@ -52,6 +52,38 @@ std::vector<int> parseFrames(std::string_view option, std::string_view text) {
   return frames;
 }
 
+// COLSxROWS@SQUARE_M, e.g. 7x6@0.2.
+processing::Checkerboard parseMatBoard(std::string_view option, std::string_view text) {
+  const std::string what =
+      "COLSxROWS@SQUARE_M: inner corners, each 2 to 64, and the square's side in metres from 0.01 "
+      "to 2 (e.g. 7x6@0.2)";
+  const auto x = text.find('x');
+  const auto at = text.find('@');
+  if (x == std::string_view::npos || at == std::string_view::npos || at < x) {
+    throw UsageError(fmt::format("{}: expected {}, got '{}'", option, what, text));
+  }
+  try {
+    return {{parseNumber<int>(option, text.substr(0, x), 2, 64, what),
+             parseNumber<int>(option, text.substr(x + 1, at - x - 1), 2, 64, what)},
+            parseNumber<double>(option, text.substr(at + 1), 0.01, 2.0, what)};
+  } catch (const UsageError&) {
+    throw UsageError(fmt::format("{}: expected {}, got '{}'", option, what, text));
+  }
+}
+
+std::vector<std::string> parseNames(std::string_view text) {
+  std::vector<std::string> names;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const auto comma = text.find(',', start);
+    names.emplace_back(
+        text.substr(start, comma == std::string_view::npos ? text.npos : comma - start));
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  return names;
+}
+
 }  // namespace
 
 int SynthOptions::frameCount() const {
@@ -173,6 +205,10 @@ SynthOptions parseSynthArguments(std::span<const std::string_view> arguments) {
       o.panoramaSize = parseSize(option, value());
     } else if (option == "--crf") {
       o.crf = parseNumber<int>(option, value(), 0, 51, "an x264 CRF from 0 (lossless) to 51");
+    } else if (option == "--calibration-mat") {
+      o.calibrationMat = parseMatBoard(option, value());
+    } else if (option == "--mat-ahead") {
+      o.matAhead = parseNames(value());
     } else if (option == "--force") {
       o.force = true;
     } else {
@@ -227,6 +263,13 @@ usage: surround-synth --rig FILE --out DIR [options]
                              wall on the left, 1-3 m from the car at its start pose
   --panorama-size WxH        ground-truth panorama size (default 2048x1024)
   --crf N                    x264 CRF of the videos (default 14, visually lossless)
+  --calibration-mat BOARD    instead of a recording: one picture per camera (NAME.png) of a
+                             calibration mat laid around the rig, a board of pattern BOARD
+                             (COLSxROWS@SQUARE_M, e.g. 7x6@0.2) in each overlap of two neighbouring
+                             cameras, with its layout (mat.yaml, for surround-calibrate extrinsics
+                             --mat) and the true rig (rig.yaml)
+  --mat-ahead NAMES          with --calibration-mat: these cameras (comma-separated) also get a
+                             board straight ahead
   --force                    replace DIR if it exists (a DIR made by the same arguments, rig and
                              generator is kept as it is: "up to date")
   --help                     this text

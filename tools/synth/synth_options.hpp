@@ -14,6 +14,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "processing/calibration_targets.hpp"
 #include "tools/synth/scene.hpp"
 
 namespace surroundd::synth {
@@ -53,6 +54,10 @@ struct SynthOptions {
   cv::Size panoramaSize{2048, 1024};
   int crf = 14;        // x264 CRF: visually lossless camera masters
   bool force = false;  // replace an existing output folder
+  // Instead of a recording: one picture per camera of a calibration mat laid around the rig
+  // (calibration_mat.hpp) with boards of this pattern, its layout and the true rig.
+  std::optional<processing::Checkerboard> calibrationMat;
+  std::vector<std::string> matAhead;  // cameras that also get a board straight ahead
 
   int frameCount() const;
   // Everything that decides the recording's content (not --out or --force), in a fixed order:
