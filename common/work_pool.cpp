@@ -1,6 +1,7 @@
 #include "common/work_pool.hpp"
 
 #include <algorithm>
+#include <utility>
 
 namespace surroundd {
 
@@ -41,6 +42,7 @@ void WorkPool::run(int count, int chunks, void* callable, Trampoline trampoline)
   takeChunks();
   std::unique_lock lock(mutex_);
   done_.wait(lock, [this] { return unfinished_ == 0; });
+  if (failure_) std::rethrow_exception(std::exchange(failure_, nullptr));
 }
 
 void WorkPool::takeChunks() {
@@ -53,8 +55,19 @@ void WorkPool::takeChunks() {
     void* callable = callable_;
     const Trampoline trampoline = trampoline_;
     lock.unlock();
-    trampoline(callable, begin, end);
+    std::exception_ptr failure;
+    try {
+      trampoline(callable, begin, end);
+    } catch (...) {
+      failure = std::current_exception();
+    }
     lock.lock();
+    if (failure) {
+      if (!failure_) failure_ = failure;
+      // The chunks not handed out yet are dropped: the loop has failed.
+      unfinished_ -= chunks_ - nextChunk_;
+      nextChunk_ = chunks_;
+    }
     if (--unfinished_ == 0) done_.notify_one();
   }
 }

@@ -7,6 +7,7 @@
 
 #include <condition_variable>
 #include <cstddef>
+#include <exception>
 #include <mutex>
 #include <thread>
 #include <type_traits>
@@ -26,7 +27,9 @@ class WorkPool {
 
   // Calls body(begin, end) on disjoint chunks that together cover [0, count), in parallel, and
   // returns when all are done. `chunks` (default: one per thread) sets how finely the range is cut;
-  // more chunks balance uneven work better.
+  // more chunks balance uneven work better. An exception from the body (on any thread) stops the
+  // chunks not yet begun, and the first one is rethrown here once every running chunk is done;
+  // the pool stays usable.
   template <typename Body>
   void parallelFor(int count, Body&& body, int chunks = 0) {
     using Callable = std::remove_reference_t<Body>;
@@ -53,8 +56,9 @@ class WorkPool {
   Trampoline trampoline_ = nullptr;
   int count_ = 0;
   int chunks_ = 0;
-  int nextChunk_ = 0;   // next chunk to hand out
-  int unfinished_ = 0;  // chunks not yet finished
+  int nextChunk_ = 0;           // next chunk to hand out
+  int unfinished_ = 0;          // chunks not yet finished
+  std::exception_ptr failure_;  // the first exception of the current loop
 };
 
 }  // namespace surroundd

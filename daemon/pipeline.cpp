@@ -150,6 +150,7 @@ PipelineReport Pipeline::report() const {
   report.latency = latency_;
   report.outputs = outputs_.size() + recorders_.size();
   report.failedOutputs = failedSinks_;
+  report.failedSets = failedSets_;
   for (const auto& output : outputs_)
     report.outputDropped += output.sink ? output.sink->dropped() : 0;
   if (gl_) report.renderer = gl_->description();
@@ -178,9 +179,19 @@ RunSummary Pipeline::run(const std::atomic<bool>& stop, PipelineObserver* observ
       stageTime_[static_cast<std::size_t>(Stage::kSync)] +=
           setStageTime_[static_cast<std::size_t>(Stage::kSync)];
       setStagesRun_.set(static_cast<std::size_t>(Stage::kSync));
-      process(*set);
-      ++frameSets_;
+      try {
+        if (observer != nullptr) observer->onFrameSet(*this, *set);
+        process(*set);
+        failedInARow_ = 0;
+        ++frameSets_;
+      } catch (const std::exception& e) {
+        if (dropFailedSet(e)) {
+          summary.rebuild = true;
+          break;
+        }
+      }
     }
+    if (summary.rebuild) break;
     const auto now = Clock::now();
     followPages(now);
     if (now >= nextProgress) {
@@ -193,8 +204,30 @@ RunSummary Pipeline::run(const std::atomic<bool>& stop, PipelineObserver* observ
   if (stop) spdlog::info("stop requested: finalizing outputs");
   finish(summary);
   summary.frameSets = frameSets_;
+  summary.failedSets = failedSets_;
   summary.wallTime = Clock::now() - start_;
   return summary;
+}
+
+bool Pipeline::dropFailedSet(const std::exception& error) {
+  ++failedSets_;
+  ++failedInARow_;
+  setStageTime_.fill(std::chrono::nanoseconds(0));
+  setStagesRun_.reset();
+  const auto now = Clock::now();
+  if (now - lastFailureLog_ >= std::chrono::seconds(1)) {
+    spdlog::error("frame set dropped: {}{}", error.what(),
+                  unloggedFailures_ == 0
+                      ? std::string()
+                      : fmt::format(" ({} more since the last such message)", unloggedFailures_));
+    lastFailureLog_ = now;
+    unloggedFailures_ = 0;
+  } else {
+    ++unloggedFailures_;
+  }
+  if (failedInARow_ < kRebuildAfterFailures) return false;
+  spdlog::error("{} frame sets failed in a row: the pipeline is rebuilt", failedInARow_);
+  return true;
 }
 
 std::optional<capture::FrameSet> Pipeline::nextSet(const std::atomic<bool>& stop) {

@@ -55,6 +55,8 @@ struct RunSummary {
   std::vector<capture::CameraStreamStats> cameras;
   std::vector<std::string> outputs;  // what each output wrote
   std::uint64_t failedOutputs = 0;
+  std::uint64_t failedSets = 0;  // frame sets a stage failed on: dropped, the run went on
+  bool rebuild = false;          // ended because kRebuildAfterFailures sets failed in a row
   std::array<std::chrono::nanoseconds, kStageCount> stageTime{};  // summed over the run
   std::vector<capture::HealthChange> healthChanges;               // in order; `at` is stream time
   std::string renderer;   // the EGL context's description, when there were surround outputs
@@ -76,6 +78,8 @@ class PipelineObserver {
                       std::uint64_t frameSets) = 0;
   // The run is ending; the outputs are about to be finalized.
   virtual void onStopping() = 0;
+  // Each frame set, before its stages; it counts as one of them (an exception drops the set).
+  virtual void onFrameSet(Pipeline& /*pipeline*/, const capture::FrameSet& /*set*/) {}
 };
 
 class Pipeline {
@@ -84,6 +88,11 @@ class Pipeline {
   ~Pipeline();
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
+
+  // A frame set that any stage fails on (an exception) is dropped, counted and logged (at most
+  // once a second with the count since); after this many in a row the run ends asking to be
+  // rebuilt (RunSummary::rebuild), as a state gone bad is more likely than bad frames.
+  static constexpr int kRebuildAfterFailures = 20;
 
   // Runs until every camera has ended or `stop` becomes true, then finalizes every output.
   RunSummary run(const std::atomic<bool>& stop, PipelineObserver* observer = nullptr);
@@ -167,6 +176,12 @@ class Pipeline {
   Clock::time_point start_{};
   Clock::time_point nextPageStatus_{};
   std::uint64_t failedSinks_ = 0;
+  std::uint64_t failedSets_ = 0;
+  int failedInARow_ = 0;
+  std::uint64_t unloggedFailures_ = 0;  // since the last logged one
+  Clock::time_point lastFailureLog_{};
+  // Drops a set a stage failed on; true when the run should end for a rebuild.
+  bool dropFailedSet(const std::exception& error);
   std::optional<capture::Timestamp> firstTimestamp_;
   std::chrono::nanoseconds lastStreamTime_{0};
 };

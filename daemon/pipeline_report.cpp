@@ -56,8 +56,10 @@ std::string statusText(const PipelineReport& report) {
   std::string out = fmt::format("{} frame sets in {:.1f} s: {}\n", report.frameSets,
                                 report.elapsed.count(), statusLine(report));
   fmt::format_to(std::back_inserter(out),
-                 "stale sets skipped: {}; outputs: {} ({} failed, {} pictures dropped)\n",
-                 report.staleDropped, report.outputs, report.failedOutputs, report.outputDropped);
+                 "stale sets skipped: {}; failed sets dropped: {}; outputs: {} ({} failed, {} "
+                 "pictures dropped)\n",
+                 report.staleDropped, report.failedSets, report.outputs, report.failedOutputs,
+                 report.outputDropped);
   if (!report.renderer.empty())
     fmt::format_to(std::back_inserter(out), "render: {}\n", report.renderer);
   for (std::size_t s = 0; s < kStageCount; ++s) {
@@ -161,6 +163,10 @@ std::string prometheusText(const PipelineReport& report) {
   family(out, "outputs_failed_total", "counter", "Outputs dropped after an error.");
   fmt::format_to(std::back_inserter(out), "surroundd_outputs_failed_total {}\n",
                  report.failedOutputs);
+  family(out, "frame_sets_failed_total", "counter",
+         "Frame sets a stage failed on, dropped (the run goes on).");
+  fmt::format_to(std::back_inserter(out), "surroundd_frame_sets_failed_total {}\n",
+                 report.failedSets);
   return out;
 }
 

@@ -38,6 +38,7 @@ struct PipelineReport {
   DurationHistogram latency;  // a frame's capture to its picture handed to an output
   std::size_t outputs = 0;
   std::uint64_t failedOutputs = 0;
+  std::uint64_t failedSets = 0;     // frame sets a stage failed on (dropped)
   std::uint64_t outputDropped = 0;  // pictures outputs dropped because they fell behind
   std::string renderer;
 

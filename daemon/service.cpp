@@ -1,5 +1,9 @@
 #include "daemon/service.hpp"
 
+#include <algorithm>
+#include <chrono>
+#include <thread>
+
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
@@ -14,6 +18,9 @@ void logSummary(const RunSummary& summary) {
       summary.frameSets, summary.wallTime.count(), summary.framesPerSecond(),
       summary.sync.totalDropped(),
       std::chrono::duration<double, std::milli>(summary.sync.maxSpread).count());
+  if (summary.failedSets > 0) {
+    spdlog::warn("{} frame sets failed and were dropped", summary.failedSets);
+  }
   const auto& latency = summary.report.latency;
   if (latency.count() > 0) {
     spdlog::info("latency capture to output: p50 {:.1f} ms, p99 {:.1f} ms ({} pictures)",
@@ -67,6 +74,18 @@ int Service::run() {
     const RunSummary summary = pipeline->run(endRun_, this);
     pipeline.reset();
     logSummary(summary);
+    if (summary.rebuild && !signals_.stop) {
+      // The same config again, after a pause that grows while rebuilds keep failing.
+      rebuilds_ = summary.frameSets > 0 ? 1 : rebuilds_ + 1;
+      const auto pause =
+          std::min(std::chrono::seconds(1 << std::min(rebuilds_ - 1, 5)), std::chrono::seconds(30));
+      spdlog::warn("rebuilding the pipeline in {} s", pause.count());
+      for (auto until = std::chrono::steady_clock::now() + pause;
+           std::chrono::steady_clock::now() < until && !signals_.stop;) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      }
+      if (!signals_.stop) continue;
+    }
     if (!pending_ || signals_.stop) return summary.failedOutputs == 0 ? 0 : 1;
     previous = std::exchange(config_, *std::exchange(pending_, std::nullopt));
     ++reloads_;

@@ -51,6 +51,7 @@ class Service final : public PipelineObserver {
   Config config_;
   std::optional<Config> pending_;  // a good new config, started when the current run has ended
   int reloads_ = 0;
+  int rebuilds_ = 0;  // in a row, without a frame set between: the pause before the next grows
   ServiceSignals& signals_;
   ServiceNotifier notifier_;
   std::unique_ptr<ControlServer> control_;

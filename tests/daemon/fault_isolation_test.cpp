@@ -1,0 +1,79 @@
+// Issue 18: an exception from a stage on the pipeline thread reached main's catch-all and ended
+// the service, losing the recording's end. Now a frame set a stage fails on is dropped and
+// counted, the run goes on and finalizes its outputs; many failures in a row end the run asking
+// for a rebuild. The failures come through the observer's per-set hook, which counts as a stage.
+
+#include <stdexcept>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "daemon/pipeline.hpp"
+#include "daemon/rig_yaml.hpp"
+#include "tests/support/temp_dir.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace surroundd::daemon {
+namespace {
+
+// Throws on the sets whose number (from 0) `fails` says.
+class FailingStage final : public PipelineObserver {
+ public:
+  explicit FailingStage(std::function<bool(int)> fails) : fails_(std::move(fails)) {}
+  void onLoop(Pipeline& /*pipeline*/, std::chrono::steady_clock::time_point /*now*/,
+              std::uint64_t /*frameSets*/) override {}
+  void onStopping() override {}
+  void onFrameSet(Pipeline& /*pipeline*/, const capture::FrameSet& /*set*/) override {
+    if (fails_(sets_++)) throw std::runtime_error("a stage failed on this set");
+  }
+
+ private:
+  std::function<bool(int)> fails_;
+  int sets_ = 0;
+};
+
+Config replayConfig(const std::filesystem::path& out) {
+  const auto rig = std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small" / "rig.yaml";
+  Config config;
+  config.file = rig;
+  config.cameras = loadRigFile(rig);
+  config.capture.pacing = capture::Pacing::kAsFastAsPossible;
+  config.render.widthPx = 320;
+  config.render.heightPx = 180;
+  OutputConfig video;
+  video.path = out / "mosaic.mkv";
+  config.outputs = {video};
+  return config;
+}
+
+TEST(FaultIsolation, AFailedSetIsDroppedAndTheRunGoesOn) {
+  const testing::TempDir dir;
+  Pipeline pipeline(replayConfig(dir.path()));
+  FailingStage stage([](int set) { return set >= 3 && set < 6; });
+  const std::atomic<bool> stop{false};
+  const RunSummary summary = pipeline.run(stop, &stage);
+  EXPECT_EQ(summary.failedSets, 3u);
+  EXPECT_FALSE(summary.rebuild);
+  EXPECT_EQ(summary.failedOutputs, 0u);
+  const auto video = surroundd::testing::decodeAll(dir / "mosaic.mkv");
+  EXPECT_EQ(video.last, capture::ReadStatus::kEndOfStream);  // finalized
+  EXPECT_EQ(video.images.size(), summary.frameSets);
+  EXPECT_GT(summary.frameSets, 10u);
+  EXPECT_EQ(pipeline.report().failedSets, 3u);
+}
+
+TEST(FaultIsolation, FailuresInARowEndTheRunForARebuild) {
+  const testing::TempDir dir;
+  Pipeline pipeline(replayConfig(dir.path()));
+  FailingStage stage([](int set) { return set >= 2; });
+  const std::atomic<bool> stop{false};
+  const RunSummary summary = pipeline.run(stop, &stage);
+  EXPECT_TRUE(summary.rebuild);
+  EXPECT_EQ(summary.frameSets, 2u);
+  EXPECT_EQ(summary.failedSets, static_cast<std::uint64_t>(Pipeline::kRebuildAfterFailures));
+  // What it wrote before is finalized, not lost.
+  EXPECT_EQ(surroundd::testing::decodeAll(dir / "mosaic.mkv").images.size(), 2u);
+}
+
+}  // namespace
+}  // namespace surroundd::daemon
