@@ -66,20 +66,17 @@ Pipeline::Pipeline(const Config& config)
           config.cameras, nominalFps));
       continue;
     }
-    const cv::Size size =
-        output.stream == OutputStream::kPanorama ? lut_->size : mosaic_.outputSize();
     Output out;
     out.stream = output.stream;
+    out.config = output;
+    out.size = output.stream == OutputStream::kPanorama ? lut_->size : mosaic_.outputSize();
+    out.nominalFps = nominalFps;
     const ViewKind view = output.view.value_or(config.render.view);
-    if (output.kind == OutputKind::kHttp) {
-      auto http = openHttp(output, view);
-      out.http = http.get();
-      out.sink = std::move(http);
-    } else {
-      out.sink = openSink(output, size, nominalFps, latestWins_);
-    }
+    out.config.view = view;
+    open(out);
     if (output.stream == OutputStream::kSurround) {
-      out.view = std::make_unique<render::SurroundView>(*scene_, size, view, config.render.views);
+      out.view =
+          std::make_unique<render::SurroundView>(*scene_, out.size, view, config.render.views);
     }
     outputs_.push_back(std::move(out));
   }
@@ -193,6 +190,7 @@ RunSummary Pipeline::run(const std::atomic<bool>& stop, PipelineObserver* observ
     }
     if (summary.rebuild) break;
     const auto now = Clock::now();
+    retryOutputs(now);
     followPages(now);
     if (now >= nextProgress) {
       nextProgress += kProgressInterval;
@@ -290,10 +288,46 @@ void Pipeline::guarded(Output& output, Step&& step) {
   try {
     step();
   } catch (const std::exception& e) {
-    spdlog::error("output failed, dropping it: {}", e.what());
-    ++failedSinks_;
     output.sink.reset();
+    output.http = nullptr;
+    output.retryDelay = kFirstOutputRetry;
+    output.nextRetry = Clock::now() + output.retryDelay;
+    spdlog::error("output failed, dropping it: {}; trying it again in {} s", e.what(),
+                  output.retryDelay.count());
+    ++failedSinks_;
   }
+}
+
+void Pipeline::open(Output& output) {
+  // Where the failed try left data, this one writes the next name.
+  output.config.path = unusedOutputPath(output.config);
+  if (output.config.kind == OutputKind::kHttp) {
+    auto http = openHttp(output.config, *output.config.view);
+    output.http = http.get();
+    output.sink = std::move(http);
+  } else {
+    output.sink = openSink(output.config, output.size, output.nominalFps, latestWins_);
+  }
+}
+
+void Pipeline::retryOutputs(Clock::time_point now) {
+  for (auto& output : outputs_) {
+    if (output.sink || now < output.nextRetry) continue;
+    try {
+      open(output);
+      spdlog::info("output {} works again", output.sink->describe());
+    } catch (const std::exception& e) {
+      output.retryDelay = std::min(2 * output.retryDelay, kLastOutputRetry);
+      output.nextRetry = now + output.retryDelay;
+      spdlog::error("output still failing: {}; trying it again in {} s", e.what(),
+                    output.retryDelay.count());
+    }
+  }
+}
+
+bool Pipeline::outputsWork() const {
+  return std::ranges::any_of(outputs_, [](const Output& o) { return o.sink != nullptr; }) ||
+         std::ranges::any_of(recorders_, [](const auto& r) { return r != nullptr; });
 }
 
 void Pipeline::fillNeeds(const std::atomic<bool>& stop) {

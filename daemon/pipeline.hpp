@@ -101,6 +101,13 @@ class Pipeline {
   // Switches every surround output to `view` (takes effect with the next frame set).
   void setView(ViewKind view);
   PipelineReport report() const;
+  // Whether any output (or recording) works: with none, the run records nothing (a full disk),
+  // and the service stops feeding the watchdog and says so in its status.
+  bool outputsWork() const;
+  // A failed output is opened again after kFirstOutputRetry, then after twice as long each time,
+  // up to kLastOutputRetry (a disk with room again, a display plugged back in).
+  static constexpr std::chrono::seconds kFirstOutputRetry{1};
+  static constexpr std::chrono::seconds kLastOutputRetry{60};
   // The newest picture handed to the first output that shows pictures (a surround view if there
   // is one); a header over the pipeline's buffer, valid until the next frame set. Empty before.
   cv::Mat latestPicture() const;
@@ -109,7 +116,12 @@ class Pipeline {
   using Clock = std::chrono::steady_clock;
   struct Output {
     OutputStream stream = OutputStream::kMosaic;
-    std::unique_ptr<render::FrameSink> sink;     // null once it failed
+    OutputConfig config;  // to open it again after a failure (its path: the one it writes now)
+    cv::Size size;
+    double nominalFps = 30;
+    std::unique_ptr<render::FrameSink> sink;  // null while it has failed
+    Clock::time_point nextRetry{};            // when failed: when it is opened again
+    std::chrono::seconds retryDelay{0};
     std::unique_ptr<render::SurroundView> view;  // surround outputs
     std::chrono::nanoseconds pendingTime{0};     // stream time of the view's pending picture
     Clock::time_point pendingOrigin{};           // capture time of the pending picture's set
@@ -127,6 +139,8 @@ class Pipeline {
   void followHealth(const capture::FrameSet& set);
   // HTTP outputs: the views their pages asked for, and their status once a second.
   void followPages(Clock::time_point now);
+  void open(Output& output);  // throws what the sink's constructor throws
+  void retryOutputs(Clock::time_point now);
   void renderSurround(const capture::FrameSet& set, Clock::time_point origin);
   void deliverSurround();
   void finish(RunSummary& summary);

@@ -56,10 +56,10 @@ std::string statusText(const PipelineReport& report) {
   std::string out = fmt::format("{} frame sets in {:.1f} s: {}\n", report.frameSets,
                                 report.elapsed.count(), statusLine(report));
   fmt::format_to(std::back_inserter(out),
-                 "stale sets skipped: {}; failed sets dropped: {}; outputs: {} ({} failed, {} "
-                 "pictures dropped)\n",
-                 report.staleDropped, report.failedSets, report.outputs, report.failedOutputs,
-                 report.outputDropped);
+                 "stale sets skipped: {}; outputs: {} ({} failed, {} pictures dropped); sets a "
+                 "stage failed on: {}\n",
+                 report.staleDropped, report.outputs, report.failedOutputs, report.outputDropped,
+                 report.failedSets);
   if (!report.renderer.empty())
     fmt::format_to(std::back_inserter(out), "render: {}\n", report.renderer);
   for (std::size_t s = 0; s < kStageCount; ++s) {

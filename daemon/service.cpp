@@ -100,8 +100,15 @@ void Service::onLoop(Pipeline& pipeline, std::chrono::steady_clock::time_point n
   if (control_) {
     control_->serve([&](const ControlRequest& request) { return answer(pipeline, request); });
   }
-  notifier_.tick(now, frameSets);
-  if (notifier_.statusDue(now)) notifier_.status(now, statusLine(pipeline.report()));
+  // With every output failed nothing is recorded: the watchdog is no longer fed, so systemd
+  // restarts the service if the outputs do not come back first.
+  const bool outputsWork = pipeline.outputsWork();
+  notifier_.tick(now, frameSets, outputsWork);
+  if (notifier_.statusDue(now)) {
+    const std::string line = statusLine(pipeline.report());
+    notifier_.status(now,
+                     outputsWork ? line : "degraded: every output has failed, retrying; " + line);
+  }
 }
 
 void Service::onStopping() {

@@ -16,14 +16,14 @@ ServiceNotifier ServiceNotifier::fromEnvironment() {
       watchdog, [](std::string_view message) { sd_notify(0, std::string(message).c_str()); });
 }
 
-void ServiceNotifier::tick(Clock::time_point now, std::uint64_t frameSets) {
+void ServiceNotifier::tick(Clock::time_point now, std::uint64_t frameSets, bool outputsWork) {
   if (frameSets == 0) return;  // nothing has come through yet: not ready, nothing to ping for
   if (!ready_) {
     ready_ = true;
     send_("READY=1");
     nextStatus_ = now;
   }
-  if (watchdog_ && now >= nextPing_ && frameSets > pingedAt_) {
+  if (watchdog_ && outputsWork && now >= nextPing_ && frameSets > pingedAt_) {
     send_("WATCHDOG=1");
     pingedAt_ = frameSets;
     nextPing_ = now + *watchdog_ / 2;

@@ -27,8 +27,9 @@ class ServiceNotifier {
   static ServiceNotifier fromEnvironment();
 
   // Called by the pipeline thread as it loops (at least every few hundred milliseconds, stalled
-  // or not), with the frame sets so far.
-  void tick(Clock::time_point now, std::uint64_t frameSets);
+  // or not), with the frame sets so far; the watchdog is fed only while sets come and some output
+  // works.
+  void tick(Clock::time_point now, std::uint64_t frameSets, bool outputsWork = true);
   // Whether a new status line is due (the caller then makes one and hands it to status()).
   bool statusDue(Clock::time_point now) const { return ready_ && now >= nextStatus_; }
   void status(Clock::time_point now, std::string_view text);

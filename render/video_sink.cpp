@@ -11,7 +11,8 @@ namespace {
 // Numbers above this are refused rather than let to wrap (a stray "seg-9223372036854775807").
 constexpr std::int64_t kMaxSegment = 999'999'999'999;
 
-// The highest N of the <stem>-N<ext> files next to `path`, or 0.
+// The highest N of the <stem>-N<ext> files next to `path` (or their .part files: a segment a
+// killed run left unfinished is kept too), or 0.
 std::int64_t lastSegmentIn(const std::filesystem::path& path) {
   const auto folder = path.parent_path().empty() ? std::filesystem::path(".") : path.parent_path();
   const std::string stem = path.stem().string();
@@ -19,7 +20,8 @@ std::int64_t lastSegmentIn(const std::filesystem::path& path) {
   std::int64_t last = 0;
   std::error_code error;
   for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
-    const std::string name = entry.path().filename().string();
+    std::string name = entry.path().filename().string();
+    if (name.ends_with(".part")) name.resize(name.size() - 5);
     if (!name.starts_with(stem + "-") || !name.ends_with(extension)) continue;
     const std::string_view digits(name.data() + stem.size() + 1,
                                   name.size() - stem.size() - 1 - extension.size());

@@ -46,12 +46,12 @@ TEST_F(ServiceNotifierTest, ReadyOnlyOnceTheFirstFrameSetIsThrough) {
 TEST_F(ServiceNotifierTest, PingsTheWatchdogOnlyWhileFrameSetsKeepComing) {
   std::uint64_t sets = 0;
   int pings = 0;
-  const auto pingsIn = [&](int fromMs, int toMs, bool progressing) {
+  const auto pingsIn = [&](int fromMs, int toMs, bool progressing, bool outputsWork = true) {
     pings = 0;
     for (int ms = fromMs; ms < toMs; ms += 33) {
       if (progressing) ++sets;
       const std::size_t before = sent_.size();
-      notifier_.tick(t0_ + milliseconds(ms), sets);
+      notifier_.tick(t0_ + milliseconds(ms), sets, outputsWork);
       for (std::size_t i = before; i < sent_.size(); ++i) pings += sent_[i] == "WATCHDOG=1" ? 1 : 0;
     }
     return pings;
@@ -61,6 +61,10 @@ TEST_F(ServiceNotifierTest, PingsTheWatchdogOnlyWhileFrameSetsKeepComing) {
   EXPECT_LE(pingsIn(2000, 2600, false), 1);
   EXPECT_EQ(pingsIn(2600, 5000, false), 0);
   EXPECT_EQ(pingsIn(5000, 6000, true), 2);  // going again
+  // Issue 18: sets keep coming but every output has failed (a full disk): nothing is recorded,
+  // so no pings either; and they resume once an output works again.
+  EXPECT_EQ(pingsIn(6000, 9000, true, false), 0);
+  EXPECT_EQ(pingsIn(9000, 10000, true), 2);
 }
 
 // Every message until STOPPING=1, or until nothing comes for 2.5 s.

@@ -271,10 +271,15 @@ TEST(VideoSink, SegmentsAreWholePlayableFilesAndARestartNumbersOn) {
   EXPECT_EQ(testing::decodeAll(dir / "drive-00001.mp4").images.size(), 30u);
   EXPECT_FALSE(std::filesystem::exists(dir / "drive.mp4"));
 
+  // A segment a killed run left unfinished (its .part) is kept: numbering goes on after it.
+  dir.write("drive-00005.mp4.part", "frames of a killed run");
+  EXPECT_THAT(write(85, 5), HasSubstr("drive-00006.mp4 .."));
+  EXPECT_EQ(testing::fileBytes(dir / "drive-00005.mp4.part"), "frames of a killed run");
+
   // Beside a stray segment of the highest int (UBSan saw the next number wrap to -2147483648),
   // numbering goes on; beside one at the end of the numbers it stops with the file named.
   dir.write("drive-2147483647.mp4", "");
-  EXPECT_THAT(write(85, 5), HasSubstr("drive-2147483648.mp4 .."));
+  EXPECT_THAT(write(90, 5), HasSubstr("drive-2147483648.mp4 .."));
   dir.write("drive-999999999999.mp4", "");
   EXPECT_THAT([&] { VideoSink(settings, std::chrono::seconds(1)); },
               ::testing::ThrowsMessage<EncoderError>(
