@@ -48,17 +48,26 @@ TEST(ControlProtocol, RepliesAreFramedWithTheirLength) {
   EXPECT_EQ(encodeReply(ControlReply::failure("two\nlines")), "error two lines\n");
 }
 
-// A raw client, for sending what surroundctl never would.
-std::string exchange(const std::filesystem::path& path, std::string_view bytes, bool closeWrite) {
+// A connected raw client that has sent `bytes` (maybe nothing) and reads nothing yet.
+int connectRaw(const std::filesystem::path& path, std::string_view bytes = {}) {
   const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
   sockaddr_un address{};
   address.sun_family = AF_UNIX;
   std::snprintf(address.sun_path, sizeof(address.sun_path), "%s", path.c_str());
   if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
     ::close(fd);
-    return "connect failed";
+    return -1;
   }
-  [[maybe_unused]] const auto sent = ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+  if (!bytes.empty()) {
+    [[maybe_unused]] const auto sent = ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+  }
+  return fd;
+}
+
+// A raw client, for sending what surroundctl never would.
+std::string exchange(const std::filesystem::path& path, std::string_view bytes, bool closeWrite) {
+  const int fd = connectRaw(path, bytes);
+  if (fd < 0) return "connect failed";
   if (closeWrite) ::shutdown(fd, SHUT_WR);
   std::string reply;
   std::array<char, 4096> buffer{};
@@ -138,22 +147,6 @@ TEST_F(ControlServerTest, MisbehavingClientsGetAnErrorAndTheServerGoesOn) {
   EXPECT_EQ(served_, 0);  // none of them reached the pipeline
   EXPECT_EQ(exchange(path_, "status\n", false), "ok 12\nanswer to 0 ");
   EXPECT_EQ(served_, 1);
-}
-
-// A connected raw client that has sent `bytes` (maybe nothing) and reads nothing yet.
-int connectRaw(const std::filesystem::path& path, std::string_view bytes = {}) {
-  const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
-  sockaddr_un address{};
-  address.sun_family = AF_UNIX;
-  std::snprintf(address.sun_path, sizeof(address.sun_path), "%s", path.c_str());
-  if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
-    ::close(fd);
-    return -1;
-  }
-  if (!bytes.empty()) {
-    [[maybe_unused]] const auto sent = ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
-  }
-  return fd;
 }
 
 // Whether the server has said anything to `fd` yet (without waiting).

@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "daemon/pipeline.hpp"
-#include "daemon/rig_yaml.hpp"
+#include "tests/daemon/replay_config.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -32,23 +32,13 @@ class FailingStage final : public PipelineObserver {
   int sets_ = 0;
 };
 
-Config replayConfig(const std::filesystem::path& out) {
-  const auto rig = std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small" / "rig.yaml";
-  Config config;
-  config.file = rig;
-  config.cameras = loadRigFile(rig);
-  config.capture.pacing = capture::Pacing::kAsFastAsPossible;
-  config.render.widthPx = 320;
-  config.render.heightPx = 180;
-  OutputConfig video;
-  video.path = out / "mosaic.mkv";
-  config.outputs = {video};
-  return config;
+Config mosaicReplay(const std::filesystem::path& out) {
+  return fixtureReplay("synth_small", {videoOutputAt(out / "mosaic.mkv")});
 }
 
 TEST(FaultIsolation, AFailedSetIsDroppedAndTheRunGoesOn) {
   const testing::TempDir dir;
-  Pipeline pipeline(replayConfig(dir.path()));
+  Pipeline pipeline(mosaicReplay(dir.path()));
   FailingStage stage([](int set) { return set >= 3 && set < 6; });
   const std::atomic<bool> stop{false};
   const RunSummary summary = pipeline.run(stop, &stage);
@@ -64,7 +54,7 @@ TEST(FaultIsolation, AFailedSetIsDroppedAndTheRunGoesOn) {
 
 TEST(FaultIsolation, FailuresInARowEndTheRunForARebuild) {
   const testing::TempDir dir;
-  Pipeline pipeline(replayConfig(dir.path()));
+  Pipeline pipeline(mosaicReplay(dir.path()));
   FailingStage stage([](int set) { return set >= 2; });
   const std::atomic<bool> stop{false};
   const RunSummary summary = pipeline.run(stop, &stage);

@@ -13,6 +13,7 @@
 #include "daemon/pipeline.hpp"
 #include "daemon/rig_yaml.hpp"
 #include "tests/daemon/config_test_support.hpp"
+#include "tests/daemon/replay_config.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace surroundd::daemon {
@@ -100,16 +101,7 @@ TEST(OutputFiles, AFolderThatCannotBeMadeNamesItsOutput) {
 // any run wrote is lost, truncated or overwritten.
 TEST(OutputFiles, RestartsKeepEveryRunsVideo) {
   const testing::TempDir dir;
-  const auto rig = std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small" / "rig.yaml";
-  Config config;
-  config.file = rig;
-  config.cameras = loadRigFile(rig);
-  config.capture.pacing = capture::Pacing::kAsFastAsPossible;
-  config.render.widthPx = 320;
-  config.render.heightPx = 180;
-  OutputConfig video;
-  video.path = dir / "whole.mkv";
-  config.outputs = {video};
+  const Config config = fixtureReplay("synth_small", {videoOutputAt(dir / "whole.mkv")});
   const std::string killed = "the frames of a run that was killed";
   dir.write("whole.mkv.part", killed);
   const std::atomic<bool> stop{false};

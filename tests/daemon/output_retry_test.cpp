@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "daemon/pipeline.hpp"
-#include "daemon/rig_yaml.hpp"
+#include "tests/daemon/replay_config.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -37,16 +37,10 @@ class OutputWatch final : public PipelineObserver {
 TEST(OutputRetry, AFailedOutputIsOpenedAgainAndNothingItWroteIsLost) {
   const testing::TempDir dir;
   // Two seconds of frames, played in real time, so that the retry after 1 s comes within the run.
-  const auto rig = std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_drop" / "rig.yaml";
-  Config config;
-  config.file = rig;
-  config.cameras = loadRigFile(rig);
-  config.render.widthPx = 320;
-  config.render.heightPx = 180;
-  OutputConfig video;
-  video.path = dir / "drive.mkv";
+  OutputConfig video = videoOutputAt(dir / "drive.mkv");
   video.segmentS = 0.25;
-  config.outputs = {video};
+  Config config = fixtureReplay("synth_drop", {video});
+  config.capture.pacing = capture::Pacing::kRealtime;
   Pipeline pipeline(config);
   OutputWatch watch(dir / "drive-00002.mkv.part" / "taken");
   const std::atomic<bool> stop{false};

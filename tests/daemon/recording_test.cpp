@@ -7,6 +7,7 @@
 
 #include "daemon/pipeline.hpp"
 #include "daemon/rig_yaml.hpp"
+#include "tests/daemon/replay_config.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace surroundd::daemon {
@@ -16,13 +17,9 @@ const std::filesystem::path kRecording =
     std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
 
 RunSummary replay(const std::filesystem::path& rig, const std::vector<OutputConfig>& outputs) {
-  Config config;
+  Config config = fixtureReplay("synth_small", outputs);
   config.file = rig;
   config.cameras = loadRigFile(rig);
-  config.capture.pacing = capture::Pacing::kAsFastAsPossible;
-  config.render.widthPx = 320;
-  config.render.heightPx = 180;
-  config.outputs = outputs;
   Pipeline pipeline(config);
   const std::atomic<bool> stop{false};
   return pipeline.run(stop);
