@@ -82,6 +82,15 @@ std::vector<std::string> writeLens(const GuideOptions& options, const GuideSessi
   return written;
 }
 
+// A recording is a session to watch: after its first frame it waits for the page to open (its
+// picture stream to be asked for: HttpStreamSink then wants frames again), so that the page sees
+// the session from its start. A poll: the sink has no call that waits.
+void waitForPage(const render::HttpStreamSink& page) {
+  while (!stopRequested && !page.wantsFrame({})) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
 }  // namespace
 
 void runGuide(const GuideOptions& options, std::ostream& log) {
@@ -157,6 +166,7 @@ void runGuide(const GuideOptions& options, std::ostream& log) {
       }
       drawFrame(frame.image, session, run.last);
       page.consume(frame.image, run.streamTime);
+      if (options.file && session.framesOffered() == 1) waitForPage(page);
     }
     page.setStatus(guideStateJson(session, run));
     log << std::flush;

@@ -27,7 +27,8 @@ status is 0 when the lens passed and was written, 1 otherwise.
                              sequence's rate (default 30)
   --file PATH                a video, a picture sequence (frame_%04d.png) or one picture, replayed
                              at its own pace (a recording of a session, surround-synth
-                             --calibration-session)
+                             --calibration-session); it waits after its first frame until
+                             the page is open, so that the page shows the session from its start
   --loop                     with --file: start again at the end
   --listen ADDR:PORT         where to serve the page (default 127.0.0.1:8080; port 0: any free
                              one; the address is printed)
