@@ -24,13 +24,8 @@ trap '[ -n "$pid" ] && { kill $pid 2>/dev/null || true; wait $pid 2>/dev/null ||
 pid=$!
 
 # The port it chose is in its first line.
-url=""
-for _ in $(seq 1 100); do
-  url=$(sed -n 's/^guide page: \(http:[^ ]*\).*/\1/p' "$work/log.txt" | head -n 1)
-  [ -n "$url" ] && break
-  kill -0 "$pid" 2>/dev/null || break
-  sleep 0.1
-done
+. "$here/served_url.sh"
+url=$(served_url "$work/log.txt" "$pid" 's/^guide page: \(http:[^ ]*\).*/\1/p')
 if [ -z "$url" ]; then
   echo "calibration_guide_test: surround-calibrate guide did not serve its page:" >&2
   cat "$work/log.txt" >&2

@@ -22,7 +22,7 @@ std::string hintFor(const std::string& part) {
 
 }  // namespace
 
-GuideSession::GuideSession(GuideSettings settings) : settings_(std::move(settings)) {}
+GuideSession::GuideSession(const GuideSettings& settings) : settings_(settings) {}
 
 FrameResult GuideSession::offer(const cv::Mat& gray, std::chrono::nanoseconds streamTime) {
   if (imageSize_.area() == 0) {

@@ -72,7 +72,7 @@ struct GuideSolve {
 
 class GuideSession {
  public:
-  explicit GuideSession(GuideSettings settings);
+  explicit GuideSession(const GuideSettings& settings);
 
   // `gray`: CV_8U, every frame the same size; `streamTime`: the frame's time from the start of
   // the stream. Solves when the view it keeps makes enough. Throws std::invalid_argument when

@@ -76,6 +76,7 @@ void writeCalibrationSession(const SynthOptions& options, std::ostream& log) {
   });
   if (found == cameras.end()) {
     std::vector<std::string> names;
+    names.reserve(cameras.size());
     for (const auto& c : cameras) names.push_back(c.calibration.name);
     throw UsageError(fmt::format("--calibration-session: no camera '{}' in {} (it has {})",
                                  *options.calibrationSession, options.rig.string(),
