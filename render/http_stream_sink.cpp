@@ -66,6 +66,11 @@ void HttpStreamSettings::validate() const {
           fmt::format("views: expected names of letters, digits, '-' and '_', got '{}'", view));
     }
   }
+  if (statusPath.size() < 2 || statusPath.front() != '/' || statusPath == "/stream.mjpg" ||
+      statusPath == "/snapshot.jpg" || statusPath == "/views.json" || statusPath == "/view") {
+    throw invalid(fmt::format("status path: expected a free path such as /status.json, got '{}'",
+                              statusPath));
+  }
   if (!initialView.empty() && std::find(views.begin(), views.end(), initialView) == views.end()) {
     throw invalid(fmt::format("initial view: '{}' is not one of the views [{}]", initialView,
                               fmt::join(views, ", ")));
@@ -160,12 +165,12 @@ struct HttpStreamSink::Impl {
       return method == "POST" ? requestView(connection) : replyNotAllowed(connection, "POST");
     }
     const bool known = path == "/" || path == "/stream.mjpg" || path == "/snapshot.jpg" ||
-                       path == "/status.json" || path == "/views.json";
+                       path == settings.statusPath || path == "/views.json";
     if (!known) return reply(connection, MHD_HTTP_NOT_FOUND, "not found\n");
     if (method != "GET" && method != "HEAD") return replyNotAllowed(connection, "GET, HEAD");
     if (path == "/stream.mjpg") return startStream(connection);
     if (path == "/snapshot.jpg") return serveSnapshot(connection);
-    if (path == "/status.json") {
+    if (path == settings.statusPath) {
       std::unique_lock lock(controlMutex);
       MHD_Response* response =
           MHD_create_response_from_buffer(status.size(), status.data(), MHD_RESPMEM_MUST_COPY);
@@ -176,7 +181,7 @@ struct HttpStreamSink::Impl {
       return reply(connection, MHD_HTTP_OK, viewsJson(), "application/json");
     }
     // PERSISTENT: the page is static and libmicrohttpd never writes through the pointer.
-    const std::string_view page = livePage();
+    const std::string_view page = settings.page.empty() ? livePage() : settings.page;
     return queue(connection, MHD_HTTP_OK,
                  MHD_create_response_from_buffer(page.size(), const_cast<char*>(page.data()),
                                                  MHD_RESPMEM_PERSISTENT),

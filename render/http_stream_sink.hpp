@@ -5,7 +5,8 @@
 //   GET  /stream.mjpg   multipart/x-mixed-replace JPEGs; each client gets the newest picture each
 //                       time one is made: a slow client skips pictures, it never queues them
 //   GET  /snapshot.jpg  the newest picture (503 before the first one)
-//   GET  /status.json   the text last given to setStatus() ("{}" before)
+//   GET  /status.json   the text last given to setStatus() ("{}" before); the path and the page
+//                       are settings, for other programs' pages on this stream
 //   GET  /views.json    {"views": [...], "active": "top" or null}, for the page's buttons
 //   POST /view?name=X   202 and X is handed once to takeViewRequest(); 400 if X is not a view
 //
@@ -43,6 +44,10 @@ struct HttpStreamSettings {
   // Host names (besides IP addresses and localhost) the server answers to; see HttpServer.
   std::vector<std::string> allowedHosts;
   std::chrono::milliseconds headerTimeout = kHeaderTimeout;  // for a whole request head
+  // Another program's page on the same stream (surround-calibrate guide): the HTML served at "/"
+  // (static, self-contained; empty: livePage()) and the path of setStatus()'s JSON.
+  std::string_view page;
+  std::string statusPath = "/status.json";
 
   // Throws std::invalid_argument naming the field.
   void validate() const;

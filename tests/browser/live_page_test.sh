@@ -29,13 +29,8 @@ CONFIG
 pid=$!
 
 # The port it chose is in its log.
-url=""
-for _ in $(seq 1 100); do
-  url=$(sed -n 's/.*HTTP stream: \(http:[^ ]*\).*/\1/p' "$work/log.txt" | head -n 1)
-  [ -n "$url" ] && break
-  kill -0 "$pid" 2>/dev/null || break
-  sleep 0.1
-done
+. "$here/served_url.sh"
+url=$(served_url "$work/log.txt" "$pid" 's/.*HTTP stream: \(http:[^ ]*\).*/\1/p')
 if [ -z "$url" ]; then
   echo "live_page_test: surroundd did not start its HTTP stream:" >&2
   cat "$work/log.txt" >&2

@@ -253,10 +253,26 @@ TEST(CalibrateCli, IntrinsicsWithAnUnreadableOrOddSizedImage) {
 TEST(CalibrateCli, UsageErrorsNameTheOption) {
   const TempDir dir;
   expectFailure(calibrate(dir, {}), 2,
-                "surround-calibrate: missing the subcommand: intrinsics, extrinsics, import or "
-                "mask (see --help)");
+                "surround-calibrate: missing the subcommand: intrinsics, guide, extrinsics, import "
+                "or mask (see --help)");
   expectFailure(calibrate(dir, {"calibrate"}), 2,
-                "unknown subcommand 'calibrate': expected intrinsics, extrinsics, import or mask");
+                "unknown subcommand 'calibrate': expected intrinsics, guide, extrinsics, import or "
+                "mask");
+  // The guide: no camera, an unreachable device, a recording that is not there.
+  const std::vector<std::string> guide{
+      "guide", "--board", "9x6", "--model", "fisheye", "--out", (dir / "lens.yaml").string()};
+  expectFailure(calibrate(dir, guide), 2,
+                "surround-calibrate guide: --device or --file: give one camera (a V4L2 device, or "
+                "a recording)");
+  auto onDevice = guide;
+  onDevice.insert(onDevice.end(), {"--device", (dir / "video9").string()});
+  expectFailure(calibrate(dir, onDevice), 2,
+                "surround-calibrate guide: --device: camera 'guide': " + (dir / "video9").string() +
+                    ": cannot open: No such file or directory");
+  auto onFile = guide;
+  onFile.insert(onFile.end(), {"--file", (dir / "missing_%04d.png").string()});
+  expectFailure(calibrate(dir, onFile), 2, "surround-calibrate guide: --file: ");
+  EXPECT_FALSE(std::filesystem::exists(dir / "lens.yaml"));
   expectFailure(calibrate(dir, {"import", "--pjlab", dir.path().string(), "--axes",
                                 "right,forward,down", "--out", "rig.yaml"}),
                 2,

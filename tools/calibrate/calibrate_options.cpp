@@ -189,7 +189,8 @@ void parseOptions(std::span<const std::string_view> arguments, const Handlers& v
 
 Command parseArguments(std::span<const std::string_view> arguments) {
   if (arguments.empty()) {
-    throw UsageError("missing the subcommand: intrinsics, extrinsics, import or mask (see --help)");
+    throw UsageError(
+        "missing the subcommand: intrinsics, guide, extrinsics, import or mask (see --help)");
   }
   const std::string_view subcommand = arguments.front();
   const auto rest = arguments.subspan(1);
@@ -214,17 +215,22 @@ Command parseArguments(std::span<const std::string_view> arguments) {
     if (asksForHelp(rest)) return HelpRequest{std::string(kMaskUsage)};
     return parseMask(rest);
   }
-  throw UsageError(fmt::format(
-      "unknown subcommand '{}': expected intrinsics, extrinsics, import or mask (see --help)",
-      subcommand));
+  if (subcommand == "guide") {
+    if (asksForHelp(rest)) return HelpRequest{fmt::format("{}\n{}", kGuideUsage, kUpdateRigUsage)};
+    return parseGuide(rest);
+  }
+  throw UsageError(
+      fmt::format("unknown subcommand '{}': expected intrinsics, guide, extrinsics, import or mask "
+                  "(see --help)",
+                  subcommand));
 }
 
 std::string usage() {
   return fmt::format(
-      "surround-calibrate: camera calibration for surroundd.\n\n{}\n{}\n{}\n{}\n{}\n"
+      "surround-calibrate: camera calibration for surroundd.\n\n{}\n{}\n{}\n{}\n{}\n{}\n"
       "exit status: 0 done, 1 calibration failed (too little in the images), 2 bad arguments or "
       "input files\n",
-      kIntrinsicsUsage, kExtrinsicsUsage, kUpdateRigUsage, kImportUsage, kMaskUsage);
+      kIntrinsicsUsage, kGuideUsage, kExtrinsicsUsage, kUpdateRigUsage, kImportUsage, kMaskUsage);
 }
 
 }  // namespace surroundd::calibrate

@@ -18,6 +18,7 @@
 
 #include "processing/camera_model.hpp"
 #include "processing/mat_calibration.hpp"
+#include "tools/calibrate/guide_options.hpp"
 #include "tools/calibrate/import_options.hpp"
 #include "tools/calibrate/intrinsics_options.hpp"
 
@@ -55,8 +56,8 @@ struct HelpRequest {
   std::string text;
 };
 
-using Command =
-    std::variant<IntrinsicsOptions, ExtrinsicsOptions, ImportOptions, MaskOptions, HelpRequest>;
+using Command = std::variant<IntrinsicsOptions, GuideOptions, ExtrinsicsOptions, ImportOptions,
+                             MaskOptions, HelpRequest>;
 
 // `arguments` excludes the program name. Throws UsageError.
 Command parseArguments(std::span<const std::string_view> arguments);
@@ -67,6 +68,10 @@ std::string usage();
 using Handlers = std::map<std::string_view, std::function<void(std::string_view)>>;
 void parseOptions(std::span<const std::string_view> arguments, const Handlers& valued,
                   const Handlers& flags);
+// The lens options of surround-calibrate intrinsics (board, model, --out, limits, --update-rig)
+// and `valued`/`flags` besides; `pictureFolder`: --images is required, otherwise refused.
+IntrinsicsOptions parseLensOptions(std::span<const std::string_view> arguments, Handlers valued,
+                                   const Handlers& flags, bool pictureFolder);
 // A number in [min, max]; UsageError naming the option and `expected` otherwise.
 double parseDouble(std::string_view option, std::string_view text, double min, double max,
                    std::string_view expected);

@@ -4,7 +4,6 @@
 #include <array>
 #include <cctype>
 #include <mutex>
-#include <numbers>
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
@@ -14,6 +13,7 @@
 #include "processing/view_acceptance.hpp"
 #include "tools/calibrate/calibration_output.hpp"
 #include "tools/calibrate/intrinsics_report.hpp"
+#include "tools/calibrate/lens_field.hpp"
 #include "tools/calibrate/residual_plot.hpp"
 
 namespace surroundd::calibrate {
@@ -233,23 +233,10 @@ void runIntrinsics(const IntrinsicsOptions& options, std::ostream& log) {
       used.push_back(view);
     }
   }
-  auto circle = processing::findImageCircle(found.brightest);
-  if (options.model == processing::LensModel::kPinhole) {
-    // A pinhole lens's image fills the sensor; dark corners there are vignetting or the scene.
-    circle = {cv::Mat(found.imageSize, CV_8U, cv::Scalar(255)), false};
-  }
+  const auto circle = lensCircle(options.model, found.brightest);
   const auto coverage = processing::coverageOf(used, found.imageSize, circle.lit);
   auto& lens = result.intrinsics;
-  processing::FieldOfView field;
-  if (lens.model == processing::LensModel::kFisheye) {
-    field = processing::fieldOfViewOf(lens, circle);
-    if (options.fieldOfViewDeg)
-      field = {*options.fieldOfViewDeg, false, "given by --field-of-view-deg"};
-    // Within the polynomial's monotonic range, which calibrateIntrinsics() left in the field.
-    lens.maxFieldAngleRad = std::min(lens.maxFieldAngleRad, field.fullDeg * std::numbers::pi / 360);
-  } else {
-    field = processing::fieldOfViewOf(lens, circle);
-  }
+  const auto field = limitField(lens, circle, options.fieldOfViewDeg);
   printViewTable(result, options.squareMm, options.limits.maxViewRmsPx, log);
   printLens(result, field, log);
   log << fmt::format("coverage {:.0f} % of the lens's cells", 100 * coverage.coveredShare);

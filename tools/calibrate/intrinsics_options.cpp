@@ -93,6 +93,11 @@ void splitNames(std::string_view list, std::vector<std::string>& names) {
 }  // namespace
 
 IntrinsicsOptions parseIntrinsics(std::span<const std::string_view> arguments) {
+  return parseLensOptions(arguments, {}, {}, true);
+}
+
+IntrinsicsOptions parseLensOptions(std::span<const std::string_view> arguments, Handlers valued,
+                                   const Handlers& flags, bool pictureFolder) {
   IntrinsicsOptions o;
   bool model = false, chessboard = false, charuco = false;
   std::optional<std::string> dictionary;
@@ -109,61 +114,67 @@ IntrinsicsOptions parseIntrinsics(std::span<const std::string_view> arguments) {
                         std::string_view expected) {
     return [=, &field](std::string_view v) { field = parseDouble(option, v, min, max, expected); };
   };
-  parseOptions(
-      arguments,
-      {{"--images", [&](auto v) { o.images = std::string(v); }},
-       {"--board",
-        [&](auto v) {
-          o.board.size = parseGrid("--board", v, 2, "inner corners");
-          chessboard = true;
-        }},
-       {"--charuco",
-        [&](auto v) {
-          o.board.size = parseGrid("--charuco", v, 3, "squares");
-          o.board.kind = processing::BoardKind::kCharuco;
-          charuco = true;
-        }},
-       {"--dictionary", [&](auto v) { dictionary = std::string(v); }},
-       {"--marker-ratio",
-        [&](auto v) {
-          markerRatio = parseDouble("--marker-ratio", v, 0.1, 0.95, "a ratio from 0.1 to 0.95");
-        }},
-       {"--square",
-        [&](auto v) { o.squareMm = parseDouble("--square", v, 0.1, 10000, "millimetres"); }},
-       {"--model",
-        [&](auto v) {
-          if (v != "pinhole" && v != "fisheye") throw wrongModel(v);
-          o.model =
-              v == "pinhole" ? processing::LensModel::kPinhole : processing::LensModel::kFisheye;
-          model = true;
-        }},
-       {"--out", [&](auto v) { o.out = std::string(v); }},
-       {"--exclude", [&](auto v) { splitNames(v, o.exclude); }},
-       {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
-       {"--residual-scale", limit("--residual-scale", o.residualScale, 1, 10000, "1 to 10000")},
-       {"--coverage", [&](auto v) { o.coverage = std::string(v); }},
-       {"--field-of-view-deg",
-        [&](auto v) {
-          o.fieldOfViewDeg = parseDouble("--field-of-view-deg", v, 1, 360, "degrees from 1 to 360");
-        }},
-       {"--update-rig", [&](auto v) { o.updateRig = std::string(v); }},
-       {"--camera", [&](auto v) { o.camera = std::string(v); }},
-       {"--detect-timeout-s",
-        limit("--detect-timeout-s", o.detectTimeoutS, 0.1, 3600, "seconds from 0.1 to 3600")},
-       {"--max-rms-px", limit("--max-rms-px", limits.maxRmsPx, 0.01, 100, "pixels, 0.01 to 100")},
-       {"--max-view-rms-px",
-        limit("--max-view-rms-px", limits.maxViewRmsPx, 0.01, 100, "pixels, 0.01 to 100")},
-       {"--max-edge-width-px",
-        limit("--max-edge-width-px", limits.maxEdgeWidthPx, 0.5, 100, "pixels, 0.5 to 100")},
-       {"--min-coverage", limit("--min-coverage", limits.minCoverage, 0, 1, "a share, 0 to 1")},
-       {"--min-views",
-        [&](auto v) {
-          limits.minViews = static_cast<int>(
-              parseDouble("--min-views", v, processing::kMinimumBoardViews, 1000,
-                          fmt::format("a count from {}", processing::kMinimumBoardViews)));
-        }}},
-      {});
-  if (o.images.empty()) throw UsageError("--images: missing (the folder of board images)");
+  Handlers lensOptions{
+      {"--images", [&](auto v) { o.images = std::string(v); }},
+      {"--board",
+       [&](auto v) {
+         o.board.size = parseGrid("--board", v, 2, "inner corners");
+         chessboard = true;
+       }},
+      {"--charuco",
+       [&](auto v) {
+         o.board.size = parseGrid("--charuco", v, 3, "squares");
+         o.board.kind = processing::BoardKind::kCharuco;
+         charuco = true;
+       }},
+      {"--dictionary", [&](auto v) { dictionary = std::string(v); }},
+      {"--marker-ratio",
+       [&](auto v) {
+         markerRatio = parseDouble("--marker-ratio", v, 0.1, 0.95, "a ratio from 0.1 to 0.95");
+       }},
+      {"--square",
+       [&](auto v) { o.squareMm = parseDouble("--square", v, 0.1, 10000, "millimetres"); }},
+      {"--model",
+       [&](auto v) {
+         if (v != "pinhole" && v != "fisheye") throw wrongModel(v);
+         o.model =
+             v == "pinhole" ? processing::LensModel::kPinhole : processing::LensModel::kFisheye;
+         model = true;
+       }},
+      {"--out", [&](auto v) { o.out = std::string(v); }},
+      {"--exclude", [&](auto v) { splitNames(v, o.exclude); }},
+      {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
+      {"--residual-scale", limit("--residual-scale", o.residualScale, 1, 10000, "1 to 10000")},
+      {"--coverage", [&](auto v) { o.coverage = std::string(v); }},
+      {"--field-of-view-deg",
+       [&](auto v) {
+         o.fieldOfViewDeg = parseDouble("--field-of-view-deg", v, 1, 360, "degrees from 1 to 360");
+       }},
+      {"--update-rig", [&](auto v) { o.updateRig = std::string(v); }},
+      {"--camera", [&](auto v) { o.camera = std::string(v); }},
+      {"--detect-timeout-s",
+       limit("--detect-timeout-s", o.detectTimeoutS, 0.1, 3600, "seconds from 0.1 to 3600")},
+      {"--max-rms-px", limit("--max-rms-px", limits.maxRmsPx, 0.01, 100, "pixels, 0.01 to 100")},
+      {"--max-view-rms-px",
+       limit("--max-view-rms-px", limits.maxViewRmsPx, 0.01, 100, "pixels, 0.01 to 100")},
+      {"--max-edge-width-px",
+       limit("--max-edge-width-px", limits.maxEdgeWidthPx, 0.5, 100, "pixels, 0.5 to 100")},
+      {"--min-coverage", limit("--min-coverage", limits.minCoverage, 0, 1, "a share, 0 to 1")},
+      {"--min-views", [&](auto v) {
+         limits.minViews = static_cast<int>(
+             parseDouble("--min-views", v, processing::kMinimumBoardViews, 1000,
+                         fmt::format("a count from {}", processing::kMinimumBoardViews)));
+       }}};
+  valued.merge(lensOptions);
+  parseOptions(arguments, valued, flags);
+  if (pictureFolder && o.images.empty()) {
+    throw UsageError("--images: missing (the folder of board images)");
+  }
+  if (!pictureFolder && (!o.images.empty() || !o.exclude.empty() || o.residuals || o.coverage)) {
+    throw UsageError(
+        "--images, --exclude, --residuals and --coverage are for a folder of pictures "
+        "(surround-calibrate intrinsics); the guide reads a camera (--device or --file)");
+  }
   if (chessboard && charuco) throw UsageError("--board and --charuco: give one board");
   if (!chessboard && !charuco) {
     throw UsageError("--board: missing (a chessboard's inner corners, e.g. 9x6; or --charuco)");

@@ -12,6 +12,7 @@
 #include "processing/calibration_error.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 #include "tools/calibrate/extrinsics_command.hpp"
+#include "tools/calibrate/guide_command.hpp"
 #include "tools/calibrate/import_command.hpp"
 #include "tools/calibrate/intrinsics_command.hpp"
 #include "tools/calibrate/mask_command.hpp"
@@ -22,7 +23,8 @@ int run(const std::vector<std::string_view>& arguments) {
   using namespace surroundd::calibrate;
   std::string_view subcommand = arguments.empty() ? "" : arguments.front();
   const std::string prefix = subcommand == "intrinsics" || subcommand == "extrinsics" ||
-                                     subcommand == "import" || subcommand == "mask"
+                                     subcommand == "import" || subcommand == "mask" ||
+                                     subcommand == "guide"
                                  ? "surround-calibrate " + std::string(subcommand) + ": "
                                  : std::string("surround-calibrate: ");
   try {
@@ -31,6 +33,8 @@ int run(const std::vector<std::string_view>& arguments) {
       std::cout << help->text;
     } else if (const auto* intrinsics = std::get_if<IntrinsicsOptions>(&command)) {
       runIntrinsics(*intrinsics, std::cout);
+    } else if (const auto* guide = std::get_if<GuideOptions>(&command)) {
+      runGuide(*guide, std::cout);
     } else if (const auto* import = std::get_if<ImportOptions>(&command)) {
       runImport(*import, std::cout);
     } else if (const auto* mask = std::get_if<MaskOptions>(&command)) {

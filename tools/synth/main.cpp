@@ -8,6 +8,7 @@ extern "C" {
 #include <libavutil/log.h>
 }
 
+#include "tools/synth/calibration_session.hpp"
 #include "tools/synth/mat_scene_writer.hpp"
 #include "tools/synth/recording_writer.hpp"
 #include "tools/synth/synth_options.hpp"
@@ -22,7 +23,9 @@ int main(int argc, char** argv) {
   av_log_set_level(AV_LOG_ERROR);  // x264's per-stream statistics would bury our one-line summary
   try {
     const SynthOptions options = parseSynthArguments(arguments);
-    if (options.calibrationMat) {
+    if (options.calibrationSession) {
+      writeCalibrationSession(options, std::cout);
+    } else if (options.calibrationMat) {
       writeMatScene(options, std::cout);
     } else {
       writeRecording(options, std::cout);

@@ -207,6 +207,8 @@ SynthOptions parseSynthArguments(std::span<const std::string_view> arguments) {
       o.crf = parseNumber<int>(option, value(), 0, 51, "an x264 CRF from 0 (lossless) to 51");
     } else if (option == "--calibration-mat") {
       o.calibrationMat = parseMatBoard(option, value());
+    } else if (option == "--calibration-session") {
+      o.calibrationSession = std::string(value());
     } else if (option == "--mat-ahead") {
       o.matAhead = parseNames(value());
     } else if (option == "--force") {
@@ -217,6 +219,9 @@ SynthOptions parseSynthArguments(std::span<const std::string_view> arguments) {
   }
   if (!haveRig) throw UsageError("--rig: missing (the rig preset YAML to render)");
   if (!haveOut) throw UsageError("--out: missing (the folder to write the recording to)");
+  if (o.calibrationSession && o.calibrationMat) {
+    throw UsageError("--calibration-session and --calibration-mat: give one");
+  }
   if (o.photometrics == SynthOptions::Photometrics::kIdentity) {
     // Identity means neutral sensors: no noise, no drift, whatever else was asked.
     o.noiseSigma = 0;
@@ -270,6 +275,11 @@ usage: surround-synth --rig FILE --out DIR [options]
                              --mat) and the true rig (rig.yaml)
   --mat-ahead NAMES          with --calibration-mat: these cameras (comma-separated) also get a
                              board straight ahead
+  --calibration-session NAME instead of a recording: camera NAME's view of a 9x6 chessboard
+                             (5 cm squares) walked around its field and held still at 12 poses
+                             that cover it, for --seconds at --fps: frame_0000.png ... (an image
+                             sequence, frame_%04d.png) and rig.yaml with the camera's true lens
+                             (for surround-calibrate guide)
   --force                    replace DIR if it exists (a DIR made by the same arguments, rig and
                              generator is kept as it is: "up to date")
   --help                     this text

@@ -58,6 +58,9 @@ struct SynthOptions {
   // (calibration_mat.hpp) with boards of this pattern, its layout and the true rig.
   std::optional<processing::Checkerboard> calibrationMat;
   std::vector<std::string> matAhead;  // cameras that also get a board straight ahead
+  // Instead of a recording: this camera's view of a chessboard walked around its field, as an
+  // image sequence with its true lens (calibration_session.hpp).
+  std::optional<std::string> calibrationSession;
 
   int frameCount() const;
   // Everything that decides the recording's content (not --out or --force), in a fixed order:

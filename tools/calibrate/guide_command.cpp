@@ -1,0 +1,188 @@
+#include "tools/calibrate/guide_command.hpp"
+
+#include <atomic>
+#include <csignal>
+#include <thread>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "capture/file_source.hpp"
+#include "capture/v4l2_source.hpp"
+#include "processing/calibration_error.hpp"
+#include "render/http_stream_sink.hpp"
+#include "tools/calibrate/calibrate_options.hpp"
+#include "tools/calibrate/calibration_output.hpp"
+#include "tools/calibrate/guide_page.hpp"
+#include "tools/calibrate/guide_session.hpp"
+#include "tools/calibrate/guide_state_json.hpp"
+
+namespace surroundd::calibrate {
+namespace {
+
+std::atomic<bool> stopRequested{false};
+extern "C" void onStopSignal(int /*signal*/) { stopRequested = true; }
+
+// A file that keeps failing is not a camera that may come back: after this many faults in a row
+// the replay counts as ended. A device is retried for ever (it reopens with backoff).
+constexpr int kFileFaultsToEnd = 30;
+
+std::unique_ptr<capture::FrameSource> openCamera(const GuideOptions& options) {
+  try {
+    if (options.device) {
+      capture::V4l2Settings settings;
+      settings.device = *options.device;
+      settings.size = options.size;
+      settings.fps = options.fps;
+      return std::make_unique<capture::V4l2Source>("guide", settings);
+    }
+    return std::make_unique<capture::FileSource>(
+        "guide", capture::FileSourceSettings{*options.file, options.fps, options.loop,
+                                             capture::Pacing::kRealtime});
+  } catch (const capture::CaptureError& error) {
+    throw UsageError(fmt::format("{}: {}", options.device ? "--device" : "--file", error.what()));
+  }
+}
+
+// The frame as the page shows it: kept views' outlines thin, the board found now with its corners
+// (green when kept, amber when not).
+void drawFrame(cv::Mat& bgr, const GuideSession& session, const FrameResult& result) {
+  for (const auto& view : session.views()) {
+    std::vector<cv::Point> hull;
+    std::vector<cv::Point> points(view.view.corners.begin(), view.view.corners.end());
+    cv::convexHull(points, hull);
+    cv::polylines(bgr, hull, true, cv::Scalar(90, 160, 90), 1, cv::LINE_AA);
+  }
+  const cv::Scalar colour =
+      result.outcome == FrameOutcome::kAccepted ? cv::Scalar(60, 220, 60) : cv::Scalar(0, 190, 255);
+  for (const auto& corner : result.corners) {
+    cv::circle(bgr, corner, 3, colour, 1, cv::LINE_AA);
+  }
+}
+
+std::string sourceName(const GuideOptions& options) {
+  return options.device ? options.device->string() : options.file->string();
+}
+
+// Writes the passed lens (and the rig's camera); the files written, or throws.
+std::vector<std::string> writeLens(const GuideOptions& options, const GuideSession& session) {
+  const auto& solve = *session.lastSolve();
+  const std::string comment = fmt::format(
+      "Written by surround-calibrate guide from {} of {} views of {} ({}):\n"
+      "RMS reprojection error {:.3f} px; passed after {:.1f} s of stream.",
+      solve.result.views.size(), session.views().size(), sourceName(options),
+      options.lens.board.describe(), solve.result.rmsPx,
+      std::chrono::duration<double>(session.passedAt()).count());
+  writeLensBlock(options.lens.out, solve.result.intrinsics, comment);
+  std::vector<std::string> written{options.lens.out.string()};
+  if (options.lens.updateRig) {
+    updateRigLens(*options.lens.updateRig, options.lens.camera, solve.result.intrinsics, comment);
+    written.push_back(options.lens.updateRig->string());
+  }
+  return written;
+}
+
+// A recording is a session to watch: after its first frame it waits for the page to open (its
+// picture stream to be asked for: HttpStreamSink then wants frames again), so that the page sees
+// the session from its start. A poll: the sink has no call that waits.
+void waitForPage(const render::HttpStreamSink& page) {
+  while (!stopRequested && !page.wantsFrame({})) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
+}  // namespace
+
+void runGuide(const GuideOptions& options, std::ostream& log) {
+  if (options.lens.updateRig) rigCamera(*options.lens.updateRig, options.lens.camera);
+  auto camera = openCamera(options);
+  GuideSettings settings;
+  settings.board = options.lens.board;
+  settings.model = options.lens.model;
+  settings.limits = options.lens.limits;
+  settings.fieldOfViewDeg = options.lens.fieldOfViewDeg;
+  GuideSession session(settings);
+  GuideRunState run;
+
+  render::HttpStreamSettings http;
+  http.address = options.address;
+  http.port = options.port;
+  http.page = guidePage();
+  http.statusPath = "/state.json";
+  try {
+    http.validate();
+  } catch (const std::invalid_argument& error) {
+    throw UsageError(fmt::format("--listen: {}", error.what()));
+  }
+  render::HttpStreamSink page(http);
+  page.setStatus(guideStateJson(session, run));
+  log << fmt::format("guide page: http://{}:{}/ (reading {}; Ctrl-C stops)\n", options.address,
+                     page.port(), sourceName(options))
+      << std::flush;
+
+  std::signal(SIGINT, onStopSignal);
+  std::signal(SIGTERM, onStopSignal);
+  capture::Frame frame;
+  frame.image = cv::Mat(camera->frameSize(), CV_8UC3);
+  cv::Mat gray;
+  std::optional<capture::Timestamp> start;
+  int faults = 0;
+  bool written = false;
+  while (!stopRequested && !run.ended) {
+    const auto status = camera->read(frame);
+    if (status == capture::ReadStatus::kEndOfStream ||
+        (status == capture::ReadStatus::kFault && options.file && ++faults >= kFileFaultsToEnd)) {
+      run.ended = true;
+    } else if (status == capture::ReadStatus::kFault) {
+      run.error = fmt::format("{}: {}", sourceName(options), camera->lastError());
+    } else {
+      faults = 0;
+      run.error.clear();
+      if (!start) start = frame.timestamp;
+      run.streamTime = frame.timestamp - *start;
+      cv::cvtColor(frame.image, gray, cv::COLOR_BGR2GRAY);
+      const std::size_t kept = session.views().size();
+      run.last = session.offer(gray, run.streamTime);
+      if (session.views().size() > kept) {
+        log << fmt::format("{:7.2f} s  {}\n", std::chrono::duration<double>(run.streamTime).count(),
+                           run.last.note);
+        if (const auto& solve = session.lastSolve(); solve && solve->viewsOffered == kept + 1) {
+          log << fmt::format(
+              "          solved with {} views: {}\n", solve->viewsOffered,
+              solve->verdict.passed
+                  ? fmt::format("pass, RMS {:.3f} px", solve->result.rmsPx)
+                  : fmt::format("fail ({})", fmt::join(solve->verdict.failures, "; ")));
+        }
+      }
+      if (session.passed() && !written) {
+        written = true;
+        try {
+          run.written = writeLens(options, session);
+          for (const auto& file : run.written) log << "wrote " << file << "\n";
+        } catch (const std::exception& error) {
+          run.error = fmt::format("cannot write the lens: {}", error.what());
+          log << run.error << "\n";
+        }
+      }
+      drawFrame(frame.image, session, run.last);
+      page.consume(frame.image, run.streamTime);
+      if (options.file && session.framesOffered() == 1) waitForPage(page);
+    }
+    page.setStatus(guideStateJson(session, run));
+    log << std::flush;
+  }
+  if (run.ended) log << "the recording ended; the page stays up until Ctrl-C\n" << std::flush;
+  // The page keeps showing the result until the user stops it. A poll, not a synchronisation:
+  // nothing waits on anything but the signal.
+  while (!stopRequested) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  page.finish({}, run.streamTime);
+  if (!session.passed() || run.written.empty()) {
+    throw processing::CalibrationError(
+        session.passed() ? run.error
+                         : fmt::format("stopped before the lens passed ({} views kept); nothing "
+                                       "was written",
+                                       session.views().size()));
+  }
+}
+
+}  // namespace surroundd::calibrate

@@ -1,0 +1,26 @@
+#include "tools/calibrate/lens_field.hpp"
+
+#include <algorithm>
+#include <numbers>
+
+namespace surroundd::calibrate {
+
+processing::ImageCircle lensCircle(processing::LensModel model, const cv::Mat& brightest) {
+  if (model == processing::LensModel::kPinhole) {
+    return {cv::Mat(brightest.size(), CV_8U, cv::Scalar(255)), false};
+  }
+  return processing::findImageCircle(brightest);
+}
+
+processing::FieldOfView limitField(processing::Intrinsics& lens,
+                                   const processing::ImageCircle& circle,
+                                   std::optional<double> givenDeg) {
+  auto field = processing::fieldOfViewOf(lens, circle);
+  if (lens.model == processing::LensModel::kFisheye) {
+    if (givenDeg) field = {*givenDeg, false, "given by --field-of-view-deg"};
+    lens.maxFieldAngleRad = std::min(lens.maxFieldAngleRad, field.fullDeg * std::numbers::pi / 360);
+  }
+  return field;
+}
+
+}  // namespace surroundd::calibrate
