@@ -176,5 +176,8 @@ double topViewReachM(const RenderConfig& render);
 // Reads and validates the whole file; throws ConfigError with one line per problem. Every camera
 // must have a source.
 Config loadConfig(const std::filesystem::path& file);
+// The same for a config's text: `file` is where its relative paths start and what messages name
+// (the fuzz test's entry, with no file to write).
+Config loadConfigText(const std::string& text, const std::filesystem::path& file);
 
 }  // namespace surroundd::daemon

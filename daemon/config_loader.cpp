@@ -329,11 +329,13 @@ double topViewReachM(const RenderConfig& render) {
   return render.views.topRangeM * std::hypot(1.0, longer / shorter);
 }
 
-Config loadConfig(const std::filesystem::path& file) {
+namespace {
+
+Config readConfig(const YAML::Node& document, const std::filesystem::path& file) {
   Diagnostics diag;
   Config config;
   config.file = file;
-  YamlObject root(parseYamlFile(file), "", file, diag);
+  YamlObject root(document, "", file, diag);
   readRig(root, config);
   const auto readSection = [&](std::string_view key, auto&& read) {
     if (auto section = root.object(key)) read(*section);
@@ -428,6 +430,16 @@ Config loadConfig(const std::filesystem::path& file) {
   root.finish();
   diag.throwIfAny();
   return config;
+}
+
+}  // namespace
+
+Config loadConfig(const std::filesystem::path& file) {
+  return readConfig(parseYamlFile(file), file);
+}
+
+Config loadConfigText(const std::string& text, const std::filesystem::path& file) {
+  return readConfig(parseYamlText(text, file), file);
 }
 
 }  // namespace surroundd::daemon

@@ -313,15 +313,25 @@ std::optional<std::string> lensFieldCutWarning(const processing::CameraCalibrati
                         2 * cut->askedRad * kRadToDeg));
 }
 
-RigFile loadRig(const std::filesystem::path& file) {
+namespace {
+
+RigFile readRig(const YAML::Node& document, const std::filesystem::path& file) {
   Diagnostics diag;
-  YamlObject root(parseYamlFile(file), "", file, diag);
+  YamlObject root(document, "", file, diag);
   RigFile rig;
   rig.cameras = readRigCameras(root);
   if (auto vehicle = root.object("vehicle")) rig.vehicle = readVehicle(*vehicle);
   root.finish();
   diag.throwIfAny();
   return rig;
+}
+
+}  // namespace
+
+RigFile loadRig(const std::filesystem::path& file) { return readRig(parseYamlFile(file), file); }
+
+RigFile loadRigText(const std::string& text, const std::filesystem::path& file) {
+  return readRig(parseYamlText(text, file), file);
 }
 
 std::vector<RigCamera> loadRigFile(const std::filesystem::path& file) {

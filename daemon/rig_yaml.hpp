@@ -69,6 +69,8 @@ std::vector<RigCamera> readRigCameras(YamlObject& rig);
 
 // A whole rig file; throws ConfigError listing every problem.
 RigFile loadRig(const std::filesystem::path& file);
+// The same for a rig file's text: `file` is where its relative paths start and what messages name.
+RigFile loadRigText(const std::string& text, const std::filesystem::path& file);
 // Its cameras only.
 std::vector<RigCamera> loadRigFile(const std::filesystem::path& file);
 

@@ -92,6 +92,10 @@ YAML::Node parseYamlFile(const std::filesystem::path& file) {
   } catch (const FileReadError& e) {
     throw ConfigError({fmt::format("cannot open the file {}", e.what())});
   }
+  return parseYamlText(text, file);
+}
+
+YAML::Node parseYamlText(const std::string& text, const std::filesystem::path& file) {
   try {
     return YAML::Load(text);
   } catch (const YAML::Exception& e) {

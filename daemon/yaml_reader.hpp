@@ -47,6 +47,8 @@ class Diagnostics {
 
 // Parses a YAML file; a syntax error or a missing/unreadable file becomes a ConfigError at once.
 YAML::Node parseYamlFile(const std::filesystem::path& file);
+// The same for text already read; `file` is what messages name.
+YAML::Node parseYamlText(const std::string& text, const std::filesystem::path& file);
 
 struct NumberRange {
   double min = -1e300;

@@ -1,5 +1,6 @@
 #include "processing/panorama_lut_cache.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <cstring>
@@ -66,7 +67,9 @@ class Reader {
     std::uint64_t count = 0;
     if (!value(count) || count > bytes_.size() / sizeof(T)) return false;
     values.resize(count);
-    std::memcpy(values.data(), bytes_.data(), count * sizeof(T));
+    // An empty vector's data() may be null, which memcpy must not get even for 0 bytes (UBSan
+    // stopped the fuzz seed writer on a LUT without blend taps).
+    if (count > 0) std::memcpy(values.data(), bytes_.data(), count * sizeof(T));
     bytes_.remove_prefix(count * sizeof(T));
     return true;
   }
@@ -86,8 +89,11 @@ class Reader {
 // The LUT's own invariants, so that a file that passes the checksum but was written by a faulty
 // build cannot make the stitcher read outside a camera image.
 bool consistent(const PanoramaLut& lut) {
-  const auto pixels = static_cast<std::size_t>(lut.size.area());
-  if (lut.size.width < 1 || lut.size.height < 1 || lut.taps.size() != pixels ||
+  if (lut.size.width < 1 || lut.size.height < 1) return false;
+  // In size_t: a damaged size's int area() overflows (found by the fuzz target).
+  const auto pixels =
+      static_cast<std::size_t>(lut.size.width) * static_cast<std::size_t>(lut.size.height);
+  if (lut.taps.size() != pixels ||
       lut.blendRowBegin.size() != static_cast<std::size_t>(lut.size.height) + 1 ||
       lut.blendRowBegin.back() != lut.blendTaps.size()) {
     return false;
@@ -106,8 +112,11 @@ bool consistent(const PanoramaLut& lut) {
   for (const auto& tap : lut.taps) {
     if (!tapInside(tap)) return false;
   }
+  // Sorted and ending at the blend taps' count, so no row reaches past them: checked for every row
+  // before any row is read (a later row going back down let an earlier one read past the end:
+  // found by the fuzz target).
+  if (!std::ranges::is_sorted(lut.blendRowBegin)) return false;
   for (std::size_t v = 0; v + 1 < lut.blendRowBegin.size(); ++v) {
-    if (lut.blendRowBegin[v] > lut.blendRowBegin[v + 1]) return false;
     for (auto b = lut.blendRowBegin[v]; b < lut.blendRowBegin[v + 1]; ++b) {
       const BlendTap& blend = lut.blendTaps[b];
       if (blend.pixel / lut.size.width != v || blend.tap.camera == PanoramaLut::kUnseen ||

@@ -129,6 +129,11 @@ bool isAllowedHost(std::string_view host, const std::vector<std::string>& allowe
   });
 }
 
+bool isSameOrigin(std::string_view origin, std::string_view host) {
+  const auto scheme = origin.find("://");
+  return scheme != std::string_view::npos && lowered(origin.substr(scheme + 3)) == lowered(host);
+}
+
 HttpServer::HttpServer(std::string name, const std::string& address, int port,
                        std::vector<std::string> allowedHosts,
                        std::chrono::milliseconds headerTimeout, Handler handler)
@@ -231,13 +236,11 @@ MHD_Result HttpServer::onRequest(void* cls, MHD_Connection* connection, const ch
     const std::string_view verb(method);
     const char* origin =
         MHD_lookup_connection_value(connection, MHD_HEADER_KIND, MHD_HTTP_HEADER_ORIGIN);
-    if (verb != "GET" && verb != "HEAD" && origin != nullptr) {
-      const std::string_view from(origin);
-      const auto scheme = from.find("://");
-      if (scheme == std::string_view::npos || lowered(from.substr(scheme + 3)) != lowered(host)) {
-        state->answered = true;
-        return reply(connection, MHD_HTTP_FORBIDDEN, "cross-origin request refused\n");
-      }
+    // Without a Host (HTTP/1.0) the origin cannot be compared: such a request is refused too.
+    if (verb != "GET" && verb != "HEAD" && origin != nullptr &&
+        (host == nullptr || !isSameOrigin(origin, host))) {
+      state->answered = true;
+      return reply(connection, MHD_HTTP_FORBIDDEN, "cross-origin request refused\n");
     }
     std::uint64_t declared = 0;
     const char* length =

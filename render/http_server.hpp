@@ -37,6 +37,9 @@ inline constexpr std::chrono::milliseconds kHeaderTimeout{10'000};
 // Whether a request's Host header names this server: an IPv4 or [IPv6] address, "localhost", or
 // one of `allowedHosts` (names, with or without ":port"), any port. Case does not matter.
 bool isAllowedHost(std::string_view host, const std::vector<std::string>& allowedHosts);
+// Whether a request's Origin ("http://name:port") is the server it was sent to, as its Host header
+// names it. Case does not matter.
+bool isSameOrigin(std::string_view origin, std::string_view host);
 
 class HttpServer {
  public:

@@ -1,6 +1,7 @@
 #!/bin/sh
 # Installs the Debian 12 packages surroundd needs to build, test and run. Idempotent: installs only
 # what is missing and says what that is. Runs apt-get as root, or through sudo.
+# --fuzz: also clang and its sanitizer runtimes, for scripts/fuzz.sh (libFuzzer).
 set -eu
 
 PACKAGES="
@@ -14,6 +15,10 @@ PACKAGES="
   libgtest-dev libgmock-dev opencv-doc help2man lintian
   libmicrohttpd-dev chromium
 "
+
+if [ "${1:-}" = "--fuzz" ]; then
+  PACKAGES="$PACKAGES clang libclang-rt-dev"
+fi
 
 # Node.js drives the browser test; Debian's is enough where none is installed.
 if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then

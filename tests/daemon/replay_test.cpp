@@ -2,7 +2,9 @@
 // recorded timestamps, and the pipeline loses exactly the frame sets that camera misses.
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <thread>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -106,8 +108,37 @@ TEST_F(ReplayTest, PipelineLosesOnlyTheSetsOfTheDroppedFrames) {
   EXPECT_TRUE(std::filesystem::exists(dir / "last.png"));
 }
 
-// Seen as live: the cameras decode far faster than the panorama is made, so sets go stale while
-// the pipeline works; they are skipped and counted, and no set is lost without being counted.
+// Holds the pipeline thread once, after its first frame set, until every camera has newer frames
+// queued: what a slow stitch does live, made certain rather than left to the machine's speed (under
+// CI load or a sanitizer, decoding need not outrun processing). Bounded: 30 s.
+class HoldUntilQueued final : public PipelineObserver {
+ public:
+  void onLoop(Pipeline& pipeline, std::chrono::steady_clock::time_point /*now*/,
+              std::uint64_t frameSets) override {
+    if (held_ || frameSets == 0) return;
+    held_ = true;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (!everyCameraQueued(pipeline)) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        ADD_FAILURE() << "the cameras never queued frames while the pipeline was held";
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  }
+  void onStopping() override {}
+
+ private:
+  static bool everyCameraQueued(const Pipeline& pipeline) {
+    const auto report = pipeline.report();
+    return std::ranges::all_of(report.cameras,
+                               [](const CameraReport& camera) { return camera.queued >= 2; });
+  }
+  bool held_ = false;
+};
+
+// Seen as live: while the pipeline works on a set, newer ones come (here: while it is held), so
+// sets go stale; they are skipped and counted, and no set is lost without being counted.
 TEST_F(ReplayTest, LatestWinsSkipsStaleSetsAndCountsThem) {
   const testing::TempDir dir;
   config_.capture.pacing = capture::Pacing::kAsFastAsPossible;
@@ -121,7 +152,8 @@ TEST_F(ReplayTest, LatestWinsSkipsStaleSetsAndCountsThem) {
     config_.capture.latestWins = latestWins;
     Pipeline pipeline(config_);
     const std::atomic<bool> stop{false};
-    return pipeline.run(stop);
+    HoldUntilQueued hold;
+    return pipeline.run(stop, &hold);
   };
   const RunSummary every = replay(CaptureConfig::LatestWins::kAuto);  // files: every set
   EXPECT_EQ(every.report.staleDropped, 0u);

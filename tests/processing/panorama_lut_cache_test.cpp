@@ -46,6 +46,48 @@ TEST_F(PanoramaLutCacheTest, StoredLutComesBackIdentical) {
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir_ / "cache"), {}), 1);
 }
 
+// A LUT with no blend taps (one camera, no seams) reads back an empty array: under UBSan that was
+// a memcpy into an empty vector's null data() (found by the fuzz seed writer, tests/fuzz).
+TEST_F(PanoramaLutCacheTest, ALutWithoutBlendTapsComesBackIdentical) {
+  PanoramaLut single;
+  single.size = {2, 1};
+  single.cameraSizes = {{4, 4}};
+  single.taps = {{0, 0, 0, 0, 0}, {5, 64, 64, 0, 0}};
+  single.blendRowBegin = {0, 0};
+  cache_.store("single", single);
+  const auto lookup = cache_.load("single");
+  ASSERT_TRUE(lookup.lut.has_value()) << lookup.problem;
+  EXPECT_EQ(*lookup.lut, single);
+}
+
+// Blend rows that go back down ({0, 5, 0} over no blend taps) once let the first row be read past
+// the end of the blend taps, before the second row's order was checked (found by the fuzz target).
+TEST_F(PanoramaLutCacheTest, BlendRowsOutOfOrderAreCorruptNotReadPastTheEnd) {
+  PanoramaLut damaged;
+  damaged.size = {1, 2};
+  damaged.cameraSizes = {{4, 4}};
+  damaged.taps = {{0, 0, 0, 0, 0}, {5, 0, 0, 0, 0}};
+  damaged.blendRowBegin = {0, 5, 0};
+  cache_.store("damaged", damaged);  // a faulty writer's file: its checksum is right
+  const auto lookup = cache_.load("damaged");
+  EXPECT_FALSE(lookup.lut.has_value());
+  EXPECT_THAT(lookup.problem, HasSubstr("is corrupt (inconsistent contents)"));
+}
+
+// A size whose area overflows an int (201326594 x 262146) was signed overflow (UB) in the check of
+// the tap count; now it is a corrupt file (found by the fuzz target).
+TEST_F(PanoramaLutCacheTest, ASizeWhoseAreaOverflowsIsCorrupt) {
+  PanoramaLut damaged;
+  damaged.size = {201326594, 262146};
+  damaged.cameraSizes = {{4, 4}};
+  damaged.taps = {{0, 0, 0, 0, 0}, {5, 0, 0, 0, 0}};
+  damaged.blendRowBegin = {0, 0};
+  cache_.store("damaged", damaged);
+  const auto lookup = cache_.load("damaged");
+  EXPECT_FALSE(lookup.lut.has_value());
+  EXPECT_THAT(lookup.problem, HasSubstr("is corrupt (inconsistent contents)"));
+}
+
 TEST_F(PanoramaLutCacheTest, EveryInputIsPartOfTheKey) {
   auto settings = settings_;
   settings.featherRad *= 1.0000001;

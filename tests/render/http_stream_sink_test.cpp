@@ -244,9 +244,10 @@ TEST(HttpStreamSink, ForeignHostsAndOriginsAreRefused) {
   };
   EXPECT_EQ(get("attacker.example").status, 421);
   EXPECT_EQ(get("attacker.example:" + std::to_string(sink.port())).status, 421);
-  for (const std::string& host : {fmt::format("127.0.0.1:{}", sink.port()), std::string("localhost"),
-                                 std::string("LOCALHOST:80"), std::string("[::1]:8080"),
-                                 std::string("surround.local:8080"), std::string("192.168.1.7")}) {
+  for (const std::string& host :
+       {fmt::format("127.0.0.1:{}", sink.port()), std::string("localhost"),
+        std::string("LOCALHOST:80"), std::string("[::1]:8080"), std::string("surround.local:8080"),
+        std::string("192.168.1.7")}) {
     EXPECT_EQ(get(host).status, 503) << host;  // no picture yet, but answered
   }
   const auto post = [&](std::string_view origin) {
@@ -265,6 +266,25 @@ TEST(HttpStreamSink, ForeignHostsAndOriginsAreRefused) {
   EXPECT_EQ(echoed.status, 400);
   EXPECT_THAT(echoed.headers, HasSubstr("X-Content-Type-Options: nosniff"));
   EXPECT_THAT(echoed.headers, HasSubstr("Content-Type: text/plain"));
+}
+
+// Found by the HTTP fuzz target: a POST with an Origin and no Host (HTTP/1.0 sends none) compared
+// the origin with a null Host and crashed the daemon. It cannot be compared, so it is refused.
+TEST(HttpStreamSink, AnOriginWithoutAHostIsRefused) {
+  HttpStreamSink sink(testSettings());
+  const auto answer =
+      httpExchange(sink.port(), "POST /view?name=top HTTP/1.0\r\nOrigin: http://127.0.0.1\r\n\r\n");
+  EXPECT_EQ(answer.status, 403);
+  EXPECT_EQ(sink.takeViewRequest(), std::nullopt);
+  EXPECT_EQ(httpRequest(sink.port(), "GET", "/status.json").status, 200);  // and it serves on
+}
+
+TEST(HttpStreamSink, SameOriginComparesSchemeLessOriginWithHost) {
+  EXPECT_TRUE(isSameOrigin("http://127.0.0.1:8080", "127.0.0.1:8080"));
+  EXPECT_TRUE(isSameOrigin("http://Surround.Local", "surround.local"));
+  EXPECT_FALSE(isSameOrigin("http://attacker.example", "127.0.0.1:8080"));
+  EXPECT_FALSE(isSameOrigin("null", "127.0.0.1"));  // sandboxed pages send "null"
+  EXPECT_FALSE(isSameOrigin("", ""));
 }
 
 // Issue 18: 16 clients sending a header line every 5 s kept every other request out for as long

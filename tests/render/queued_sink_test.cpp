@@ -3,10 +3,12 @@
 
 #include "render/queued_sink.hpp"
 
+#include <chrono>
+#include <future>
 #include <latch>
 #include <mutex>
 #include <stdexcept>
-#include <thread>
+#include <utility>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -32,12 +34,17 @@ class KeepingSink final : public FrameSink {
     std::vector<std::pair<cv::Mat, std::chrono::nanoseconds>> consumed;
     std::latch release{1};
     bool hold = false;
+    std::promise<void> holding;  // set when the first held picture is taken
+    bool holdingSet = false;     // only the worker thread touches it
     int failAt = -1;
     bool finished = false;
   };
   explicit KeepingSink(Shared& shared) : shared_(shared) {}
   void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) override {
-    if (shared_.hold) shared_.release.wait();
+    if (shared_.hold) {
+      if (!std::exchange(shared_.holdingSet, true)) shared_.holding.set_value();
+      shared_.release.wait();
+    }
     const std::lock_guard lock(shared_.mutex);
     if (static_cast<int>(shared_.consumed.size()) == shared_.failAt) {
       throw std::runtime_error("disk full");
@@ -73,8 +80,12 @@ TEST(QueuedSink, WhenItDropsTheNewestPicturesWinAndDropsAreCounted) {
   shared.hold = true;
   QueuedSink sink(std::make_unique<KeepingSink>(shared), kSize, 3, WhenFull::kDropOldest);
   sink.consume(picture(0), milliseconds(0));
-  // Let the worker take the first picture and get stuck on it.
-  std::this_thread::sleep_for(milliseconds(50));
+  // The worker has taken the first picture and is stuck on it (bounded: a worker that never takes
+  // it fails the test instead of hanging it).
+  const bool taken =
+      shared.holding.get_future().wait_for(std::chrono::seconds(30)) == std::future_status::ready;
+  if (!taken) shared.release.count_down();
+  ASSERT_TRUE(taken);
   for (int i = 1; i < 10; ++i) sink.consume(picture(i), milliseconds(i));  // never blocks
   shared.release.count_down();
   sink.finish({}, {});

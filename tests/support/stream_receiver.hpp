@@ -4,6 +4,9 @@
 // started afterwards loses nothing; reading ends when nothing has come for `idle`.
 
 #include <chrono>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -31,6 +34,23 @@ inline int freeUdpPort() {
   return ntohs(address.sin_port);
 }
 
+// Whether a UDP socket of this machine is bound to `port` (any address): /proc/net/udp lists each
+// as "sl local_address:PORT ...", the port in hexadecimal.
+inline bool udpPortBound(int port) {
+  std::ifstream table("/proc/net/udp");
+  const std::string suffix = fmt::format(":{:04X}", port);
+  std::string line;
+  std::getline(table, line);  // the header
+  while (std::getline(table, line)) {
+    std::istringstream fields(line);
+    std::string slot;
+    std::string localAddress;
+    fields >> slot >> localAddress;
+    if (localAddress.ends_with(suffix)) return true;
+  }
+  return false;
+}
+
 class StreamReceiver {
  public:
   StreamReceiver(int port, std::chrono::seconds idle) {
@@ -40,8 +60,15 @@ class StreamReceiver {
         "udp://127.0.0.1:{}?timeout={}&fifo_size=1000000&overrun_nonfatal=1&buffer_size=8388608",
         port, std::chrono::microseconds(idle).count());
     ready_ = std::jthread([this, url] { receive(url); });
-    // avformat_open_input() binds before it blocks on the first datagram.
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    // avformat_open_input() binds before it blocks on the first datagram: once the port is bound,
+    // nothing the sender sends is lost. Bounded, so a receiver that never binds fails the test.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (!udpPortBound(port)) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        throw std::runtime_error(fmt::format("the stream receiver never bound UDP port {}", port));
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
   }
 
   // Waits for the stream to end; the decoded pictures in order.

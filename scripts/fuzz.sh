@@ -1,0 +1,63 @@
+#!/bin/sh
+# Runs every libFuzzer target (tests/fuzz) for SECONDS each, one after another, and prints each
+# one's executions and findings: `scripts/fuzz.sh [SECONDS]` (default 60).
+#
+# Builds the `fuzz` preset first (clang with ASan + UBSan; `scripts/install-deps.sh --fuzz`
+# installs clang), at most FUZZ_JOBS (default 2) compile jobs. Each target starts from its seeds in
+# tests/fuzz/corpus/<target>/ and keeps what it finds in build/fuzz/corpus/<target>/ (the repo's
+# seeds stay as they are). A crash, leak, UB, timeout or out-of-memory input is written to
+# build/fuzz/findings/<target>-*; rerun one with `build/fuzz/tests/fuzz/<target> FILE`.
+# Exits 1 when any target found something.
+set -eu
+cd "$(dirname "$0")/.."
+seconds="${1:-60}"
+case "$seconds" in
+  '' | *[!0-9]*) echo "usage: scripts/fuzz.sh [SECONDS]" >&2; exit 2 ;;
+esac
+if ! command -v clang++ >/dev/null 2>&1; then
+  echo "fuzz: clang++ is missing: scripts/install-deps.sh --fuzz installs it" >&2
+  exit 2
+fi
+
+cmake --preset fuzz >/dev/null
+cmake --build --preset fuzz -j"${FUZZ_JOBS:-2}"
+
+build=build/fuzz
+targets="config_fuzz rig_fuzz control_fuzz http_host_fuzz http_server_fuzz lut_cache_fuzz jpeg_fuzz"
+mkdir -p "$build/findings"
+# Leaks count as findings; UB stops the run with a stack like ASan's.
+export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}"
+export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
+
+failed=""
+summary=""
+for target in $targets; do
+  seeds="tests/fuzz/corpus/${target%_fuzz}"
+  corpus="$build/corpus/${target%_fuzz}"
+  log="$build/findings/$target.log"
+  mkdir -p "$corpus"
+  echo "fuzz: $target for ${seconds}s (seeds: $seeds)"
+  # -timeout: an input that takes 10 s is a hang; -rss_limit_mb: 2 GiB is an unbounded allocation.
+  status=0
+  "$build/tests/fuzz/$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+    -print_final_stats=1 -artifact_prefix="$build/findings/$target-" "$corpus" "$seeds" \
+    >"$log" 2>&1 || status=$?
+  executions=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
+  rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -n 1)
+  if [ "$status" -eq 0 ]; then
+    verdict="no finding"
+  else
+    verdict="FINDING (exit $status): $(grep -m 1 -E '^(==[0-9]+==ERROR|SUMMARY|.*runtime error)' "$log" || echo "see $log")"
+    failed="$failed $target"
+  fi
+  line=$(printf '%-18s %12s executions %8s/s  %s' "$target" "${executions:-?}" "${rate:-?}" "$verdict")
+  echo "fuzz: $line"
+  summary="$summary
+$line"
+done
+
+echo "fuzz: summary (${seconds}s each):$summary"
+if [ -n "$failed" ]; then
+  echo "fuzz: findings in:$failed (inputs and logs under $build/findings/)" >&2
+  exit 1
+fi

@@ -1,0 +1,45 @@
+#pragma once
+// What the fuzz targets share: a private scratch folder for inputs that must be files, and quiet
+// logging (a target that logs each input runs a hundred times slower).
+
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include <spdlog/spdlog.h>
+
+namespace surroundd::fuzz {
+
+// A folder of this process's own under $TMPDIR (libFuzzer's -fork/-jobs run several at once),
+// removed at exit.
+inline const std::filesystem::path& scratchFolder() {
+  static const std::filesystem::path folder = [] {
+    std::string pattern =
+        (std::filesystem::temp_directory_path() / "surroundd-fuzz-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr) std::abort();
+    std::atexit([] {
+      std::error_code ignored;
+      std::filesystem::remove_all(scratchFolder(), ignored);
+    });
+    return std::filesystem::path(pattern);
+  }();
+  return folder;
+}
+
+inline void quietLogs() { spdlog::set_level(spdlog::level::off); }
+
+inline std::string_view asText(const std::uint8_t* data, std::size_t size) {
+  return {reinterpret_cast<const char*>(data), size};
+}
+
+inline void writeFile(const std::filesystem::path& path, std::string_view bytes) {
+  std::ofstream file(path, std::ios::binary | std::ios::trunc);
+  file.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  if (!file) std::abort();  // the harness's own failure, not the code's
+}
+
+}  // namespace surroundd::fuzz

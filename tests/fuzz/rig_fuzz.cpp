@@ -1,0 +1,23 @@
+// The rig file reader (loadRig) on any text: a rig, or ConfigError; anything else is a finding.
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "daemon/rig_yaml.hpp"
+#include "tests/fuzz/fuzz_support.hpp"
+
+extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
+  surroundd::fuzz::quietLogs();
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  static const auto file = surroundd::fuzz::scratchFolder() / "rig.yaml";
+  try {
+    (void)surroundd::daemon::loadRigText(std::string(surroundd::fuzz::asText(data, size)), file);
+  } catch (const surroundd::daemon::ConfigError&) {
+    // the documented answer to a bad rig
+  }
+  return 0;
+}
