@@ -54,6 +54,8 @@ std::string_view withoutPort(std::string_view host) {
 }
 
 bool isIpAddress(std::string_view name) {
+  // inet_pton reads a C string: it would stop at a NUL and pass what comes before.
+  if (name.find('\0') != std::string_view::npos) return false;
   std::array<unsigned char, sizeof(in6_addr)> address{};
   if (name.starts_with('[') && name.ends_with(']')) {
     const std::string inner(name.substr(1, name.size() - 2));

@@ -1,15 +1,18 @@
-// The config reader (loadConfig) on any text: it either gives a config or throws ConfigError
-// listing the problems. Anything else escaping it (a YAML or standard-library exception), a crash
-// or undefined behaviour is a finding. The file sits in an empty folder, so relative paths it
-// names (rig files, masks, recordings) do not exist.
+// The config reader (loadConfig) on any text: it either gives a config whose cameras hold what the
+// daemon relies on (rig_invariants.hpp) and whose panorama and picture sizes are usable, or throws
+// ConfigError listing the problems. Anything else escaping it (a YAML or standard-library
+// exception), a crash or undefined behaviour is a finding. The file sits in an empty folder, so
+// relative paths it names (rig files, masks, recordings) do not exist.
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <string>
 
 #include "daemon/config.hpp"
 #include "daemon/yaml_reader.hpp"
 #include "tests/fuzz/fuzz_support.hpp"
+#include "tests/fuzz/rig_invariants.hpp"
 
 extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
   surroundd::fuzz::quietLogs();
@@ -19,7 +22,14 @@ extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const auto file = surroundd::fuzz::scratchFolder() / "surroundd.yaml";
   try {
-    (void)surroundd::daemon::loadConfigText(std::string(surroundd::fuzz::asText(data, size)), file);
+    const auto config =
+        surroundd::daemon::loadConfigText(std::string(surroundd::fuzz::asText(data, size)), file);
+    surroundd::fuzz::checkAcceptedCameras(config.cameras);
+    if (config.cameras.empty() || config.panorama.widthPx < 1 || config.panorama.heightPx < 1 ||
+        !(config.panorama.elevationTopDeg > config.panorama.elevationBottomDeg) ||
+        config.render.widthPx < 1 || config.render.heightPx < 1) {
+      std::abort();
+    }
   } catch (const surroundd::daemon::ConfigError&) {
     // the documented answer to a bad config
   }

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <span>
 #include <string>
 
@@ -31,9 +32,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     width = 64;
     height = 48;
   }
+  // A camera's frame buffer is written in place, never replaced: the pool owns it.
   cv::Mat bgr(height, width, CV_8UC3);
-  (void)decoder.decode(jpeg, bgr, error);
+  const auto* const buffer = bgr.data;
+  const bool decoded = decoder.decode(jpeg, bgr, error);
+  if (bgr.data != buffer || bgr.rows != height || bgr.cols != width) std::abort();
+  if (!decoded && error.empty()) std::abort();  // a refusal says why
+  error.clear();
   cv::Mat smaller(height / 2 + 1, width / 2 + 1, CV_8UC3);
-  (void)decoder.decode(jpeg, smaller, error);
+  const bool decodedSmaller = decoder.decode(jpeg, smaller, error);
+  if (decoded && decodedSmaller) std::abort();  // a picture of another size must be refused
+  if (!decodedSmaller && error.empty()) std::abort();
   return 0;
 }

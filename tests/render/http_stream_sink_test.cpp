@@ -287,6 +287,16 @@ TEST(HttpStreamSink, SameOriginComparesSchemeLessOriginWithHost) {
   EXPECT_FALSE(isSameOrigin("", ""));
 }
 
+// Found by the host-check fuzz target: the address parser read a C string, so a name with a NUL
+// after an address ("127.0.0.1\0.evil.example") passed as that address.
+TEST(HttpStreamSink, AHostWithANulIsNotAnAddress) {
+  using namespace std::string_view_literals;
+  EXPECT_TRUE(isAllowedHost("127.0.0.1:8080", {}));
+  EXPECT_FALSE(isAllowedHost("127.0.0.1\0.evil.example"sv, {}));
+  EXPECT_FALSE(isAllowedHost("127.0.0.1\0\0:8080"sv, {}));
+  EXPECT_FALSE(isAllowedHost("[::1\0]:8080"sv, {}));
+}
+
 // Issue 18: 16 clients sending a header line every 5 s kept every other request out for as long
 // as they liked. Now a request head must be whole within the header timeout, or the connection is
 // cut off (and one address holds at most 8 connections: libmicrohttpd's per-IP limit).
