@@ -2,6 +2,8 @@
 # Installs the Debian 12 packages surroundd needs to build, test and run. Idempotent: installs only
 # what is missing and says what that is. Runs apt-get as root, or through sudo.
 # --fuzz: also clang and its sanitizer runtimes, for scripts/fuzz.sh (libFuzzer).
+# --cross-arm64: also the aarch64 cross compiler, qemu-user and mmdebstrap, for
+#   scripts/cross-arm64.sh.
 set -eu
 
 PACKAGES="
@@ -16,9 +18,10 @@ PACKAGES="
   libmicrohttpd-dev chromium
 "
 
-if [ "${1:-}" = "--fuzz" ]; then
-  PACKAGES="$PACKAGES clang libclang-rt-dev"
-fi
+case "${1:-}" in
+  --fuzz) PACKAGES="$PACKAGES clang libclang-rt-dev" ;;
+  --cross-arm64) PACKAGES="$PACKAGES crossbuild-essential-arm64 qemu-user-static mmdebstrap" ;;
+esac
 
 # Node.js drives the browser test; Debian's is enough where none is installed.
 if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
