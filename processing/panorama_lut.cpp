@@ -119,10 +119,19 @@ cv::Vec3d PanoramaProjector::surfacePoint(const cv::Point2d& panoramaPixel) cons
 std::optional<cv::Point2d> PanoramaProjector::cameraPixel(std::size_t camera,
                                                           const cv::Point2d& panoramaPixel) const {
   const Pose& pose = poses_[camera];
-  const cv::Vec3d pointCamera =
-      settings_.projection == PanoramaProjection::kSphere
-          ? pose.rotation.t() * settings_.geometry.direction(panoramaPixel)
-          : pose.toCamera(surfacePoint(panoramaPixel));
+  if (settings_.projection != PanoramaProjection::kSphere) {
+    return cameraPixelOf(camera, surfacePoint(panoramaPixel));
+  }
+  return visiblePixel(camera, pose.rotation.t() * settings_.geometry.direction(panoramaPixel));
+}
+
+std::optional<cv::Point2d> PanoramaProjector::cameraPixelOf(std::size_t camera,
+                                                            const cv::Vec3d& point) const {
+  return visiblePixel(camera, poses_[camera].toCamera(point));
+}
+
+std::optional<cv::Point2d> PanoramaProjector::visiblePixel(std::size_t camera,
+                                                           const cv::Vec3d& pointCamera) const {
   const auto pixel = models_[camera].project(pointCamera);
   const cv::Size size = models_[camera].intrinsics().imageSize;
   if (!pixel || pixel->x < 0 || pixel->y < 0 || pixel->x > size.width - 1 ||
