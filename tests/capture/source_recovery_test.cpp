@@ -27,6 +27,7 @@ using std::chrono::milliseconds;
 using ::testing::HasSubstr;
 using Step = SourceRecovery::Step;
 
+// NOLINTNEXTLINE(cert-err58-cpp): cv::Size stores two ints; its constructor throws nothing.
 const cv::Size kSize(320, 240);
 
 // Catches what is logged while it lives; the default logger is put back after.

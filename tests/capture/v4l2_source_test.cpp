@@ -18,6 +18,7 @@ namespace {
 using testing::FakeV4l2Device;
 using ::testing::HasSubstr;
 
+// NOLINTNEXTLINE(cert-err58-cpp): cv::Size stores two ints; its constructor throws nothing.
 const cv::Size kSize(320, 240);
 
 std::shared_ptr<FakeV4l2Device::State> deviceOffering(std::vector<FakeV4l2Device::Mode> modes) {
