@@ -20,6 +20,7 @@ LibcameraSource::~LibcameraSource() = default;
 cv::Size LibcameraSource::frameSize() const { return {}; }
 Timestamp LibcameraSource::nominalPeriod() const { return {}; }
 ReadStatus LibcameraSource::read(Frame& /*out*/) { return ReadStatus::kEndOfStream; }
+void LibcameraSource::reopen() { throw CaptureError("built without libcamera"); }
 const std::string& LibcameraSource::lastError() const {
   static const std::string kNone;
   return kNone;

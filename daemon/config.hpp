@@ -13,6 +13,7 @@
 #include <spdlog/common.h>
 
 #include "capture/file_source.hpp"
+#include "capture/source_recovery.hpp"
 #include "daemon/rig_yaml.hpp"
 #include "daemon/vehicle_yaml.hpp"
 #include "processing/panorama_lut.hpp"
@@ -33,6 +34,9 @@ struct CaptureConfig {
   // drop its oldest picture): auto = only with live cameras; always also for replays (to see a
   // replay as a live rig would show it), never keeps every set.
   enum class LatestWins { kAuto, kAlways, kNever } latestWins = LatestWins::kAuto;
+  // How every camera, whatever its kind, recovers from faults (capture/source_recovery.hpp):
+  // reopening backoff, giving up, and how often repeated faults are logged.
+  capture::RecoverySettings recovery;
 
   bool operator==(const CaptureConfig&) const = default;
 };

@@ -81,6 +81,22 @@ void readCapture(YamlObject& section, CaptureConfig& c) {
                                 {{"auto", LatestWins::kAuto},
                                  {"always", LatestWins::kAlways},
                                  {"never", LatestWins::kNever}});
+  auto& r = c.recovery;
+  r.firstBackoff = std::chrono::milliseconds(
+      section.integer("reopen_backoff_ms", static_cast<int>(r.firstBackoff.count()), 1, 60'000));
+  r.maxBackoff = std::chrono::milliseconds(
+      section.integer("reopen_backoff_max_ms", static_cast<int>(r.maxBackoff.count()), 1, 600'000));
+  if (r.maxBackoff < r.firstBackoff) {
+    section.error("reopen_backoff_max_ms",
+                  fmt::format("expected at least reopen_backoff_ms ({}), got {}",
+                              r.firstBackoff.count(), r.maxBackoff.count()));
+  }
+  r.giveUpAfterFaults =
+      section.integer("give_up_after_faults", r.giveUpAfterFaults, 0, 1'000'000'000);
+  r.logInterval = std::chrono::milliseconds(
+      std::lround(1000 * section.number("fault_log_interval_s",
+                                        static_cast<double>(r.logInterval.count()) / 1000,
+                                        {0.0, 3600.0, false, "seconds"})));
   section.finish();
 }
 

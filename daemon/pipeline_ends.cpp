@@ -27,17 +27,14 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
     const auto& name = camera.calibration.name;
     std::unique_ptr<capture::FrameSource> source;
     std::string origin;
-    int maxConsecutiveFaults = 30;  // a replay that keeps failing ends
     if (camera.libcamera) {
       source = std::make_unique<capture::LibcameraSource>(name, *camera.libcamera);
       origin = fmt::format("libcamera {}", camera.libcamera->camera);
-      maxConsecutiveFaults = 0;
     } else if (camera.device) {
       auto device = std::make_unique<capture::V4l2Source>(name, *camera.device);
       origin = fmt::format("{} ({})", camera.device->device.string(),
                            capture::toString(device->format()));
       source = std::move(device);
-      maxConsecutiveFaults = 0;  // a live camera is reopened until it is back
     } else {
       auto settings = *camera.source;
       settings.pacing = config.capture.pacing;
@@ -55,7 +52,7 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
                  source->frameSize().height,
                  1e9 / static_cast<double>(source->nominalPeriod().count()));
     cameras.push_back(std::make_unique<capture::CameraStream>(name, std::move(source), poolFrames,
-                                                              maxConsecutiveFaults));
+                                                              config.capture.recovery));
   }
   return cameras;
 }

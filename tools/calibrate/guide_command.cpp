@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "capture/file_source.hpp"
+#include "capture/source_recovery.hpp"
 #include "capture/v4l2_source.hpp"
 #include "processing/calibration_error.hpp"
 #include "render/http_stream_sink.hpp"
@@ -22,10 +23,6 @@ namespace {
 
 std::atomic<bool> stopRequested{false};
 extern "C" void onStopSignal(int /*signal*/) { stopRequested = true; }
-
-// A file that keeps failing is not a camera that may come back: after this many faults in a row
-// the replay counts as ended. A device is retried for ever (it reopens with backoff).
-constexpr int kFileFaultsToEnd = 30;
 
 std::unique_ptr<capture::FrameSource> openCamera(const GuideOptions& options) {
   try {
@@ -126,17 +123,21 @@ void runGuide(const GuideOptions& options, std::ostream& log) {
   frame.image = cv::Mat(camera->frameSize(), CV_8UC3);
   cv::Mat gray;
   std::optional<capture::Timestamp> start;
-  int faults = 0;
   bool written = false;
+  // The daemon's policy for every camera: faults counted and logged with rate limiting, a lost
+  // device reopened with backoff, for as long as the guide runs.
+  capture::SourceRecovery recovery("guide", {});
+  const capture::SourceRecovery::Wait wait = [](std::chrono::milliseconds duration) {
+    std::this_thread::sleep_for(duration);
+    return !stopRequested;
+  };
   while (!stopRequested && !run.ended) {
-    const auto status = camera->read(frame);
-    if (status == capture::ReadStatus::kEndOfStream ||
-        (status == capture::ReadStatus::kFault && options.file && ++faults >= kFileFaultsToEnd)) {
+    const auto status = recovery.read(*camera, frame, wait);
+    if (status == capture::ReadStatus::kEndOfStream) {
       run.ended = true;
     } else if (status == capture::ReadStatus::kFault) {
       run.error = fmt::format("{}: {}", sourceName(options), camera->lastError());
     } else {
-      faults = 0;
       run.error.clear();
       if (!start) start = frame.timestamp;
       run.streamTime = frame.timestamp - *start;
