@@ -2,9 +2,9 @@
 # Installs what is missing, builds everything with warnings as errors, and runs the whole test suite.
 #
 # --sanitizers (CI passes it): then also the whole suite built with AddressSanitizer + UBSan (the
-# `asan` preset; tests labelled asan_slow left out, each with its reason where it is labelled), and
-# the threaded parts (capture, the pipeline, its outputs' queues and servers, the service) built
-# with ThreadSanitizer (the `tsan` preset). Each phase's time is printed at the end.
+# `asan` preset; what is left out says why below), and the threaded parts (the work pool, capture,
+# the pipeline, its outputs' queues and servers, the control server, the service) built with
+# ThreadSanitizer (the `tsan` preset). Each phase's time is printed at the end.
 set -eu
 cd "$(dirname "$0")/.."
 sanitizers=no
@@ -46,20 +46,35 @@ if [ "$sanitizers" = yes ]; then
   cmake --build --preset asan
   end "asan build"
   begin "asan suite"
-  # The browser test drives Chromium against the daemon; under ASan only its driver's timeouts
-  # would be tested. Packaging builds a .deb of the sanitized binaries: no memory is checked there.
-  ctest --preset asan -j2 -LE '^(asan_slow|browser|packaging)$'
+  # Mesa's llvmpipe driver keeps some allocations in its own static data, and eglTerminate()
+  # unloads it: LeakSanitizer then no longer sees those references and reports the blocks as
+  # leaked from an "<unknown module>", which no suppression can name. Loaded with every process,
+  # the driver stays mapped to the end and what it holds stays reachable; ASan is told that a
+  # library loaded before its runtime is meant.
+  dri="/usr/lib/$(gcc -print-multiarch)/dri/swrast_dri.so"
+  [ -e "$dri" ] || dri=""
+  # Left out: the browser tests (Chromium and its node driver are not instrumented; the server
+  # side of the page runs under ASan in http_stream_sink_test and end_to_end_test) and lintian's
+  # verdict on the .deb (it judges a release package; the ci suite runs it).
+  LD_PRELOAD="$dri" ASAN_OPTIONS="$ASAN_OPTIONS:verify_asan_link_order=0" \
+    ctest --preset asan -j2 -LE '^browser$' -E '^Packaging\.TheDebPassesLintian$'
   end "asan suite"
 
-  # Threads: capture, the synchronizer and camera health, the pipeline (replays, faults, report),
-  # the output queue and HTTP server, the control server and the whole service.
-  tsan_tests="synchronizer_test file_source_test v4l2_source_test camera_health_test
-    queued_sink_test http_stream_sink_test replay_test fault_replay_test pipeline_report_test
-    control_server_test service_notifier_test service_test end_to_end_test"
+  # Threads: the work pool, capture (camera streams, the synchronizer, camera health), every test
+  # that runs the pipeline (replays, faults, recordings, output files and retries, its report), the
+  # output queue and HTTP server, the control server and the whole service. Left out: the
+  # libcamera test (no camera here: it only checks a message, and libcamera's own threads are not
+  # instrumented) and the v4l2loopback test (skipped without the kernel module).
+  tsan_tests="work_pool_test synchronizer_test file_source_test v4l2_source_test
+    camera_health_test queued_sink_test http_stream_sink_test replay_test fault_replay_test
+    fault_isolation_test output_retry_test output_files_test recording_test still_rig_test
+    pipeline_report_test control_server_test service_notifier_test service_test end_to_end_test"
   begin "tsan build"
-  cmake --preset tsan
+  # Only these tests and the programs they run are built; their recordings are made by the ci
+  # build's generator (checked under ASan above), so it need not be built a third time.
+  cmake --preset tsan -DSURROUNDD_FIXTURE_SYNTH="$here/build/ci/tools/synth/surround-synth"
   # shellcheck disable=SC2086 # the list is meant to split into words
-  cmake --build --preset tsan --target $tsan_tests surroundd surroundctl surround-synth
+  cmake --build --preset tsan --target $tsan_tests surroundd surroundctl
   end "tsan build"
   begin "tsan suite"
   # shellcheck disable=SC2086 # the list is meant to split into words
