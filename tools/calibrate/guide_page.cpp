@@ -52,7 +52,7 @@ poll();
 }
 
 std::string_view guidePage() {
-  static const std::string page = guidePageFrom(
+  static const std::string kPage = guidePageFrom(
       "surround-calibrate guide",
       R"style(  main { display: grid; grid-template-columns: minmax(0, 3fr) minmax(16em, 1fr); gap: 1em;
          padding: 1em; }
@@ -142,7 +142,7 @@ function show(state) {
 }
 
 )script");
-  return page;
+  return kPage;
 }
 
 }  // namespace surroundd::calibrate

@@ -7,7 +7,7 @@
 namespace surroundd::calibrate {
 
 std::string_view matGuidePage() {
-  static const std::string page = guidePageFrom(
+  static const std::string kPage = guidePageFrom(
       "surround-calibrate guide --mat",
       R"style(  main { display: grid; grid-template-columns: minmax(0, 3fr) minmax(22em, 2fr); gap: 1em;
          padding: 1em; }
@@ -83,7 +83,7 @@ function show(state) {
 }
 
 )script");
-  return page;
+  return kPage;
 }
 
 }  // namespace surroundd::calibrate
