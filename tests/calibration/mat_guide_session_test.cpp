@@ -54,7 +54,7 @@ std::filesystem::path nominalRigFile(const surroundd::testing::TempDir& dir,
     camera.calibration = calibration;
     cameras.push_back(camera);
   }
-  const auto rig = dir / "rig.yaml";
+  auto rig = dir / "rig.yaml";
   daemon::writeRigFile(rig, cameras, "The rig as measured by hand.");
   return rig;
 }
