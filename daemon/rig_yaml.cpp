@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "capture/sequence_pattern.hpp"
+#include "common/camera_limit.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -241,7 +242,7 @@ processing::ColourRole defaultRole(const processing::Pose& pose) {
 std::vector<RigCamera> readRigCameras(YamlObject& rig) {
   std::vector<RigCamera> cameras;
   std::set<std::string, std::less<>> names;
-  for (auto& entry : rig.objectList("cameras", 1, 8)) {
+  for (auto& entry : rig.objectList("cameras", 1, kMaxCameras)) {
     RigCamera camera;
     auto& calibration = camera.calibration;
     calibration.name = entry.requiredString("name").value_or("");
