@@ -110,6 +110,11 @@ capture::V4l2Settings readDevice(YamlObject& source) {
 capture::LibcameraSettings readLibcamera(YamlObject& source) {
   capture::LibcameraSettings settings;
   settings.camera = source.string("libcamera", "");
+  if (!capture::libcameraAvailable()) {
+    source.error("libcamera",
+                 "this surroundd is built without libcamera cameras: configure with "
+                 "-DSURROUNDD_WITH_LIBCAMERA=ON (needs libcamera-dev)");
+  }
   settings.fps = source.number("fps", settings.fps, {1.0, 1000.0, false, "frames per second"});
   settings.buffers = source.integer("buffers", settings.buffers, 2, 32);
   settings.timeout = std::chrono::milliseconds(source.integer("timeout_ms", 500, 20, 60'000));
