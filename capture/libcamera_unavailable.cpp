@@ -1,4 +1,5 @@
-// Built instead of libcamera_source.cpp where configure found no libcamera.
+// Built instead of libcamera_source.cpp where SURROUNDD_WITH_LIBCAMERA is off
+// (cmake/OptionalParts.cmake).
 #include <fmt/format.h>
 
 #include "capture/libcamera_source.hpp"
@@ -10,10 +11,10 @@ bool libcameraAvailable() { return false; }
 struct LibcameraSource::Impl {};
 
 LibcameraSource::LibcameraSource(std::string cameraName, LibcameraSettings /*settings*/) {
-  throw CaptureError(fmt::format(
-      "camera '{}': this surroundd was built without libcamera (install libcamera-dev and "
-      "rebuild)",
-      cameraName));
+  throw CaptureError(
+      fmt::format("camera '{}': this surroundd was built without libcamera (configure with "
+                  "-DSURROUNDD_WITH_LIBCAMERA=ON; needs libcamera-dev)",
+                  cameraName));
 }
 
 LibcameraSource::~LibcameraSource() = default;

@@ -5,19 +5,8 @@
 #include "capture/file_source.hpp"
 #include "capture/libcamera_source.hpp"
 #include "capture/v4l2_source.hpp"
-#include "daemon/output_files.hpp"
-#include "render/drm_display_sink.hpp"
-#include "render/queued_sink.hpp"
-#include "render/x11_window_sink.hpp"
 
 namespace surroundd::daemon {
-namespace {
-
-// Pictures that may wait for an encoder: enough to ride out a slow frame, few enough that a live
-// view stays current.
-constexpr std::size_t kEncoderQueue = 3;
-
-}  // namespace
 
 std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& config) {
   // Each camera's queue, plus one frame waiting in the synchronizer and one being composed.
@@ -77,54 +66,6 @@ void setUpHealthChecks(const Config& config,
           check == FrozenCheck::kOff ? "health.frozen_check: off" : "a still picture, looped");
     }
   }
-}
-
-std::unique_ptr<render::HttpStreamSink> openHttp(const OutputConfig& output, ViewKind view) {
-  render::HttpStreamSettings settings;
-  settings.address = output.listenAddress;
-  settings.port = output.listenPort;
-  settings.jpegQuality = output.jpegQuality;
-  settings.allowedHosts = output.allowedHosts;
-  if (output.stream == OutputStream::kSurround) {
-    for (const ViewKind kind : render::kViewKinds) settings.views.emplace_back(toString(kind));
-    settings.initialView = toString(view);
-  }
-  auto sink = std::make_unique<render::HttpStreamSink>(std::move(settings));
-  spdlog::info("HTTP stream: http://{}:{}/", output.listenAddress, sink->port());
-  return sink;
-}
-
-std::unique_ptr<render::FrameSink> openSink(const OutputConfig& output, cv::Size videoSize,
-                                            double nominalFps, bool latestWins) {
-  if (output.kind == OutputKind::kWindow) {
-    return std::make_unique<render::X11WindowSink>(
-        render::X11WindowSettings{output.display, output.title, videoSize});
-  }
-  if (output.kind == OutputKind::kDisplay) {
-    return std::make_unique<render::DrmDisplaySink>(
-        render::DrmDisplaySettings{output.device, output.connector});
-  }
-  if (output.path.has_parent_path()) createOutputFolder(output.path.parent_path(), output.path);
-  if (output.kind == OutputKind::kSnapshot) {
-    return std::make_unique<render::SnapshotSink>(
-        output.path, std::chrono::duration_cast<std::chrono::nanoseconds>(
-                         std::chrono::duration<double>(output.atSeconds)));
-  }
-  render::VideoEncoderSettings settings;
-  settings.path = output.path;
-  settings.size = videoSize;
-  settings.nominalFps = nominalFps;
-  settings.crf = output.crf;
-  settings.preset = output.preset;
-  settings.pixelFormat = output.pixelFormat;
-  settings.url = output.url;
-  auto video = std::make_unique<render::VideoSink>(
-      std::move(settings), std::chrono::duration_cast<std::chrono::nanoseconds>(
-                               std::chrono::duration<double>(output.segmentS)));
-  // Encoding runs beside the next frame set's stitching; live, the newest picture wins.
-  return std::make_unique<render::QueuedSink>(
-      std::move(video), videoSize, kEncoderQueue,
-      latestWins ? render::QueuedSink::WhenFull::kDropOldest : render::QueuedSink::WhenFull::kWait);
 }
 
 }  // namespace surroundd::daemon

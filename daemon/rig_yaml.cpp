@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "capture/sequence_pattern.hpp"
+#include "common/camera_limit.hpp"
 #include "processing/camera_model.hpp"
 
 namespace surroundd::daemon {
@@ -110,6 +111,11 @@ capture::V4l2Settings readDevice(YamlObject& source) {
 capture::LibcameraSettings readLibcamera(YamlObject& source) {
   capture::LibcameraSettings settings;
   settings.camera = source.string("libcamera", "");
+  if (!capture::libcameraAvailable()) {
+    source.error("libcamera",
+                 "this surroundd is built without libcamera cameras: configure with "
+                 "-DSURROUNDD_WITH_LIBCAMERA=ON (needs libcamera-dev)");
+  }
   settings.fps = source.number("fps", settings.fps, {1.0, 1000.0, false, "frames per second"});
   settings.buffers = source.integer("buffers", settings.buffers, 2, 32);
   settings.timeout = std::chrono::milliseconds(source.integer("timeout_ms", 500, 20, 60'000));
@@ -291,7 +297,7 @@ processing::ColourRole defaultRole(const processing::Pose& pose) {
 std::vector<RigCamera> readRigCameras(YamlObject& rig) {
   std::vector<RigCamera> cameras;
   std::set<std::string, std::less<>> names;
-  for (auto& entry : rig.objectList("cameras", 1, 8)) {
+  for (auto& entry : rig.objectList("cameras", 1, kMaxCameras)) {
     RigCamera camera;
     auto& calibration = camera.calibration;
     calibration.name = entry.requiredString("name").value_or("");

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "common/camera_limit.hpp"
 #include "common/work_pool.hpp"
 
 namespace surroundd::processing {
@@ -148,9 +149,11 @@ std::optional<cv::Point2d> PanoramaProjector::visiblePixel(std::size_t camera,
 
 PanoramaLut buildPanoramaLut(const Rig& rig, const PanoramaSettings& settings, WorkPool& pool,
                              const LutProgress& progress) {
-  if (rig.cameras.empty() || rig.cameras.size() >= PanoramaLut::kUnseen) {
+  // A tap's camera is a byte beside kUnseen; every camera a rig may have fits it.
+  static_assert(kMaxCameras < PanoramaLut::kUnseen);
+  if (rig.cameras.empty() || rig.cameras.size() > kMaxCameras) {
     throw std::invalid_argument(
-        fmt::format("a panorama needs 1 to 254 cameras, not {}", rig.cameras.size()));
+        fmt::format("a panorama needs 1 to {} cameras, not {}", kMaxCameras, rig.cameras.size()));
   }
   const PanoramaProjector projector(rig, settings);
   const std::vector<ColumnPlan> columns = planColumns(projector);

@@ -126,7 +126,8 @@ class PanoramaProjector {
 using LutProgress = std::function<void(double)>;
 
 // Builds the LUT row-parallel on `pool`. Throws RigError naming a camera that sees none of the
-// panorama, and std::invalid_argument for a rig of more than 254 cameras.
+// panorama, and std::invalid_argument for a rig of more than kMaxCameras
+// (common/camera_limit.hpp).
 PanoramaLut buildPanoramaLut(const Rig& rig, const PanoramaSettings& settings, WorkPool& pool,
                              const LutProgress& progress = {});
 

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "common/camera_limit.hpp"
 #include "common/work_pool.hpp"
 #include "processing/poisson_correction_state.hpp"
 
@@ -77,11 +78,15 @@ const std::vector<std::string>& PoissonColourCorrection::notes() const {
 
 const CorrectionDomain& PoissonColourCorrection::domain() const { return active_->domain; }
 
+// Which cameras are present is a bitmask (configurationFor's key); the rig's LUT holds at most
+// kMaxCameras (buildPanoramaLut), so every camera has its bit.
+static_assert(kMaxCameras <= 32, "a std::uint32_t camera bitmask holds every camera");
+
 PoissonColourCorrection::Configuration& PoissonColourCorrection::configurationFor(
     std::uint32_t presentCameras) {
   auto& configuration = configurations_[presentCameras];
   if (configuration) return *configuration;
-  std::array<bool, 32> present{};
+  std::array<bool, kMaxCameras> present{};
   for (std::size_t c = 0; c < rig_.cameras.size(); ++c) present[c] = (presentCameras >> c) & 1U;
   configuration = std::make_unique<Configuration>();
   configuration->domain =

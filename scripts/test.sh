@@ -4,15 +4,22 @@
 # --sanitizers (CI passes it): then also the whole suite built with AddressSanitizer + UBSan (the
 # `asan` preset; what is left out says why below), and the threaded parts (the work pool, capture,
 # the pipeline, its outputs' queues and servers, the control server, the service) built with
-# ThreadSanitizer (the `tsan` preset). Each phase's time is printed at the end.
+# ThreadSanitizer (the `tsan` preset).
+# --minimal: then also builds the `minimal` preset (every optional part left out: X11, DRM, HTTP,
+# libcamera) and runs the tests that apply to it; those of left-out parts are not run (configure
+# lists them).
+# Each phase's time is printed at the end.
 set -eu
 cd "$(dirname "$0")/.."
 sanitizers=no
-case "${1:-}" in
-  --sanitizers) sanitizers=yes ;;
-  "") ;;
-  *) echo "usage: scripts/test.sh [--sanitizers]" >&2; exit 2 ;;
-esac
+minimal=no
+for argument in "$@"; do
+  case "$argument" in
+    --sanitizers) sanitizers=yes ;;
+    --minimal) minimal=yes ;;
+    *) echo "usage: scripts/test.sh [--sanitizers] [--minimal]" >&2; exit 2 ;;
+  esac
+done
 
 timings=""
 phase_start=0
@@ -81,6 +88,17 @@ if [ "$sanitizers" = yes ]; then
   labels=$(echo $tsan_tests | tr ' ' '|')
   ctest --preset tsan -j2 -L "^($labels)\$"
   end "tsan suite"
+fi
+
+if [ "$minimal" = yes ]; then
+  begin "minimal build"
+  cmake --preset minimal
+  cmake --build --preset minimal
+  end "minimal build"
+  begin "minimal suite"
+  # The package is the full build's concern (tested above).
+  ctest --preset minimal -j2 --label-exclude packaging
+  end "minimal suite"
 fi
 
 echo "test: phase times:$timings"
