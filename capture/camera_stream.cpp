@@ -11,13 +11,13 @@ constexpr std::chrono::milliseconds kPoolWait{100};
 }  // namespace
 
 CameraStream::CameraStream(std::string name, std::unique_ptr<FrameSource> source,
-                           std::size_t poolFrames, int maxConsecutiveFaults)
+                           std::size_t poolFrames, RecoverySettings recovery)
     : name_(std::move(name)),
       source_(std::move(source)),
       pool_(poolFrames, source_->frameSize()),
       nominalPeriod_(source_->nominalPeriod()),
       repeatsOnePicture_(source_->repeatsOnePicture()),
-      maxConsecutiveFaults_(maxConsecutiveFaults),
+      recovery_(recovery),
       queue_(poolFrames) {}
 
 CameraStream::~CameraStream() { stop(); }
@@ -27,41 +27,43 @@ void CameraStream::start() {
 }
 
 void CameraStream::stop() {
-  stopping_ = true;
+  {
+    const std::lock_guard lock(stopMutex_);
+    stopping_ = true;
+  }
+  stopCondition_.notify_all();
   if (thread_.joinable()) thread_.join();
 }
 
 void CameraStream::run() {
-  int consecutiveFaults = 0;
+  SourceRecovery recovery(name_, recovery_);
+  const SourceRecovery::Wait wait = [this](std::chrono::milliseconds duration) {
+    std::unique_lock lock(stopMutex_);
+    return !stopCondition_.wait_for(lock, duration, [this] { return stopping_.load(); });
+  };
   std::uint64_t sequence = 0;
   while (!stopping_) {
     FrameRef frame = pool_.acquire(kPoolWait);
     if (!frame) continue;
     const auto readStart = std::chrono::steady_clock::now();
-    const ReadStatus status = source_->read(*frame);
+    const ReadStatus status = recovery.read(*source_, *frame, wait);
+    {
+      const std::lock_guard lock(mutex_);
+      stats_.faults = recovery.faults();
+      stats_.reopens = recovery.reopens();
+    }
     if (status == ReadStatus::kFrame) {
-      consecutiveFaults = 0;
       frame->sequence = sequence++;
       push(std::move(frame), std::chrono::steady_clock::now() - readStart);
       continue;
     }
-    if (status == ReadStatus::kFault) {
-      {
-        const std::lock_guard lock(mutex_);
-        ++stats_.faults;
-      }
-      // One line per fault: a replay gives up after maxConsecutiveFaults_ of them; a live source
-      // paces its own retries (a timeout or a reopening backoff per fault).
-      spdlog::warn("camera '{}': {}", name_, source_->lastError());
-      ++consecutiveFaults;
-      if (maxConsecutiveFaults_ == 0 || consecutiveFaults < maxConsecutiveFaults_) continue;
-      spdlog::error("camera '{}': {} faults in a row, giving up on this camera", name_,
-                    consecutiveFaults);
-    } else {
+    if (status == ReadStatus::kFault) continue;
+    if (!recovery.gaveUp() && !stopping_) {
       spdlog::info("camera '{}': end of stream after {} frames", name_, sequence);
     }
     break;
   }
+  recovery.onEnd(std::chrono::steady_clock::now());
   {
     const std::lock_guard lock(mutex_);
     ended_ = true;

@@ -4,9 +4,9 @@
 //
 // Back-pressure: the pool holds `poolFrames` buffers; when the consumer keeps all of them (queued
 // or in flight down the pipeline), the thread waits for one to come back instead of dropping —
-// replay stays lossless. A fault is logged and read again (sources may recover);
-// `maxConsecutiveFaults` in a row (0: never, for live cameras that reconnect), or the end of the
-// stream, ends the stream.
+// replay stays lossless. Faults go through the one recovery policy of every source kind
+// (SourceRecovery: counted, logged with rate limiting, a lost device reopened with backoff, given
+// up only where the settings say); the end of the stream, or the policy giving up, ends the stream.
 //
 // Threads: the capture thread owns the source; the queue (mutex + condition variable) is the only
 // state it shares with the consumer.
@@ -21,12 +21,14 @@
 #include <vector>
 
 #include "capture/frame_source.hpp"
+#include "capture/source_recovery.hpp"
 
 namespace surroundd::capture {
 
 struct CameraStreamStats {
-  std::uint64_t frames = 0;  // delivered to the queue
-  std::uint64_t faults = 0;  // reads that failed
+  std::uint64_t frames = 0;   // delivered to the queue
+  std::uint64_t faults = 0;   // reads that failed, frames with concealed errors, failed reopenings
+  std::uint64_t reopens = 0;  // a lost device opened again
   // Spent in the source's read() for the delivered frames: decoding and conversion, and in a
   // real-time replay the wait for each frame's time.
   std::chrono::nanoseconds readTime{0};
@@ -37,7 +39,7 @@ class CameraStream {
   enum class Next { kFrame, kEnded, kTimeout };
 
   CameraStream(std::string name, std::unique_ptr<FrameSource> source, std::size_t poolFrames,
-               int maxConsecutiveFaults = 30);
+               RecoverySettings recovery = {});
   ~CameraStream();  // stops and joins the thread
   CameraStream(const CameraStream&) = delete;
   CameraStream& operator=(const CameraStream&) = delete;
@@ -66,7 +68,7 @@ class CameraStream {
   // Read once: the source belongs to the capture thread once started.
   Timestamp nominalPeriod_;
   bool repeatsOnePicture_;
-  int maxConsecutiveFaults_;
+  RecoverySettings recovery_;
 
   mutable std::mutex mutex_;
   std::condition_variable ready_;
@@ -77,6 +79,8 @@ class CameraStream {
   CameraStreamStats stats_;
 
   std::atomic<bool> stopping_{false};
+  std::mutex stopMutex_;  // with stopCondition_: a backoff wait that stop() cuts short
+  std::condition_variable stopCondition_;
   std::thread thread_;
 };
 

@@ -22,9 +22,24 @@ namespace {
 
 constexpr AVRational kNanoseconds{1, 1'000'000'000};
 constexpr int kSwsFlags = SWS_BICUBIC | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT;
-// A file cannot heal: after this many faults in a row without a frame, report the end instead of
-// letting a caller that retries on kFault spin forever.
-constexpr int kMaxConsecutiveFaults = 100;
+// The decoder's own messages about corrupt data (one or more per damaged frame, straight to stderr)
+// are moved down to debug level: each damaged frame is a fault with the camera's name instead,
+// counted and logged with rate limiting by the recovery policy.
+constexpr int kDecoderLogOffset = AV_LOG_DEBUG - AV_LOG_ERROR;
+
+// What FFmpeg says about a frame it decoded with errors and concealed them.
+std::string concealedErrorsOf(const AVFrame& frame) {
+  std::string what;
+  const auto add = [&what](const char* part) {
+    what += (what.empty() ? "" : ", ") + std::string(part);
+  };
+  if ((frame.decode_error_flags & FF_DECODE_ERROR_INVALID_BITSTREAM) != 0) add("invalid bitstream");
+  if ((frame.decode_error_flags & FF_DECODE_ERROR_MISSING_REFERENCE) != 0) add("missing reference");
+  if ((frame.decode_error_flags & FF_DECODE_ERROR_CONCEALMENT_ACTIVE) != 0) add("concealed");
+  if ((frame.decode_error_flags & FF_DECODE_ERROR_DECODE_SLICES) != 0) add("slices lost");
+  if (what.empty() && (frame.flags & AV_FRAME_FLAG_CORRUPT) != 0) add("corrupt");
+  return what;
+}
 
 // FFmpeg's demuxers for pictures: image2 (a pattern, or one named file) and the per-format pipes
 // (png_pipe, jpeg_pipe, ...). Their frame rate is a made-up default, not the file's.
@@ -76,8 +91,8 @@ struct FileSource::Impl {
   bool haveDecoded = false;  // `decoded` holds a frame not yet returned (the one probed at start)
   bool draining = false;     // the demuxer is done; the decoder is being flushed
   std::uint64_t framesRead = 0;  // since the start, across loops
-  int consecutiveFaults = 0;
-  Timestamp loopOffset{0};  // added to timestamps after each loop so they keep increasing
+  bool drainFailed = false;      // the decoder failed while being flushed: it has nothing more
+  Timestamp loopOffset{0};       // added to timestamps after each loop so they keep increasing
   Timestamp firstTimestamp{0};
   Timestamp lastTimestamp{0};  // latest of this pass through the file, without loopOffset
   std::optional<std::chrono::steady_clock::time_point> pacingStart;
@@ -141,6 +156,7 @@ void FileSource::Impl::open() {
   }
   // One decoding thread: the pipeline already runs one capture thread per camera.
   codec->thread_count = 1;
+  codec->log_level_offset = kDecoderLogOffset;
   if (const int error = avcodec_open2(codec.get(), decoder, nullptr); error < 0) {
     throw CaptureError(describe("cannot open the decoder for", error));
   }
@@ -185,8 +201,13 @@ int FileSource::Impl::decodeNext() {
   while (true) {
     const int received = avcodec_receive_frame(codec.get(), decoded.get());
     if (received == 0) return 1;
-    if (received == AVERROR_EOF) return 0;
-    if (received != AVERROR(EAGAIN)) return received;
+    if (received == AVERROR_EOF || drainFailed) return 0;
+    if (received != AVERROR(EAGAIN)) {
+      // Reported once; a decoder that fails while flushing is not asked again (it would answer
+      // the same for ever).
+      drainFailed = draining;
+      return received;
+    }
     if (draining) return 0;  // a decoder that says EAGAIN after the flush has nothing more
     const int read = av_read_frame(format.get(), packet.get());
     if (read < 0) {
@@ -218,6 +239,7 @@ bool FileSource::Impl::restart() {
   }
   avcodec_flush_buffers(codec.get());
   draining = false;
+  drainFailed = false;
   // A whole number of nominal periods: the cameras of a rig loop by the same offset, whatever the
   // jitter of their last frames' timestamps (which would otherwise pull them apart, pass by pass).
   const auto periods = std::llround(static_cast<double>((lastTimestamp - firstTimestamp).count()) /
@@ -288,10 +310,6 @@ bool FileSource::Impl::convert(cv::Mat& out) {
 
 ReadStatus FileSource::Impl::fault(std::string message) {
   lastError = std::move(message);
-  if (++consecutiveFaults < kMaxConsecutiveFaults) return ReadStatus::kFault;
-  // Give up on the file: its tail is skipped and the next read reports the end.
-  draining = true;
-  avcodec_send_packet(codec.get(), nullptr);
   return ReadStatus::kFault;
 }
 
@@ -357,7 +375,12 @@ ReadStatus FileSource::read(Frame& out) {
     out.image.create(s.size, CV_8UC3);
   }
   if (!s.convert(out.image)) return s.fault(s.lastError);
-  s.consecutiveFaults = 0;
+  const std::string errors = concealedErrorsOf(*s.decoded);
+  out.concealedErrors = !errors.empty();
+  if (out.concealedErrors) {
+    s.lastError = fmt::format("camera '{}': frame {} of '{}' was decoded with errors ({})",
+                              s.camera, s.framesRead, s.settings.path.string(), errors);
+  }
   const Timestamp fileTimestamp = s.timestampOf(*s.decoded);
   s.lastTimestamp = std::max(s.lastTimestamp, fileTimestamp);
   out.timestamp = fileTimestamp + s.loopOffset;

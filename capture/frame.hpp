@@ -25,6 +25,9 @@ struct Frame {
   cv::Mat image;               // 8-bit BGR, allocated once by the pool; never reallocated per frame
   Timestamp timestamp{0};      // presentation (capture) time of the first pixel row
   std::uint64_t sequence = 0;  // per-source frame counter; gaps mean the source skipped frames
+  // Decoded with errors that the decoder concealed (the source's lastError() says which): shown,
+  // and counted as a fault.
+  bool concealedErrors = false;
   // When its source handed it over (set by CameraStream): where a replayed frame's latency starts.
   std::chrono::steady_clock::time_point arrival{};
 };

@@ -6,11 +6,12 @@
 #include <cstddef>
 
 #include "capture/frame.hpp"
+#include "common/camera_limit.hpp"
 
 namespace surroundd::capture {
 
-// A rig has at most this many cameras; fixed so that a FrameSet never allocates.
-inline constexpr std::size_t kMaxCameras = 8;
+// A FrameSet has a slot for each camera a rig may have, so that it never allocates.
+using surroundd::kMaxCameras;
 
 struct FrameSet {
   std::array<FrameRef, kMaxCameras> frames;

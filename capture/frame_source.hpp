@@ -3,7 +3,9 @@
 //
 // Error policy of capture/: constructors and open() throw CaptureError with a message that names
 // the camera and the device or file (start-up boundary). read() never throws: a fault at run time
-// is a ReadStatus plus lastError(), so a capture thread never unwinds through the pipeline.
+// is a ReadStatus plus lastError(), so a capture thread never unwinds through the pipeline. What
+// happens after a fault (reading again, reopening, giving up, logging) is not the source's choice:
+// one policy decides it for every kind (SourceRecovery, capture/source_recovery.hpp).
 
 #include <stdexcept>
 #include <string>
@@ -20,7 +22,10 @@ class CaptureError : public std::runtime_error {
 enum class ReadStatus {
   kFrame,        // `out` holds a new frame
   kEndOfStream,  // a finite source ran out (and does not loop)
-  kFault,        // the source failed; lastError() says why. It may recover on a later read().
+  kFault,        // this read lost a frame (corrupt, undecodable); lastError() says why. The next
+                 // read() goes on.
+  kLost,         // the device stopped delivering or went away, and is closed; lastError() says
+                 // why. reopen() before reading again.
 };
 
 class FrameSource {
@@ -37,6 +42,10 @@ class FrameSource {
   // Blocks until the next frame is decoded or captured into `out` (whose image has frameSize()).
   virtual ReadStatus read(Frame& out) = 0;
   virtual const std::string& lastError() const = 0;
+  // Opens the device again after kLost, keeping frameSize() and nominalPeriod(). Throws
+  // CaptureError when it cannot (yet). A source that never reports kLost keeps this default, which
+  // cannot.
+  virtual void reopen() { throw CaptureError(lastError()); }
   // True for a source that shows one picture over and over by design (a still picture, looped):
   // its frames repeat without anything being wrong. Known once the source is constructed.
   virtual bool repeatsOnePicture() const { return false; }

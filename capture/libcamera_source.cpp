@@ -1,8 +1,8 @@
 #include "capture/libcamera_source.hpp"
 
 #include <algorithm>
-#include <cstdlib>
 #include <condition_variable>
+#include <cstdlib>
 #include <deque>
 #include <map>
 #include <mutex>
@@ -199,14 +199,35 @@ Timestamp LibcameraSource::nominalPeriod() const {
 
 const std::string& LibcameraSource::lastError() const { return impl_->error; }
 
+void LibcameraSource::reopen() {
+  impl_->close();
+  {
+    const std::lock_guard lock(impl_->mutex);
+    impl_->completed.clear();
+  }
+  try {
+    impl_->open();
+  } catch (...) {
+    impl_->close();
+    throw;
+  }
+}
+
 ReadStatus LibcameraSource::read(Frame& out) {
   Impl& s = *impl_;
+  if (!s.started) {
+    s.error = fmt::format("{}: stopped; reopen it", s.where());
+    return ReadStatus::kLost;
+  }
   libcamera::Request* request = nullptr;
   {
     std::unique_lock lock(s.mutex);
     if (!s.ready.wait_for(lock, s.settings.timeout, [&] { return !s.completed.empty(); })) {
-      s.error = fmt::format("{}: no frame within {} ms", s.where(), s.settings.timeout.count());
-      return ReadStatus::kFault;
+      s.error = fmt::format("{}: no frame within {} ms; reopening", s.where(),
+                            s.settings.timeout.count());
+      lock.unlock();
+      s.close();
+      return ReadStatus::kLost;
     }
     request = s.completed.front();
     s.completed.pop_front();

@@ -5,8 +5,10 @@
 // the sensor's timestamps (CLOCK_MONOTONIC, like V4L2's) and leave read() as BGR.
 //
 // Built only where libcamera is found at configure time; elsewhere constructing one throws a
-// CaptureError that says so. Faults at run time (no frame within the timeout, a failed or
-// cancelled request, the camera removed) are read() statuses.
+// CaptureError that says so. Faults at run time are read() statuses: a failed request is kFault;
+// no frame within the timeout (a stalled or removed camera) stops and releases the camera and is
+// kLost, and reopen() acquires and starts it again, as a V4L2 device is (the recovery policy,
+// capture/source_recovery.hpp, decides when).
 
 #include <chrono>
 #include <memory>
@@ -39,6 +41,7 @@ class LibcameraSource final : public FrameSource {
   Timestamp nominalPeriod() const override;
   ReadStatus read(Frame& out) override;
   const std::string& lastError() const override;
+  void reopen() override;
 
  private:
   struct Impl;  // libcamera's types stay out of the header

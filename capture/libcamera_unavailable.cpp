@@ -1,4 +1,5 @@
-// Built instead of libcamera_source.cpp where configure found no libcamera.
+// Built instead of libcamera_source.cpp where SURROUNDD_WITH_LIBCAMERA is off
+// (cmake/OptionalParts.cmake).
 #include <fmt/format.h>
 
 #include "capture/libcamera_source.hpp"
@@ -10,16 +11,17 @@ bool libcameraAvailable() { return false; }
 struct LibcameraSource::Impl {};
 
 LibcameraSource::LibcameraSource(std::string cameraName, LibcameraSettings /*settings*/) {
-  throw CaptureError(fmt::format(
-      "camera '{}': this surroundd was built without libcamera (install libcamera-dev and "
-      "rebuild)",
-      cameraName));
+  throw CaptureError(
+      fmt::format("camera '{}': this surroundd was built without libcamera (configure with "
+                  "-DSURROUNDD_WITH_LIBCAMERA=ON; needs libcamera-dev)",
+                  cameraName));
 }
 
 LibcameraSource::~LibcameraSource() = default;
 cv::Size LibcameraSource::frameSize() const { return {}; }
 Timestamp LibcameraSource::nominalPeriod() const { return {}; }
 ReadStatus LibcameraSource::read(Frame& /*out*/) { return ReadStatus::kEndOfStream; }
+void LibcameraSource::reopen() { throw CaptureError("built without libcamera"); }
 const std::string& LibcameraSource::lastError() const {
   static const std::string kNone;
   return kNone;

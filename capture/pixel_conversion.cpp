@@ -50,4 +50,23 @@ bool convertToBgr(PixelLayout layout, std::span<const std::uint8_t> data, std::s
   return false;
 }
 
+bool convertNv12PlanesToBgr(PlaneView luma, PlaneView chroma, cv::Mat& bgr, std::string& error) {
+  const auto rows = static_cast<std::size_t>(bgr.rows);
+  const auto cols = static_cast<std::size_t>(bgr.cols);
+  if (luma.bytesPerLine < cols || chroma.bytesPerLine < cols ||
+      luma.data.size() < luma.bytesPerLine * rows ||
+      chroma.data.size() < chroma.bytesPerLine * (rows / 2)) {
+    error = fmt::format("a two-plane NV12 frame of {} + {} bytes is too short for {}x{}",
+                        luma.data.size(), chroma.data.size(), bgr.cols, bgr.rows);
+    return false;
+  }
+  // cv::Mat has no read-only header; the planes are only read.
+  const cv::Mat y(bgr.rows, bgr.cols, CV_8UC1, const_cast<std::uint8_t*>(luma.data.data()),
+                  luma.bytesPerLine);
+  const cv::Mat uv(bgr.rows / 2, bgr.cols / 2, CV_8UC2,
+                   const_cast<std::uint8_t*>(chroma.data.data()), chroma.bytesPerLine);
+  cv::cvtColorTwoPlane(y, uv, bgr, cv::COLOR_YUV2BGR_NV12);
+  return true;
+}
+
 }  // namespace surroundd::capture

@@ -22,4 +22,13 @@ const char* toString(PixelLayout layout);
 bool convertToBgr(PixelLayout layout, std::span<const std::uint8_t> data, std::size_t bytesPerLine,
                   JpegDecoder& jpeg, cv::Mat& bgr, std::string& error);
 
+// One plane of a frame whose planes lie in separate buffers (V4L2 multi-planar formats).
+struct PlaneView {
+  std::span<const std::uint8_t> data;
+  std::size_t bytesPerLine = 0;
+};
+// NV12 with luma and interleaved chroma in two buffers (V4L2's NV12M). False, with `error` set,
+// for a plane too short for the frame's size.
+bool convertNv12PlanesToBgr(PlaneView luma, PlaneView chroma, cv::Mat& bgr, std::string& error);
+
 }  // namespace surroundd::capture

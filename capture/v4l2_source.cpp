@@ -5,27 +5,16 @@
 #include <cmath>
 #include <cstring>
 #include <span>
-#include <thread>
 
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <linux/videodev2.h>
 #include <unistd.h>
 
+#include "capture/v4l2_formats.hpp"
+
 namespace surroundd::capture {
 namespace {
-
-struct FormatCode {
-  V4l2Format format;
-  std::uint32_t fourcc;
-  PixelLayout layout;
-};
-constexpr std::array<FormatCode, 4> kFormats{{
-    {V4l2Format::kYuyv, V4L2_PIX_FMT_YUYV, PixelLayout::kYuyv},
-    {V4l2Format::kUyvy, V4L2_PIX_FMT_UYVY, PixelLayout::kUyvy},
-    {V4l2Format::kNv12, V4L2_PIX_FMT_NV12, PixelLayout::kNv12},
-    {V4l2Format::kMjpeg, V4L2_PIX_FMT_MJPEG, PixelLayout::kMjpeg},
-}};
 
 struct ControlName {
   const char* name;
@@ -42,83 +31,26 @@ constexpr std::array<ControlName, 8> kControls{{
     {"saturation", V4L2_CID_SATURATION},
 }};
 
-std::string fourccText(std::uint32_t code) {
-  std::string text(4, ' ');
-  for (int i = 0; i < 4; ++i)
-    text[static_cast<std::size_t>(i)] = static_cast<char>((code >> (8 * i)) & 0xff);
-  return text;
-}
-
-// What the device offers, for the message when the settings cannot be met: "YUYV 640x480,
-// 1280x720; MJPG 1920x1080".
-struct Offer {
-  std::uint32_t fourcc = 0;
-  std::vector<cv::Size> sizes;  // discrete sizes
-  bool anySize = false;         // stepwise or continuous ranges
-  cv::Size smallest, largest;   // of a range
-  bool has(cv::Size size) const {
-    if (anySize) {
-      return size.width >= smallest.width && size.width <= largest.width &&
-             size.height >= smallest.height && size.height <= largest.height;
-    }
-    return std::ranges::find(sizes, size) != sizes.end();
-  }
-};
-
-std::vector<Offer> offersOf(V4l2Device& device) {
-  std::vector<Offer> offers;
-  for (std::uint32_t i = 0;; ++i) {
-    v4l2_fmtdesc description{};
-    description.index = i;
-    description.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    if (device.ioctl(VIDIOC_ENUM_FMT, &description) != 0) break;
-    Offer offer;
-    offer.fourcc = description.pixelformat;
-    for (std::uint32_t k = 0;; ++k) {
-      v4l2_frmsizeenum size{};
-      size.index = k;
-      size.pixel_format = offer.fourcc;
-      if (device.ioctl(VIDIOC_ENUM_FRAMESIZES, &size) != 0) break;
-      if (size.type == V4L2_FRMSIZE_TYPE_DISCRETE) {
-        offer.sizes.emplace_back(static_cast<int>(size.discrete.width),
-                                 static_cast<int>(size.discrete.height));
-      } else {
-        offer.anySize = true;
-        offer.smallest = {static_cast<int>(size.stepwise.min_width),
-                          static_cast<int>(size.stepwise.min_height)};
-        offer.largest = {static_cast<int>(size.stepwise.max_width),
-                         static_cast<int>(size.stepwise.max_height)};
-        break;
-      }
-    }
-    offers.push_back(std::move(offer));
-  }
-  return offers;
-}
-
-std::string describe(const std::vector<Offer>& offers) {
-  std::string text;
-  for (const auto& offer : offers) {
-    text += fmt::format("{}{}", text.empty() ? "" : "; ", fourccText(offer.fourcc));
-    if (offer.anySize) {
-      text += fmt::format(" {}x{} to {}x{}", offer.smallest.width, offer.smallest.height,
-                          offer.largest.width, offer.largest.height);
-    }
-    for (std::size_t k = 0; k < offer.sizes.size(); ++k) {
-      text +=
-          fmt::format("{}{}x{}", k == 0 ? " " : ", ", offer.sizes[k].width, offer.sizes[k].height);
-    }
-  }
-  return text.empty() ? "nothing" : text;
-}
-
 std::string errorText(int error) { return std::strerror(error); }  // NOLINT(concurrency-mt-unsafe)
 
 }  // namespace
 
 const char* toString(V4l2Format format) {
-  const auto known = std::ranges::find(kFormats, format, &FormatCode::format);
-  return known == kFormats.end() ? "auto" : toString(known->layout);
+  const auto known = std::ranges::find(kV4l2Formats, format, &V4l2FormatCode::format);
+  return known == kV4l2Formats.end() ? "auto" : toString(known->layout);
+}
+
+// A buffer for VIDIOC_QUERYBUF, QBUF and DQBUF of this source's type; multi-planar buffers point
+// at `planes` for their per-plane lengths, offsets and sizes.
+v4l2_buffer V4l2Source::bufferFor(std::span<v4l2_plane> planes) const {
+  v4l2_buffer buffer{};
+  buffer.type = bufferType_;
+  buffer.memory = V4L2_MEMORY_MMAP;
+  if (multiplanar_) {
+    buffer.m.planes = planes.data();
+    buffer.length = static_cast<std::uint32_t>(bytesPerLine_.size());
+  }
+  return buffer;
 }
 
 V4l2Source::V4l2Source(std::string cameraName, V4l2Settings settings,
@@ -150,47 +82,42 @@ void V4l2Source::start() {
   const std::uint32_t caps = (capability.capabilities & V4L2_CAP_DEVICE_CAPS) != 0
                                  ? capability.device_caps
                                  : capability.capabilities;
-  if ((caps & V4L2_CAP_VIDEO_CAPTURE) == 0 || (caps & V4L2_CAP_STREAMING) == 0) {
+  const bool singlePlanar = (caps & V4L2_CAP_VIDEO_CAPTURE) != 0;
+  const bool multiPlanar = (caps & V4L2_CAP_VIDEO_CAPTURE_MPLANE) != 0;
+  if ((!singlePlanar && !multiPlanar) || (caps & V4L2_CAP_STREAMING) == 0) {
     throw CaptureError(fmt::format("{} ('{}', driver {}): cannot capture video by streaming",
                                    where(), reinterpret_cast<const char*>(capability.card),
                                    reinterpret_cast<const char*>(capability.driver)));
   }
+  // Most embedded capture drivers (i.MX, Rockchip, TI) speak only the multi-planar API, even for
+  // one-plane formats; a driver that speaks both is used through the single-planar one.
+  multiplanar_ = !singlePlanar;
+  bufferType_ = multiplanar_ ? V4L2_BUF_TYPE_VIDEO_CAPTURE_MPLANE : V4L2_BUF_TYPE_VIDEO_CAPTURE;
 
   // The first wanted format that the device offers at the wanted size.
-  const std::vector<Offer> offers = offersOf(*device_);
-  const FormatCode* chosen = nullptr;
-  for (const auto& candidate : kFormats) {
+  const std::vector<V4l2Offer> offers = offersOf(*device_, bufferType_);
+  const V4l2FormatCode* chosen = nullptr;
+  for (const auto& candidate : kV4l2Formats) {
     if (settings_.format != V4l2Format::kAuto && settings_.format != candidate.format) continue;
-    const auto offer = std::ranges::find(offers, candidate.fourcc, &Offer::fourcc);
+    if (candidate.planes > 1 && !multiplanar_) continue;
+    const auto offer = std::ranges::find(offers, candidate.fourcc, &V4l2Offer::fourcc);
     if (offer != offers.end() && offer->has(settings_.size)) {
       chosen = &candidate;
       break;
     }
   }
   const auto cannot = [&] {
-    return CaptureError(fmt::format("{}: does not offer {} {}x{} (it offers: {})", where(),
+    return CaptureError(fmt::format("{}: does not offer {} {}x{} (it offers{}: {})", where(),
                                     toString(settings_.format), settings_.size.width,
-                                    settings_.size.height, describe(offers)));
+                                    settings_.size.height, multiplanar_ ? ", multi-planar" : "",
+                                    describe(offers)));
   };
   if (chosen == nullptr) throw cannot();
-  v4l2_format format{};
-  format.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  format.fmt.pix.width = static_cast<std::uint32_t>(settings_.size.width);
-  format.fmt.pix.height = static_cast<std::uint32_t>(settings_.size.height);
-  format.fmt.pix.pixelformat = chosen->fourcc;
-  format.fmt.pix.field = V4L2_FIELD_NONE;
-  if (device_->ioctl(VIDIOC_S_FMT, &format) != 0 || format.fmt.pix.pixelformat != chosen->fourcc ||
-      static_cast<int>(format.fmt.pix.width) != settings_.size.width ||
-      static_cast<int>(format.fmt.pix.height) != settings_.size.height) {
-    throw cannot();
-  }
-  format_ = chosen->format;
-  layout_ = chosen->layout;
-  bytesPerLine_ = format.fmt.pix.bytesperline;
+  setFormat(*chosen, cannot);
 
   // The frame rate, where the driver lets it be set; the nominal period is what it answers.
   v4l2_streamparm parameters{};
-  parameters.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  parameters.type = bufferType_;
   if (device_->ioctl(VIDIOC_G_PARM, &parameters) == 0 &&
       (parameters.parm.capture.capability & V4L2_CAP_TIMEPERFRAME) != 0) {
     parameters.parm.capture.timeperframe = {
@@ -225,88 +152,137 @@ void V4l2Source::start() {
     }
   }
 
-  v4l2_requestbuffers request{};
-  request.count = static_cast<std::uint32_t>(settings_.buffers);
-  request.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  request.memory = V4L2_MEMORY_MMAP;
-  if (const int error = device_->ioctl(VIDIOC_REQBUFS, &request); error != 0 || request.count < 2) {
-    throw CaptureError(fmt::format("{}: cannot get {} streaming buffers: {}", where(),
-                                   settings_.buffers,
-                                   error != 0 ? errorText(error) : "too few granted"));
-  }
-  for (std::uint32_t i = 0; i < request.count; ++i) {
-    v4l2_buffer buffer{};
-    buffer.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    buffer.memory = V4L2_MEMORY_MMAP;
-    buffer.index = i;
-    if (const int error = device_->ioctl(VIDIOC_QUERYBUF, &buffer); error != 0) {
-      throw CaptureError(fmt::format("{}: buffer {}: {}", where(), i, errorText(error)));
-    }
-    void* address = device_->map(buffer.length, buffer.m.offset);
-    if (address == nullptr) throw CaptureError(fmt::format("{}: cannot map buffer {}", where(), i));
-    buffers_.push_back({address, buffer.length});
-    v4l2_exportbuffer exported{};
-    exported.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    exported.index = i;
-    exported.flags = O_CLOEXEC | O_RDONLY;
-    if (device_->ioctl(VIDIOC_EXPBUF, &exported) == 0) dmabufs_.push_back(exported.fd);
-    if (const int error = device_->ioctl(VIDIOC_QBUF, &buffer); error != 0) {
-      throw CaptureError(fmt::format("{}: queueing buffer {}: {}", where(), i, errorText(error)));
-    }
-  }
-  int type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  mapBuffers();
+  int type = static_cast<int>(bufferType_);
   if (const int error = device_->ioctl(VIDIOC_STREAMON, &type); error != 0) {
     throw CaptureError(fmt::format("{}: cannot start streaming: {}", where(), errorText(error)));
   }
   streaming_ = true;
 }
 
+void V4l2Source::setFormat(const V4l2FormatCode& chosen,
+                           const std::function<CaptureError()>& cannot) {
+  v4l2_format format{};
+  format.type = bufferType_;
+  const auto width = static_cast<std::uint32_t>(settings_.size.width);
+  const auto height = static_cast<std::uint32_t>(settings_.size.height);
+  bytesPerLine_.clear();
+  if (multiplanar_) {
+    auto& pix = format.fmt.pix_mp;
+    pix.width = width;
+    pix.height = height;
+    pix.pixelformat = chosen.fourcc;
+    pix.field = V4L2_FIELD_NONE;
+    pix.num_planes = static_cast<std::uint8_t>(chosen.planes);
+    if (device_->ioctl(VIDIOC_S_FMT, &format) != 0 || pix.pixelformat != chosen.fourcc ||
+        pix.width != width || pix.height != height) {
+      throw cannot();
+    }
+    if (pix.num_planes != chosen.planes) {
+      throw CaptureError(fmt::format("{}: {} comes in {} planes, expected {}", where(),
+                                     fourccText(chosen.fourcc), pix.num_planes, chosen.planes));
+    }
+    for (std::uint32_t p = 0; p < pix.num_planes; ++p) {
+      bytesPerLine_.push_back(pix.plane_fmt[p].bytesperline);
+    }
+  } else {
+    auto& pix = format.fmt.pix;
+    pix.width = width;
+    pix.height = height;
+    pix.pixelformat = chosen.fourcc;
+    pix.field = V4L2_FIELD_NONE;
+    if (device_->ioctl(VIDIOC_S_FMT, &format) != 0 || pix.pixelformat != chosen.fourcc ||
+        pix.width != width || pix.height != height) {
+      throw cannot();
+    }
+    bytesPerLine_.push_back(pix.bytesperline);
+  }
+  format_ = chosen.format;
+  layout_ = chosen.layout;
+}
+
+void V4l2Source::mapBuffers() {
+  v4l2_requestbuffers request{};
+  request.count = static_cast<std::uint32_t>(settings_.buffers);
+  request.type = bufferType_;
+  request.memory = V4L2_MEMORY_MMAP;
+  if (const int error = device_->ioctl(VIDIOC_REQBUFS, &request); error != 0 || request.count < 2) {
+    throw CaptureError(fmt::format("{}: cannot get {} streaming buffers: {}", where(),
+                                   settings_.buffers,
+                                   error != 0 ? errorText(error) : "too few granted"));
+  }
+  requested_ = true;
+  for (std::uint32_t i = 0; i < request.count; ++i) {
+    std::array<v4l2_plane, VIDEO_MAX_PLANES> planes{};
+    v4l2_buffer buffer = bufferFor(planes);
+    buffer.index = i;
+    if (const int error = device_->ioctl(VIDIOC_QUERYBUF, &buffer); error != 0) {
+      throw CaptureError(fmt::format("{}: buffer {}: {}", where(), i, errorText(error)));
+    }
+    std::vector<MappedPlane>& mapped = buffers_.emplace_back();
+    for (std::size_t p = 0; p < bytesPerLine_.size(); ++p) {
+      const std::size_t length = multiplanar_ ? planes[p].length : buffer.length;
+      const std::int64_t offset = multiplanar_ ? planes[p].m.mem_offset : buffer.m.offset;
+      void* address = device_->map(length, offset);
+      if (address == nullptr) {
+        throw CaptureError(fmt::format("{}: cannot map buffer {} plane {}", where(), i, p));
+      }
+      mapped.push_back({address, length});
+      v4l2_exportbuffer exported{};
+      exported.type = bufferType_;
+      exported.index = i;
+      exported.plane = static_cast<std::uint32_t>(p);
+      exported.flags = O_CLOEXEC | O_RDONLY;
+      if (device_->ioctl(VIDIOC_EXPBUF, &exported) == 0) dmabufs_.push_back(exported.fd);
+    }
+    if (const int error = device_->ioctl(VIDIOC_QBUF, &buffer); error != 0) {
+      throw CaptureError(fmt::format("{}: queueing buffer {}: {}", where(), i, errorText(error)));
+    }
+  }
+}
+
 void V4l2Source::stop() {
   if (streaming_) {
-    int type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    int type = static_cast<int>(bufferType_);
     device_->ioctl(VIDIOC_STREAMOFF, &type);
     streaming_ = false;
   }
   for (const int fd : dmabufs_) ::close(fd);
   dmabufs_.clear();
-  for (const auto& buffer : buffers_) device_->unmap(buffer.address, buffer.length);
-  if (!buffers_.empty()) {
-    v4l2_requestbuffers release{};
-    release.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    release.memory = V4L2_MEMORY_MMAP;
-    device_->ioctl(VIDIOC_REQBUFS, &release);
+  for (const auto& planes : buffers_) {
+    for (const auto& plane : planes) device_->unmap(plane.address, plane.length);
   }
   buffers_.clear();
+  if (requested_) {
+    v4l2_requestbuffers release{};
+    release.type = bufferType_;
+    release.memory = V4L2_MEMORY_MMAP;
+    device_->ioctl(VIDIOC_REQBUFS, &release);
+    requested_ = false;
+  }
   device_->close();
 }
 
-ReadStatus V4l2Source::fault(std::string message, bool reopen) {
+ReadStatus V4l2Source::fault(std::string message, bool lost) {
   error_ = std::move(message);
-  if (reopen) {
-    stop();
-    backoff_ = backoff_.count() == 0 ? settings_.firstBackoff
-                                     : std::min(backoff_ * 2, settings_.maxBackoff);
-    nextAttempt_ = std::chrono::steady_clock::now() + backoff_;
-  }
-  return ReadStatus::kFault;
+  if (!lost) return ReadStatus::kFault;
+  stop();
+  return ReadStatus::kLost;
 }
 
-ReadStatus V4l2Source::reopen() {
-  std::this_thread::sleep_until(nextAttempt_);
+void V4l2Source::reopen() {
+  stop();
   try {
     start();
-  } catch (const CaptureError& e) {
-    return fault(fmt::format("reopening failed (next try in {} ms): {}",
-                             std::min(backoff_ * 2, settings_.maxBackoff).count(), e.what()),
-                 true);
+  } catch (...) {
+    stop();
+    throw;
   }
   ++reopened_;
-  backoff_ = std::chrono::milliseconds(0);
-  return ReadStatus::kFrame;
 }
 
 ReadStatus V4l2Source::read(Frame& out) {
-  if (!streaming_ && reopen() != ReadStatus::kFrame) return ReadStatus::kFault;
+  if (!streaming_) return fault(fmt::format("{}: closed; reopen it", where()), true);
   if (const int error = device_->waitReadable(settings_.timeout); error != 0) {
     if (error == ETIMEDOUT) {
       return fault(
@@ -315,9 +291,8 @@ ReadStatus V4l2Source::read(Frame& out) {
     }
     return fault(fmt::format("{}: {}; reopening", where(), errorText(error)), true);
   }
-  v4l2_buffer buffer{};
-  buffer.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  buffer.memory = V4L2_MEMORY_MMAP;
+  std::array<v4l2_plane, VIDEO_MAX_PLANES> planes{};
+  v4l2_buffer buffer = bufferFor(planes);
   if (const int error = device_->ioctl(VIDIOC_DQBUF, &buffer); error != 0) {
     if (error == EAGAIN) return fault(fmt::format("{}: woke without a frame", where()), false);
     return fault(fmt::format("{}: {}; reopening", where(), errorText(error)), true);
@@ -325,8 +300,7 @@ ReadStatus V4l2Source::read(Frame& out) {
   bool good = (buffer.flags & V4L2_BUF_FLAG_ERROR) == 0 && buffer.index < buffers_.size();
   std::string problem = good ? "" : "the driver marked the frame corrupt";
   if (good) {
-    good = convert(static_cast<const std::uint8_t*>(buffers_[buffer.index].address),
-                   buffer.bytesused, out.image);
+    good = convert(buffer, out.image);
     if (!good) problem = error_;
   }
   out.timestamp = std::chrono::seconds(buffer.timestamp.tv_sec) +
@@ -339,8 +313,25 @@ ReadStatus V4l2Source::read(Frame& out) {
   return ReadStatus::kFrame;
 }
 
-bool V4l2Source::convert(const std::uint8_t* data, std::size_t bytes, cv::Mat& bgr) {
-  return convertToBgr(layout_, std::span(data, bytes), bytesPerLine_, jpeg_, bgr, error_);
+bool V4l2Source::convert(const v4l2_buffer& buffer, cv::Mat& bgr) {
+  const std::vector<MappedPlane>& mapped = buffers_[buffer.index];
+  // Each plane's bytes: what the driver filled, after the offset it starts at.
+  std::array<std::span<const std::uint8_t>, 2> data;
+  for (std::size_t p = 0; p < mapped.size() && p < data.size(); ++p) {
+    const std::size_t used = multiplanar_ ? buffer.m.planes[p].bytesused : buffer.bytesused;
+    const std::size_t offset = multiplanar_ ? buffer.m.planes[p].data_offset : 0;
+    const std::size_t end = std::min(used, mapped[p].length);
+    if (offset > end) {
+      error_ = fmt::format("plane {} starts at {}, past its {} bytes", p, offset, end);
+      return false;
+    }
+    data[p] = std::span(static_cast<const std::uint8_t*>(mapped[p].address) + offset, end - offset);
+  }
+  if (mapped.size() == 2) {
+    return convertNv12PlanesToBgr({data[0], bytesPerLine_[0]}, {data[1], bytesPerLine_[1]}, bgr,
+                                  error_);
+  }
+  return convertToBgr(layout_, data[0], bytesPerLine_[0], jpeg_, bgr, error_);
 }
 
 }  // namespace surroundd::capture

@@ -2,15 +2,18 @@
 // A live camera through V4L2 (video4linux2): opened by a stable path (/dev/v4l/by-path/...,
 // /dev/v4l/by-id/...) or /dev/videoN, the pixel format, size and frame rate negotiated from the
 // settings, MMAP streaming, frames converted to BGR once (YUYV, UYVY, NV12; MJPEG through
-// libjpeg-turbo) with the driver's monotonic timestamps.
+// libjpeg-turbo) with the driver's monotonic timestamps. Single-planar devices (UVC) and
+// multi-planar ones (V4L2_CAP_VIDEO_CAPTURE_MPLANE: i.MX, Rockchip, TI capture drivers) alike;
+// through the multi-planar API, NV12 also comes as NV12M (luma and chroma in two buffers).
 //
-// Faults at run time are read() statuses: no frame within the timeout, the device gone (ENODEV,
-// EIO), a corrupt frame. A device that stops delivering or disappears is closed and reopened with
-// a growing backoff, and resumes streaming without anyone restarting anything.
+// Faults at run time are read() statuses: a corrupt frame is kFault; no frame within the timeout
+// or the device gone (ENODEV, EIO) closes it and is kLost, and reopen() opens and starts it again
+// (when and how often is the recovery policy's choice, capture/source_recovery.hpp).
 
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -21,10 +24,14 @@
 #include "capture/pixel_conversion.hpp"
 #include "capture/v4l2_device.hpp"
 
+struct v4l2_buffer;
+struct v4l2_plane;
+
 namespace surroundd::capture {
 
 enum class V4l2Format { kAuto, kYuyv, kUyvy, kNv12, kMjpeg };
 const char* toString(V4l2Format format);
+struct V4l2FormatCode;
 
 // A V4L2 control by its name in the config: exposure_auto, exposure_absolute, gain,
 // white_balance_auto, white_balance_temperature, brightness, contrast, saturation.
@@ -38,11 +45,9 @@ struct V4l2Settings {
   std::filesystem::path device;
   cv::Size size{1280, 720};
   double fps = 30;
-  V4l2Format format = V4l2Format::kAuto;        // auto: YUYV, UYVY, NV12, MJPEG, the first offered
-  int buffers = 4;                              // driver buffers, 2..32
-  std::chrono::milliseconds timeout{500};       // no frame for this long: the camera is lost
-  std::chrono::milliseconds firstBackoff{100};  // reopening: first wait, doubled up to maxBackoff
-  std::chrono::milliseconds maxBackoff{2000};
+  V4l2Format format = V4l2Format::kAuto;   // auto: YUYV, UYVY, NV12, MJPEG, the first offered
+  int buffers = 4;                         // driver buffers, 2..32
+  std::chrono::milliseconds timeout{500};  // no frame for this long: the camera is lost
   std::vector<V4l2Control> controls;
   bool operator==(const V4l2Settings&) const = default;
 };
@@ -60,24 +65,29 @@ class V4l2Source final : public FrameSource {
   Timestamp nominalPeriod() const override { return period_; }
   ReadStatus read(Frame& out) override;
   const std::string& lastError() const override { return error_; }
+  void reopen() override;
 
   V4l2Format format() const { return format_; }  // as negotiated
   std::uint64_t reopened() const { return reopened_; }
+  bool multiplanar() const { return multiplanar_; }  // through the multi-planar API
   // The driver buffers as DMABUF file descriptors, where the driver exports them (VIDIOC_EXPBUF),
-  // for importing frames into a GPU without a copy; empty where it does not.
+  // for importing frames into a GPU without a copy; empty where it does not. One per plane, buffer
+  // after buffer.
   std::span<const int> dmabufs() const { return dmabufs_; }
 
  private:
-  struct MappedBuffer {
+  struct MappedPlane {
     void* address = nullptr;
     std::size_t length = 0;
   };
 
   void start();  // open, negotiate, map, stream; throws CaptureError
-  void stop();   // stream off, unmap, close; never throws
-  ReadStatus fault(std::string message, bool reopen);
-  ReadStatus reopen();
-  bool convert(const std::uint8_t* data, std::size_t bytes, cv::Mat& bgr);
+  void setFormat(const V4l2FormatCode& chosen, const std::function<CaptureError()>& cannot);
+  void mapBuffers();
+  void stop();  // stream off, unmap, close; never throws
+  ReadStatus fault(std::string message, bool lost);
+  v4l2_buffer bufferFor(std::span<v4l2_plane> planes) const;
+  bool convert(const v4l2_buffer& buffer, cv::Mat& bgr);
   std::string where() const;
 
   std::string camera_;
@@ -86,13 +96,14 @@ class V4l2Source final : public FrameSource {
   JpegDecoder jpeg_;
   V4l2Format format_ = V4l2Format::kAuto;
   PixelLayout layout_ = PixelLayout::kYuyv;
-  std::uint32_t bytesPerLine_ = 0;
+  bool multiplanar_ = false;
+  std::uint32_t bufferType_ = 0;           // V4L2_BUF_TYPE_VIDEO_CAPTURE or ..._MPLANE
+  std::vector<std::size_t> bytesPerLine_;  // per plane
   Timestamp period_{0};
-  std::vector<MappedBuffer> buffers_;
+  std::vector<std::vector<MappedPlane>> buffers_;  // per buffer, per plane
   std::vector<int> dmabufs_;
+  bool requested_ = false;  // buffers were requested (VIDIOC_REQBUFS) and must be released
   bool streaming_ = false;
-  std::chrono::milliseconds backoff_{0};
-  std::chrono::steady_clock::time_point nextAttempt_{};
   std::uint64_t reopened_ = 0;
   std::string error_;
 };

@@ -6,13 +6,16 @@
 // part that consumes them exists (processing/ and render/ never see YAML).
 
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <spdlog/common.h>
 
 #include "capture/file_source.hpp"
+#include "capture/source_recovery.hpp"
 #include "daemon/rig_yaml.hpp"
 #include "daemon/vehicle_yaml.hpp"
 #include "processing/panorama_lut.hpp"
@@ -33,6 +36,9 @@ struct CaptureConfig {
   // drop its oldest picture): auto = only with live cameras; always also for replays (to see a
   // replay as a live rig would show it), never keeps every set.
   enum class LatestWins { kAuto, kAlways, kNever } latestWins = LatestWins::kAuto;
+  // How every camera, whatever its kind, recovers from faults (capture/source_recovery.hpp):
+  // reopening backoff, giving up, and how often repeated faults are logged.
+  capture::RecoverySettings recovery;
 
   bool operator==(const CaptureConfig&) const = default;
 };
@@ -105,14 +111,76 @@ struct RenderConfig {
 // What an output shows: the labelled camera grid, the stitched panorama, or the rendered
 // surround view.
 enum class OutputStream { kMosaic, kPanorama, kSurround };
-// A recording is not a picture of the pipeline but the cameras' own streams (RigRecorder).
-enum class OutputKind { kVideo, kNetwork, kHttp, kWindow, kDisplay, kSnapshot, kRecording };
 
+// An output's `type:`: the name of an output type in the registry (output_type.hpp), where each
+// type registers its keys, its factory and what it takes from the pipeline. The built-in types are
+// named here for code that writes configs; a type registered elsewhere is OutputKind{"its-name"}.
+class OutputKind {
+ public:
+  constexpr explicit OutputKind(std::string_view name) : name_(name) {}
+  constexpr std::string_view name() const { return name_; }
+  bool operator==(const OutputKind& other) const { return name_ == other.name_; }
+
+  static const OutputKind kVideo, kNetwork, kHttp, kWindow, kDisplay, kSnapshot;
+  // Not a picture of the pipeline but the cameras' own streams (RigRecorder).
+  static const OutputKind kRecording;
+
+ private:
+  std::string_view name_;  // a literal, or the registry's copy: lives as long as the program
+};
+inline constexpr OutputKind OutputKind::kVideo{"video"};
+inline constexpr OutputKind OutputKind::kNetwork{"network"};
+inline constexpr OutputKind OutputKind::kHttp{"http"};
+inline constexpr OutputKind OutputKind::kWindow{"window"};
+inline constexpr OutputKind OutputKind::kDisplay{"display"};
+inline constexpr OutputKind OutputKind::kSnapshot{"snapshot"};
+inline constexpr OutputKind OutputKind::kRecording{"recording"};
+
+// The settings of an output type registered outside surroundd's own list (a test's, a plug-in's):
+// the struct its schema reads, kept as it is and compared by value. Copies share it (it is not
+// changed once read).
+class OtherOutputSettings {
+ public:
+  template <class Settings>
+  explicit OtherOutputSettings(Settings settings)
+      : held_(std::make_shared<const Held<Settings>>(std::move(settings))) {}
+  OtherOutputSettings() = default;
+
+  // The settings if they are a `Settings`, else null.
+  template <class Settings>
+  const Settings* get() const {
+    const auto* held = dynamic_cast<const Held<Settings>*>(held_.get());
+    return held != nullptr ? &held->settings : nullptr;
+  }
+  bool operator==(const OtherOutputSettings& other) const {
+    return held_ == other.held_ || (held_ && other.held_ && held_->equals(*other.held_));
+  }
+
+ private:
+  struct Base {
+    virtual ~Base() = default;
+    virtual bool equals(const Base& other) const = 0;
+  };
+  template <class Settings>
+  struct Held final : Base {
+    explicit Held(Settings s) : settings(std::move(s)) {}
+    bool equals(const Base& other) const override {
+      const auto* same = dynamic_cast<const Held*>(&other);
+      return same != nullptr && same->settings == settings;
+    }
+    Settings settings;
+  };
+  std::shared_ptr<const Base> held_;
+};
+
+// One entry of `outputs:`. The keys every output has come first; the built-in types' own settings
+// follow, each read only by its type's schema (daemon/<type>_output.cpp), where its ranges are.
 struct OutputConfig {
   OutputKind kind = OutputKind::kVideo;
   OutputStream stream = OutputStream::kMosaic;
   std::filesystem::path path;    // parent folders are created at start
   std::optional<ViewKind> view;  // surround: the view it starts with; default render.view
+  OtherOutputSettings other;     // a type registered outside surroundd's own list
   // video and network
   int crf = 23;
   std::string preset = "veryfast";

@@ -1,16 +1,15 @@
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <span>
 
-#include <arpa/inet.h>
 #include <fmt/format.h>
 #include <sys/un.h>
 
 #include "daemon/config.hpp"
 #include "daemon/logging.hpp"
 #include "daemon/output_files.hpp"
+#include "daemon/output_type.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -81,6 +80,22 @@ void readCapture(YamlObject& section, CaptureConfig& c) {
                                 {{"auto", LatestWins::kAuto},
                                  {"always", LatestWins::kAlways},
                                  {"never", LatestWins::kNever}});
+  auto& r = c.recovery;
+  r.firstBackoff = std::chrono::milliseconds(
+      section.integer("reopen_backoff_ms", static_cast<int>(r.firstBackoff.count()), 1, 60'000));
+  r.maxBackoff = std::chrono::milliseconds(
+      section.integer("reopen_backoff_max_ms", static_cast<int>(r.maxBackoff.count()), 1, 600'000));
+  if (r.maxBackoff < r.firstBackoff) {
+    section.error("reopen_backoff_max_ms",
+                  fmt::format("expected at least reopen_backoff_ms ({}), got {}",
+                              r.firstBackoff.count(), r.maxBackoff.count()));
+  }
+  r.giveUpAfterFaults =
+      section.integer("give_up_after_faults", r.giveUpAfterFaults, 0, 1'000'000'000);
+  r.logInterval = std::chrono::milliseconds(
+      std::lround(1000 * section.number("fault_log_interval_s",
+                                        static_cast<double>(r.logInterval.count()) / 1000,
+                                        {0.0, 3600.0, false, "seconds"})));
   section.finish();
 }
 
@@ -206,43 +221,22 @@ void readRender(YamlObject& section, RenderConfig& r) {
   section.finish();
 }
 
-// "ADDRESS:PORT" of an IPv4 address; port 0 picks a free one.
-void readListen(YamlObject& item, OutputConfig& o) {
-  const std::string listen =
-      item.string("listen", fmt::format("{}:{}", o.listenAddress, o.listenPort));
-  const auto colon = listen.rfind(':');
-  int port = -1;
-  if (colon != std::string::npos) {
-    const std::string_view digits = std::string_view(listen).substr(colon + 1);
-    const auto [end, failed] = std::from_chars(digits.data(), digits.data() + digits.size(), port);
-    if (failed != std::errc() || end != digits.data() + digits.size()) port = -1;
-  }
-  in_addr address{};
-  if (colon == std::string::npos || port < 0 || port > 65535 ||
-      inet_pton(AF_INET, listen.substr(0, colon).c_str(), &address) != 1) {
-    item.error("listen",
-               fmt::format("expected IPv4-ADDRESS:PORT (e.g. 127.0.0.1:8080), got '{}'", listen));
-    return;
-  }
-  o.listenAddress = listen.substr(0, colon);
-  o.listenPort = port;
-}
-
+// The keys every output has (type, stream, view), then its type's own (output_type.hpp).
 OutputConfig readOutput(YamlObject& item) {
   OutputConfig o;
-  o.kind = item.choice("type", o.kind,
-                       {{"video", OutputKind::kVideo},
-                        {"network", OutputKind::kNetwork},
-                        {"http", OutputKind::kHttp},
-                        {"window", OutputKind::kWindow},
-                        {"display", OutputKind::kDisplay},
-                        {"snapshot", OutputKind::kSnapshot},
-                        {"recording", OutputKind::kRecording}});
+  std::vector<std::pair<std::string_view, const OutputType*>> types;
+  for (const std::string_view name : outputTypeNames())
+    types.emplace_back(name, findOutputType(name));
+  const OutputType* type = item.choice<const OutputType*>(
+      "type", &outputTypeOf(o),
+      std::span<const std::pair<std::string_view, const OutputType*>>(types));
   if (!item.has("type")) {
-    item.errorHere(
-        "missing key 'type' (one of 'video' 'network' 'http' 'window' 'display' 'snapshot' "
-        "'recording')");
+    std::string names;
+    for (const auto& [name, t] : types)
+      names += fmt::format("{}'{}'", names.empty() ? "" : " ", name);
+    item.errorHere(fmt::format("missing key 'type' (one of {})", names));
   }
+  o.kind = OutputKind(type->name);
   o.stream = item.choice("stream", o.stream,
                          {{"mosaic", OutputStream::kMosaic},
                           {"panorama", OutputStream::kPanorama},
@@ -255,61 +249,13 @@ OutputConfig readOutput(YamlObject& item) {
       item.error("view", "only a surround output has a view");
     }
   }
-  if (o.kind == OutputKind::kNetwork) {
-    o.url = item.string("url", "");
-    if (!o.url.starts_with("udp://") || o.url.size() <= 6) {
-      item.error("url", fmt::format("expected udp://HOST:PORT, got '{}'", o.url));
-    }
-  } else if (o.kind == OutputKind::kHttp) {
-    readListen(item, o);
-    o.jpegQuality = item.integer("quality", o.jpegQuality, 1, 100);
-    o.allowedHosts = item.strings("allowed_hosts", 0, 32).value_or(std::vector<std::string>{});
-  } else if (o.kind == OutputKind::kWindow) {
-    o.display = item.string("display", o.display);
-    o.title = item.string("title", o.title);
-  } else if (o.kind == OutputKind::kDisplay) {
-    o.device = item.string("device", "");
-    o.connector = item.string("connector", o.connector);
-  } else {
-    o.path = item.outputPath("path").value_or("");
+  if (!type->leftOut.empty()) {
+    // Its keys are not read: this build does not know them.
+    item.error("type", fmt::format("this surroundd is built without '{}' outputs: {}", type->name,
+                                   type->leftOut));
+    return o;
   }
-  const auto extension = o.path.extension().string();
-  if (o.kind == OutputKind::kVideo || o.kind == OutputKind::kNetwork) {
-    o.crf = item.integer("crf", o.crf, 0, 51);
-    o.preset = item.choice<std::string>("preset", o.preset,
-                                        {{"ultrafast", "ultrafast"},
-                                         {"superfast", "superfast"},
-                                         {"veryfast", "veryfast"},
-                                         {"faster", "faster"},
-                                         {"fast", "fast"},
-                                         {"medium", "medium"}});
-    o.pixelFormat = item.choice<std::string>("pixel_format", o.pixelFormat,
-                                             {{"yuv420p", "yuv420p"}, {"yuv444p", "yuv444p"}});
-    if (o.kind == OutputKind::kVideo) {
-      o.segmentS = item.number("segment_s", o.segmentS, {0.0, 86400.0, false, "seconds"});
-    }
-    if (o.kind == OutputKind::kVideo && extension != ".mp4" && extension != ".mkv") {
-      item.error("path",
-                 fmt::format("expected a file ending in .mp4 or .mkv, got '{}'", o.path.string()));
-    }
-  } else if (o.kind == OutputKind::kRecording) {
-    if (item.has("stream")) {
-      item.error("stream", "a recording writes every camera's own stream; it takes no 'stream'");
-    }
-    o.lossless = item.boolean("lossless", o.lossless);
-    o.crf = item.integer("crf", o.crf, 0, 51);
-    std::error_code ec;
-    if (!o.path.empty() && std::filesystem::exists(o.path, ec) &&
-        !std::filesystem::is_directory(o.path, ec)) {
-      item.error("path", fmt::format("expected a folder for the recording, got the file '{}'",
-                                     o.path.string()));
-    }
-  } else if (o.kind == OutputKind::kSnapshot) {
-    o.atSeconds = item.number("at_s", o.atSeconds, {0.0, 1e7, false, "seconds of stream time"});
-    if (!o.path.empty() && extension != ".png") {
-      item.error("path", fmt::format("expected a file ending in .png, got '{}'", o.path.string()));
-    }
-  }
+  type->readSettings(item, o);
   item.finish();
   return o;
 }
@@ -410,19 +356,16 @@ Config readConfig(const YAML::Node& document, const std::filesystem::path& file)
   });
   for (auto& item : root.objectList("outputs", 1, 32)) {
     auto output = readOutput(item);
+    const OutputType& type = outputTypeOf(output);
     for (std::size_t earlier = 0; earlier < config.outputs.size(); ++earlier) {
       const OutputConfig& other = config.outputs[earlier];
       if (auto clash = outputFileClash(other, output)) {
         item.error("path", fmt::format("{} (outputs[{}] too)", *clash, earlier));
       }
-      const auto sharesAddress = [](const std::string& x, const std::string& y) {
-        return x == y || x == "0.0.0.0" || y == "0.0.0.0";
-      };
-      if (output.kind == OutputKind::kHttp && other.kind == OutputKind::kHttp &&
-          output.listenPort == other.listenPort && output.listenPort != 0 &&
-          sharesAddress(output.listenAddress, other.listenAddress)) {
-        item.error("listen", fmt::format("outputs[{}] listens on port {} already", earlier,
-                                         output.listenPort));
+      if (type.conflict && other.kind == output.kind) {
+        if (const auto conflict = type.conflict(other, output)) {
+          item.error(conflict->key, fmt::format("outputs[{}] {}", earlier, conflict->message));
+        }
       }
     }
     config.outputs.push_back(std::move(output));

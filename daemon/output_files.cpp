@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include "daemon/output_type.hpp"
+
 namespace surroundd::daemon {
 namespace {
 
@@ -17,7 +19,7 @@ std::filesystem::path resolved(const std::filesystem::path& path) {
   return ec ? std::filesystem::absolute(path).lexically_normal() : canonical;
 }
 
-bool isSegmented(const OutputConfig& o) { return o.kind == OutputKind::kVideo && o.segmentS > 0; }
+OutputPathUse pathUse(const OutputConfig& o) { return outputTypeOf(o).pathUse(o); }
 
 // Whether `file`'s name is one of segmented output `o`'s: <stem>-<digits><ext> beside it.
 bool isSegmentOf(const std::filesystem::path& file, const OutputConfig& o) {
@@ -63,11 +65,11 @@ std::optional<std::string> outputFileClash(const OutputConfig& a, const OutputCo
   }
   for (const auto& [one, other, p1, p2] :
        {std::tuple{&a, &b, pa, pb}, std::tuple{&b, &a, pb, pa}}) {
-    if (one->kind == OutputKind::kRecording && isInside(p2, p1)) {
+    if (pathUse(*one) == OutputPathUse::kFolder && isInside(p2, p1)) {
       return fmt::format("'{}' is inside the recording folder '{}'", other->path.string(),
                          one->path.string());
     }
-    if (isSegmented(*one) && isSegmentOf(p2, *one)) {
+    if (pathUse(*one) == OutputPathUse::kSegments && isSegmentOf(p2, *one)) {
       return fmt::format("'{}' would be named like the segments of '{}'", other->path.string(),
                          one->path.string());
     }
@@ -76,11 +78,12 @@ std::optional<std::string> outputFileClash(const OutputConfig& a, const OutputCo
 }
 
 std::filesystem::path unusedOutputPath(const OutputConfig& output) {
-  const bool keepsData = (output.kind == OutputKind::kVideo && output.segmentS <= 0) ||
-                         output.kind == OutputKind::kRecording;
+  const OutputPathUse use = pathUse(output);
+  const bool keepsData = use == OutputPathUse::kKept || use == OutputPathUse::kFolder;
   if (!keepsData || output.path.empty()) return output.path;
+  // A kept file is written as <path>.part and renamed: a killed run's .part holds data too.
   const auto taken = [&](const std::filesystem::path& p) {
-    return holdsData(p) || (output.kind == OutputKind::kVideo && holdsData(withPart(p)));
+    return holdsData(p) || (use == OutputPathUse::kKept && holdsData(withPart(p)));
   };
   std::filesystem::path candidate = output.path;
   for (int n = 1; taken(candidate); ++n) {

@@ -3,7 +3,8 @@
 //
 //  - Two outputs of one config never write the same file: not by the same path, not through a
 //    symlink, not a plain video named like another output's segments, not inside a recording's
-//    folder. outputFileClash() says which; the config loader refuses such a config (so does
+//    folder. What each output's path is comes from its type (OutputPathUse, output_type.hpp).
+//    outputFileClash() says which; the config loader refuses such a config (so does
 //    --check-config).
 //  - A run never overwrites what an earlier one wrote: where a video's file, the .part file a
 //    killed run left (its frames can still be recovered), or a recording's folder already holds

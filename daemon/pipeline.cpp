@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include "daemon/output_files.hpp"
+#include "daemon/output_type.hpp"
 #include "daemon/panorama_setup.hpp"
 #include "daemon/pipeline_ends.hpp"
 
@@ -60,10 +61,10 @@ Pipeline::Pipeline(const Config& config)
                    path.string());
       output.path = std::move(path);
     }
-    if (output.kind == OutputKind::kRecording) {
-      recorders_.push_back(std::make_unique<RigRecorder>(
-          RecordingSettings{output.path, output.lossless, output.crf, output.preset},
-          config.cameras, nominalFps));
+    const OutputType& type = outputTypeOf(output);
+    if (type.input == OutputInput::kCameraFrames) {
+      recorders_.push_back(
+          type.openCameraFramesSink(output, {{}, nominalFps, latestWins_, &config.cameras}));
       continue;
     }
     Output out;
@@ -128,8 +129,11 @@ Pipeline::~Pipeline() = default;
 
 void Pipeline::setView(ViewKind view) {
   for (auto& output : outputs_) {
-    if (output.view) output.view->setView(view);
-    if (output.http != nullptr && output.view) output.http->setActiveView(toString(view));
+    if (!output.view) continue;
+    output.view->setView(view);
+    if (render::ViewPage* page = output.sink ? output.sink->page() : nullptr) {
+      page->setActiveView(toString(view));
+    }
   }
 }
 
@@ -289,7 +293,6 @@ void Pipeline::guarded(Output& output, Step&& step) {
     step();
   } catch (const std::exception& e) {
     output.sink.reset();
-    output.http = nullptr;
     output.retryDelay = kFirstOutputRetry;
     output.nextRetry = Clock::now() + output.retryDelay;
     spdlog::error("output failed, dropping it: {}; trying it again in {} s", e.what(),
@@ -301,13 +304,8 @@ void Pipeline::guarded(Output& output, Step&& step) {
 void Pipeline::open(Output& output) {
   // Where the failed try left data, this one writes the next name.
   output.config.path = unusedOutputPath(output.config);
-  if (output.config.kind == OutputKind::kHttp) {
-    auto http = openHttp(output.config, *output.config.view);
-    output.http = http.get();
-    output.sink = std::move(http);
-  } else {
-    output.sink = openSink(output.config, output.size, output.nominalFps, latestWins_);
-  }
+  output.sink = outputTypeOf(output.config)
+                    .openPictureSink(output.config, {output.size, output.nominalFps, latestWins_});
 }
 
 void Pipeline::retryOutputs(Clock::time_point now) {
@@ -368,7 +366,7 @@ void Pipeline::process(const capture::FrameSet& set) {
       recorder.reset();
     }
   }
-  std::array<const cv::Mat*, capture::kMaxCameras> images{};
+  std::array<const cv::Mat*, kMaxCameras> images{};
   for (std::size_t c = 0; c < set.cameraCount; ++c) {
     images[c] = set.frame(c) != nullptr ? &set.frame(c)->image : nullptr;
   }
@@ -440,13 +438,14 @@ void Pipeline::followPages(Clock::time_point now) {
   if (statusDue) nextPageStatus_ = now + kPageStatusInterval;
   std::string status;
   for (auto& output : outputs_) {
-    if (output.http == nullptr || !output.sink) continue;
-    if (const auto name = output.http->takeViewRequest(); name && output.view) {
+    render::ViewPage* page = output.sink ? output.sink->page() : nullptr;
+    if (page == nullptr) continue;
+    if (const auto name = page->takeViewRequest(); name && output.view) {
       if (const auto view = render::parseViewKind(*name)) output.view->setView(*view);
     }
     if (statusDue) {
       if (status.empty()) status = statusJson(report());
-      output.http->setStatus(status);
+      page->setStatus(status);
     }
   }
 }

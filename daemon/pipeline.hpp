@@ -9,7 +9,8 @@
 //             that constructs the pipeline, which must be the one that runs it). A view's read-back
 //             is collected while the next frame set is stitched, so its output gets each picture
 //             one frame set later;
-//   encode    one thread per video output (QueuedSink), 3 pictures deep.
+//   outputs   one thread per output that may block (QueuedSink): a video encoder (3 pictures
+//             deep), an HTTP page's JPEG encoder, a window, a display's page flips (1 deep each).
 // Live, only the newest complete set is processed (latest wins: an
 // older one waiting is counted as stale and dropped, and so is the oldest picture an encoder has
 // not taken yet); a replay processes every set and waits for its slowest output.
@@ -30,17 +31,17 @@
 #include "capture/camera_health.hpp"
 #include "capture/camera_stream.hpp"
 #include "capture/synchronizer.hpp"
+#include "common/camera_limit.hpp"
 #include "common/work_pool.hpp"
+#include "daemon/camera_frames_sink.hpp"
 #include "daemon/config.hpp"
 #include "daemon/pipeline_report.hpp"
-#include "daemon/rig_recorder.hpp"
 #include "processing/gain_compensation.hpp"
 #include "processing/panorama_ownership.hpp"
 #include "processing/poisson_correction.hpp"
 #include "processing/stitcher.hpp"
 #include "render/egl_context.hpp"
 #include "render/frame_sink.hpp"
-#include "render/http_stream_sink.hpp"
 #include "render/mosaic.hpp"
 #include "render/surround_scene.hpp"
 #include "render/surround_view.hpp"
@@ -126,7 +127,6 @@ class Pipeline {
     std::chrono::nanoseconds pendingTime{0};     // stream time of the view's pending picture
     Clock::time_point pendingOrigin{};           // capture time of the pending picture's set
     cv::Mat latest;                              // header over the picture last handed over
-    render::HttpStreamSink* http = nullptr;      // an HTTP output's sink (owned by `sink`)
   };
 
   void fillNeeds(const std::atomic<bool>& stop);
@@ -137,7 +137,7 @@ class Pipeline {
   void handOver(Output& output, const cv::Mat& picture, std::chrono::nanoseconds streamTime,
                 Clock::time_point origin);
   void followHealth(const capture::FrameSet& set);
-  // HTTP outputs: the views their pages asked for, and their status once a second.
+  // Outputs with a page (FrameSink::page()): the views asked for, and the status once a second.
   void followPages(Clock::time_point now);
   void open(Output& output);  // throws what the sink's constructor throws
   void retryOutputs(Clock::time_point now);
@@ -160,7 +160,7 @@ class Pipeline {
   bool latestWins_;  // stale sets are skipped, encoders drop their oldest picture
   capture::Timestamp lateAfter_;
   capture::CameraHealthMonitor health_;
-  std::array<const char*, capture::kMaxCameras> faults_{};  // per camera: what is wrong, or null
+  std::array<const char*, kMaxCameras> faults_{};  // per camera: what is wrong, or null
   std::vector<capture::HealthChange> healthChanges_;
   WorkPool pool_;
   render::Mosaic mosaic_;
@@ -179,7 +179,7 @@ class Pipeline {
   std::unique_ptr<render::SurroundScene> scene_;
   std::size_t splitCamera_ = 0;
   std::vector<Output> outputs_;
-  std::vector<std::unique_ptr<RigRecorder>> recorders_;               // null once failed
+  std::vector<std::unique_ptr<CameraFramesSink>> recorders_;          // null once failed
   std::array<std::chrono::nanoseconds, kStageCount> stageTime_{};     // summed over the run
   std::array<std::chrono::nanoseconds, kStageCount> setStageTime_{};  // this set's
   std::bitset<kStageCount> setStagesRun_;

@@ -5,19 +5,8 @@
 #include "capture/file_source.hpp"
 #include "capture/libcamera_source.hpp"
 #include "capture/v4l2_source.hpp"
-#include "daemon/output_files.hpp"
-#include "render/drm_display_sink.hpp"
-#include "render/queued_sink.hpp"
-#include "render/x11_window_sink.hpp"
 
 namespace surroundd::daemon {
-namespace {
-
-// Pictures that may wait for an encoder: enough to ride out a slow frame, few enough that a live
-// view stays current.
-constexpr std::size_t kEncoderQueue = 3;
-
-}  // namespace
 
 std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& config) {
   // Each camera's queue, plus one frame waiting in the synchronizer and one being composed.
@@ -27,17 +16,14 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
     const auto& name = camera.calibration.name;
     std::unique_ptr<capture::FrameSource> source;
     std::string origin;
-    int maxConsecutiveFaults = 30;  // a replay that keeps failing ends
     if (camera.libcamera) {
       source = std::make_unique<capture::LibcameraSource>(name, *camera.libcamera);
       origin = fmt::format("libcamera {}", camera.libcamera->camera);
-      maxConsecutiveFaults = 0;
     } else if (camera.device) {
       auto device = std::make_unique<capture::V4l2Source>(name, *camera.device);
       origin = fmt::format("{} ({})", camera.device->device.string(),
                            capture::toString(device->format()));
       source = std::move(device);
-      maxConsecutiveFaults = 0;  // a live camera is reopened until it is back
     } else {
       auto settings = *camera.source;
       settings.pacing = config.capture.pacing;
@@ -55,7 +41,7 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
                  source->frameSize().height,
                  1e9 / static_cast<double>(source->nominalPeriod().count()));
     cameras.push_back(std::make_unique<capture::CameraStream>(name, std::move(source), poolFrames,
-                                                              maxConsecutiveFaults));
+                                                              config.capture.recovery));
   }
   return cameras;
 }
@@ -80,54 +66,6 @@ void setUpHealthChecks(const Config& config,
           check == FrozenCheck::kOff ? "health.frozen_check: off" : "a still picture, looped");
     }
   }
-}
-
-std::unique_ptr<render::HttpStreamSink> openHttp(const OutputConfig& output, ViewKind view) {
-  render::HttpStreamSettings settings;
-  settings.address = output.listenAddress;
-  settings.port = output.listenPort;
-  settings.jpegQuality = output.jpegQuality;
-  settings.allowedHosts = output.allowedHosts;
-  if (output.stream == OutputStream::kSurround) {
-    for (const ViewKind kind : render::kViewKinds) settings.views.emplace_back(toString(kind));
-    settings.initialView = toString(view);
-  }
-  auto sink = std::make_unique<render::HttpStreamSink>(std::move(settings));
-  spdlog::info("HTTP stream: http://{}:{}/", output.listenAddress, sink->port());
-  return sink;
-}
-
-std::unique_ptr<render::FrameSink> openSink(const OutputConfig& output, cv::Size videoSize,
-                                            double nominalFps, bool latestWins) {
-  if (output.kind == OutputKind::kWindow) {
-    return std::make_unique<render::X11WindowSink>(
-        render::X11WindowSettings{output.display, output.title, videoSize});
-  }
-  if (output.kind == OutputKind::kDisplay) {
-    return std::make_unique<render::DrmDisplaySink>(
-        render::DrmDisplaySettings{output.device, output.connector});
-  }
-  if (output.path.has_parent_path()) createOutputFolder(output.path.parent_path(), output.path);
-  if (output.kind == OutputKind::kSnapshot) {
-    return std::make_unique<render::SnapshotSink>(
-        output.path, std::chrono::duration_cast<std::chrono::nanoseconds>(
-                         std::chrono::duration<double>(output.atSeconds)));
-  }
-  render::VideoEncoderSettings settings;
-  settings.path = output.path;
-  settings.size = videoSize;
-  settings.nominalFps = nominalFps;
-  settings.crf = output.crf;
-  settings.preset = output.preset;
-  settings.pixelFormat = output.pixelFormat;
-  settings.url = output.url;
-  auto video = std::make_unique<render::VideoSink>(
-      std::move(settings), std::chrono::duration_cast<std::chrono::nanoseconds>(
-                               std::chrono::duration<double>(output.segmentS)));
-  // Encoding runs beside the next frame set's stitching; live, the newest picture wins.
-  return std::make_unique<render::QueuedSink>(
-      std::move(video), videoSize, kEncoderQueue,
-      latestWins ? render::QueuedSink::WhenFull::kDropOldest : render::QueuedSink::WhenFull::kWait);
 }
 
 }  // namespace surroundd::daemon

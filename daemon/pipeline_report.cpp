@@ -132,8 +132,11 @@ std::string prometheusText(const PipelineReport& report) {
   };
   perCamera("camera_frames_total", "counter", "Frames each camera delivered.",
             [&](std::size_t c) { return report.cameras[c].stats.frames; });
-  perCamera("camera_faults_total", "counter", "Failed reads of each camera.",
+  perCamera("camera_faults_total", "counter",
+            "Faults of each camera: failed reads, frames with decode errors, failed reopenings.",
             [&](std::size_t c) { return report.cameras[c].stats.faults; });
+  perCamera("camera_reopens_total", "counter", "Times each camera's lost device was reopened.",
+            [&](std::size_t c) { return report.cameras[c].stats.reopens; });
   perCamera("camera_queue_depth", "gauge", "Frames waiting between a camera and the synchronizer.",
             [&](std::size_t c) { return report.cameras[c].queued; });
   perCamera("camera_sync_dropped_total", "counter",

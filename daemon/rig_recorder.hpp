@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "capture/frame_set.hpp"
+#include "daemon/camera_frames_sink.hpp"
 #include "daemon/rig_yaml.hpp"
 #include "render/video_encoder.hpp"
 
@@ -28,16 +29,16 @@ struct RecordingSettings {
   std::string preset = "veryfast";
 };
 
-class RigRecorder {
+class RigRecorder final : public CameraFramesSink {
  public:
   RigRecorder(RecordingSettings settings, std::vector<RigCamera> rig, double nominalFps);
 
   // Writes each camera's frame of the set (an empty slot writes nothing for that camera).
-  void record(const capture::FrameSet& set);
+  void record(const capture::FrameSet& set) override;
   // Finalizes the videos and writes rig.yaml. Cameras that recorded nothing are left out of it
   // (with a note in the rig file's header).
-  void finish();
-  std::string describe() const;
+  void finish() override;
+  std::string describe() const override;
 
  private:
   RecordingSettings settings_;

@@ -12,6 +12,8 @@
 #include <fmt/format.h>
 
 #include "capture/sequence_pattern.hpp"
+#include "common/camera_limit.hpp"
+#include "processing/camera_model.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -109,6 +111,11 @@ capture::V4l2Settings readDevice(YamlObject& source) {
 capture::LibcameraSettings readLibcamera(YamlObject& source) {
   capture::LibcameraSettings settings;
   settings.camera = source.string("libcamera", "");
+  if (!capture::libcameraAvailable()) {
+    source.error("libcamera",
+                 "this surroundd is built without libcamera cameras: configure with "
+                 "-DSURROUNDD_WITH_LIBCAMERA=ON (needs libcamera-dev)");
+  }
   settings.fps = source.number("fps", settings.fps, {1.0, 1000.0, false, "frames per second"});
   settings.buffers = source.integer("buffers", settings.buffers, 2, 32);
   settings.timeout = std::chrono::milliseconds(source.integer("timeout_ms", 500, 20, 60'000));
@@ -145,7 +152,53 @@ void readOcam(YamlObject& lens, processing::Intrinsics& in) {
   }
 }
 
-processing::Intrinsics readLens(YamlObject& lens) {
+// The largest distortion coefficient taken. Radial terms multiply powers of the normalized radius
+// (about 1 at a wide lens's picture edge), so a coefficient of 1000 already moves the edge by three
+// orders of magnitude: real calibrations stay far below (OpenCV's k3 of a wide lens: tens at most).
+constexpr double kMaxDistortion = 1000;
+// At the picture's edge, the distortion may widen or narrow the lens's field by at most this
+// factor against the same lens without it (a 220-degree fisheye against its pinhole: under 2).
+constexpr double kMaxFieldChange = 4;
+
+// Distortion that no lens has, which would otherwise pass --check-config and fail at start (the
+// camera seeing a pinpoint, or nothing): each coefficient finite and within kMaxDistortion, and the
+// picture's left and right edges at an off-axis angle near the undistorted lens's.
+void checkDistortion(YamlObject& lens, std::string_view camera, const processing::Intrinsics& in) {
+  const bool fisheye = in.model == LensModel::kFisheye;
+  constexpr std::array<const char*, 5> kPinholeNames{"k1", "k2", "p1", "p2", "k3"};
+  constexpr std::array<const char*, 4> kFisheyeNames{"k1", "k2", "k3", "k4"};
+  for (std::size_t i = 0; i < (fisheye ? 4U : 5U); ++i) {
+    const double k = in.distortion[i];
+    if (!(std::abs(k) <= kMaxDistortion)) {
+      lens.error("distortion",
+                 fmt::format("camera '{}': {} = {:g} is no lens's distortion (expected within "
+                             "-{:g} to {:g})",
+                             camera, fisheye ? kFisheyeNames[i] : kPinholeNames[i], k,
+                             kMaxDistortion, kMaxDistortion));
+      return;
+    }
+  }
+  const processing::CameraModel model(in);
+  for (const double x : {-0.5, in.imageSize.width - 0.5}) {
+    const cv::Point2d edge(x, in.cy);
+    const auto ray = model.unproject(edge);
+    if (!ray) continue;  // beyond where the polynomial turns: lensFieldCutWarning says so
+    const double angle = std::acos(std::clamp((*ray)[2] / cv::norm(*ray), -1.0, 1.0));
+    const double undistorted = std::atan(std::abs(x - in.cx) / in.fx);
+    if (undistorted < 1e-6) continue;
+    if (!(angle <= undistorted * kMaxFieldChange && angle * kMaxFieldChange >= undistorted)) {
+      constexpr double kRadToDeg = 180 / std::numbers::pi;
+      lens.error("distortion",
+                 fmt::format("camera '{}': with this distortion the picture's edge is {:.3g} "
+                             "degrees off axis, where the lens without it sees {:.3g}; no lens "
+                             "distorts that much (check the calibration's units and order)",
+                             camera, angle * kRadToDeg, undistorted * kRadToDeg));
+      return;
+    }
+  }
+}
+
+processing::Intrinsics readLens(YamlObject& lens, std::string_view camera) {
   processing::Intrinsics in;
   in.model = lens.choice("model", LensModel::kPinhole,
                          {{"pinhole", LensModel::kPinhole},
@@ -177,7 +230,10 @@ processing::Intrinsics readLens(YamlObject& lens) {
   } else {
     const auto distortion =
         fisheye ? lens.numbers("distortion", {4}) : lens.numbers("distortion", {4, 5});
-    if (distortion) std::copy(distortion->begin(), distortion->end(), in.distortion.begin());
+    if (distortion) {
+      std::copy(distortion->begin(), distortion->end(), in.distortion.begin());
+      if (in.fx > 0 && in.imageSize.width > 0) checkDistortion(lens, camera, in);
+    }
     for (const auto key : {"affine", "world_to_image", "image_to_world"}) {
       if (lens.has(key)) lens.error(key, "only an ocam lens takes this key");
     }
@@ -241,7 +297,7 @@ processing::ColourRole defaultRole(const processing::Pose& pose) {
 std::vector<RigCamera> readRigCameras(YamlObject& rig) {
   std::vector<RigCamera> cameras;
   std::set<std::string, std::less<>> names;
-  for (auto& entry : rig.objectList("cameras", 1, 8)) {
+  for (auto& entry : rig.objectList("cameras", 1, kMaxCameras)) {
     RigCamera camera;
     auto& calibration = camera.calibration;
     calibration.name = entry.requiredString("name").value_or("");
@@ -257,7 +313,7 @@ std::vector<RigCamera> readRigCameras(YamlObject& rig) {
                                       calibration.name));
     }
     if (auto lens = entry.object("lens")) {
-      calibration.intrinsics = readLens(*lens);
+      calibration.intrinsics = readLens(*lens, calibration.name);
     } else {
       entry.errorHere("missing key 'lens' (model, size and intrinsics)");
     }

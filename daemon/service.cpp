@@ -4,6 +4,7 @@
 #include <chrono>
 #include <thread>
 
+#include <malloc.h>
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
@@ -37,6 +38,23 @@ void logSummary(const RunSummary& summary) {
         summary.sync.lateMissing[c]);
   }
   for (const auto& output : summary.outputs) spdlog::info("wrote {}", output);
+}
+
+// A run allocates its frame pools, look-up table, panorama, meshes and encoder buffers afresh (a
+// few hundred MB for four 1280x720 cameras) from the threads it starts, and frees them when it
+// ends. glibc keeps what a thread frees in that thread's arena for later allocations there, and
+// raises its mmap threshold each time a large mapped block is freed, so the next run's large
+// buffers come from the arenas instead of fresh mappings — while its new threads land on other
+// arenas and allocate again. What stayed between runs grew with each reload (272, 340, 348, 360,
+// 362 MB over the first five reloads of the soak, scripts/soak.sh; ~100 MB over ~30 reloads in
+// issue 18.10) until every arena held enough. A reload is rare and costs a pipeline start anyway:
+// hand what the finished run freed back to the system there, once.
+void releaseFreedMemory() {
+  const auto start = std::chrono::steady_clock::now();
+  const int released = malloc_trim(0);
+  spdlog::debug(
+      "memory: freed memory {}returned to the system in {:.1f} ms", released != 0 ? "" : "(none) ",
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
 }
 
 }  // namespace
@@ -73,6 +91,7 @@ int Service::run() {
     endRun_ = false;
     const RunSummary summary = pipeline->run(endRun_, this);
     pipeline.reset();
+    releaseFreedMemory();
     logSummary(summary);
     if (summary.rebuild && !signals_.stop) {
       // The same config again, after a pause that grows while rebuilds keep failing.

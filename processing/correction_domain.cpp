@@ -4,6 +4,8 @@
 #include <cmath>
 #include <deque>
 #include <map>
+#include <numbers>
+#include <optional>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -18,6 +20,10 @@ constexpr double kMinimumSeenShare = 0.25;
 constexpr int kFillReach = 2;
 // A bowl point this low is on its floor (the wall starts at height 0 and rises).
 constexpr double kFloorHeightM = 1e-6;
+// Ground seam data past the floor comes from rays at least this far below the horizon: nearer it
+// the ground is too far away for a calibration's last tenth of a degree, and the horizon's
+// objects and sky take over.
+constexpr double kHorizonMarginRad = 1.0 * std::numbers::pi / 180;
 
 struct BlockGrid {
   cv::Size size;
@@ -110,27 +116,46 @@ CorrectionDomain buildCorrectionDomain(const Rig& rig, const PanoramaSettings& s
   }
 
   const PanoramaProjector projector(rig, settings);
-  const bool floorOnly = groundSeams && settings.projection == PanoramaProjection::kBowl;
-  // The pixels of block q that cameras `target` and `source` both see, as sample taps.
-  const auto seamSamples = [&](int q, std::uint8_t target, std::uint8_t source) {
+  const bool groundOnly = groundSeams && settings.projection == PanoramaProjection::kBowl;
+  const cv::Vec3d& centre = settings.geometry.centre;
+  // The pixels of block q that cameras `target` and `source` both see, as sample taps. Ground
+  // only: the floor's pixels as the bowl puts them, and past the floor the ground itself where
+  // the pixel's ray meets it (the wall stands for that ground, but each camera sees the wall's
+  // point on a different piece of it). `beyondFloor`: most samples came from past the floor.
+  const auto seamSamples = [&](int q, std::uint8_t target, std::uint8_t source, bool& beyondFloor) {
     const std::uint32_t first = static_cast<std::uint32_t>(domain.samples.size());
     const int u0 = (q % domain.grid.width) * block;
     const int v0 = (q / domain.grid.width) * block;
+    std::size_t pastFloor = 0;
     for (int v = v0; v < v0 + block; ++v) {
       for (int u = u0; u < u0 + block; ++u) {
         const cv::Point2d pixel(u, v);
-        if (floorOnly && projector.surfacePoint(pixel)[2] > kFloorHeightM) continue;
-        const auto t = projector.cameraPixel(target, pixel);
-        const auto s = projector.cameraPixel(source, pixel);
+        std::optional<cv::Point2d> t;
+        std::optional<cv::Point2d> s;
+        if (groundOnly) {
+          const cv::Vec3d direction = settings.geometry.direction(pixel);
+          if (direction[2] > -std::sin(kHorizonMarginRad)) continue;
+          cv::Vec3d point = projector.surfacePoint(pixel);
+          const bool past = point[2] > kFloorHeightM;
+          if (past) point = centre + direction * (-centre[2] / direction[2]);
+          t = projector.cameraPixelOf(target, point);
+          s = projector.cameraPixelOf(source, point);
+          if (t && s && past) ++pastFloor;
+        } else {
+          t = projector.cameraPixel(target, pixel);
+          s = projector.cameraPixel(source, pixel);
+        }
         if (!t || !s) continue;
         domain.samples.push_back({encodeTap(*t, lut.cameraSizes[target], target),
                                   encodeTap(*s, lut.cameraSizes[source], source)});
       }
     }
-    if (static_cast<double>(domain.samples.size() - first) < kMinimumSeenShare * block * block) {
+    const std::size_t count = domain.samples.size() - first;
+    if (static_cast<double>(count) < kMinimumSeenShare * block * block) {
       domain.samples.resize(first);
       return false;
     }
+    beyondFloor = 2 * pastFloor > count;
     return true;
   };
 
@@ -182,11 +207,14 @@ CorrectionDomain buildCorrectionDomain(const Rig& rig, const PanoramaSettings& s
         auto found = dirichletOfBlock.find(q);
         if (found == dirichletOfBlock.end()) {
           const auto first = static_cast<std::uint32_t>(domain.samples.size());
-          if (!seamSamples(q, across, region.source)) continue;  // Neumann: too little overlap
+          bool beyondFloor = false;
+          if (!seamSamples(q, across, region.source, beyondFloor)) {
+            continue;  // Neumann: too little overlap
+          }
           found = dirichletOfBlock.emplace(q, static_cast<std::uint32_t>(region.dirichlet.size()))
                       .first;
           region.dirichlet.push_back(
-              {q, across, first, static_cast<std::uint32_t>(domain.samples.size())});
+              {q, across, first, static_cast<std::uint32_t>(domain.samples.size()), beyondFloor});
         }
         ++degree;
         region.dirichletOf.push_back(found->second);

@@ -7,11 +7,14 @@
 // target camera owns, and that the source camera sees too, is a Dirichlet block: its value comes
 // from the block's pixels that both cameras see, sampled through taps built here. Only pixels that
 // neither camera's body mask hides take part (the projector leaves those out) and, with
-// `groundSeams` on a bowl, only pixels on its floor: on a real rig the wall part of a seam sees
-// different things from the two cameras (parallax), the ground the same. Every other border is
-// Neumann. A region with no Dirichlet block cannot be corrected (nothing to match) and is left
-// out, with a note saying so. The Dirichlet blocks a region shares with one target camera form a
-// seam, listed along its length for the robust statistics of poisson_correction.hpp.
+// `groundSeams` on a bowl, only the ground: on a real rig the wall part of a seam sees different
+// things from the two cameras (parallax), the ground the same. So a pixel on the floor is sampled
+// where the bowl puts it, and a pixel on the wall whose ray points at least 1 degree below the
+// horizon is sampled where that ray meets the ground (the far ground, its own band: Dirichlet
+// blocks marked `beyondFloor`); pixels nearer the horizon or above it give no seam data. Every
+// other border is Neumann. A region with no Dirichlet block cannot be corrected (nothing to match)
+// and is left out, with a note saying so. The Dirichlet blocks a region shares with one target
+// camera form a seam, listed along its length for the robust statistics of poisson_correction.hpp.
 //
 // For applying the fields: `share` gives each panorama pixel the weight of source cameras in it
 // (1 inside a source region, the blend weight in the seam bands), and `fillFrom` says which field
@@ -39,6 +42,7 @@ struct DirichletBlock {
   int block = 0;                                 // index in the block grid
   std::uint8_t target = 0;                       // the camera across the seam
   std::uint32_t firstSample = 0, endSample = 0;  // range in CorrectionDomain::samples
+  bool beyondFloor = false;  // ground seam data from past the bowl's floor (the far ground)
 };
 
 struct CorrectionRegion {

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "common/camera_limit.hpp"
 #include "common/work_pool.hpp"
 
 namespace surroundd::processing {
@@ -119,10 +120,19 @@ cv::Vec3d PanoramaProjector::surfacePoint(const cv::Point2d& panoramaPixel) cons
 std::optional<cv::Point2d> PanoramaProjector::cameraPixel(std::size_t camera,
                                                           const cv::Point2d& panoramaPixel) const {
   const Pose& pose = poses_[camera];
-  const cv::Vec3d pointCamera =
-      settings_.projection == PanoramaProjection::kSphere
-          ? pose.rotation.t() * settings_.geometry.direction(panoramaPixel)
-          : pose.toCamera(surfacePoint(panoramaPixel));
+  if (settings_.projection != PanoramaProjection::kSphere) {
+    return cameraPixelOf(camera, surfacePoint(panoramaPixel));
+  }
+  return visiblePixel(camera, pose.rotation.t() * settings_.geometry.direction(panoramaPixel));
+}
+
+std::optional<cv::Point2d> PanoramaProjector::cameraPixelOf(std::size_t camera,
+                                                            const cv::Vec3d& point) const {
+  return visiblePixel(camera, poses_[camera].toCamera(point));
+}
+
+std::optional<cv::Point2d> PanoramaProjector::visiblePixel(std::size_t camera,
+                                                           const cv::Vec3d& pointCamera) const {
   const auto pixel = models_[camera].project(pointCamera);
   const cv::Size size = models_[camera].intrinsics().imageSize;
   if (!pixel || pixel->x < 0 || pixel->y < 0 || pixel->x > size.width - 1 ||
@@ -139,9 +149,11 @@ std::optional<cv::Point2d> PanoramaProjector::cameraPixel(std::size_t camera,
 
 PanoramaLut buildPanoramaLut(const Rig& rig, const PanoramaSettings& settings, WorkPool& pool,
                              const LutProgress& progress) {
-  if (rig.cameras.empty() || rig.cameras.size() >= PanoramaLut::kUnseen) {
+  // A tap's camera is a byte beside kUnseen; every camera a rig may have fits it.
+  static_assert(kMaxCameras < PanoramaLut::kUnseen);
+  if (rig.cameras.empty() || rig.cameras.size() > kMaxCameras) {
     throw std::invalid_argument(
-        fmt::format("a panorama needs 1 to 254 cameras, not {}", rig.cameras.size()));
+        fmt::format("a panorama needs 1 to {} cameras, not {}", kMaxCameras, rig.cameras.size()));
   }
   const PanoramaProjector projector(rig, settings);
   const std::vector<ColumnPlan> columns = planColumns(projector);

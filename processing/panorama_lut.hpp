@@ -100,6 +100,8 @@ class PanoramaProjector {
   // (the camera's body mask, grown by kBodyMargin pixels so that no bilinear tap reaches it).
   std::optional<cv::Point2d> cameraPixel(std::size_t camera,
                                          const cv::Point2d& panoramaPixel) const;
+  // The same for a point in the vehicle frame (bowl projection only).
+  std::optional<cv::Point2d> cameraPixelOf(std::size_t camera, const cv::Vec3d& point) const;
   // The vehicle-frame point a panorama pixel stands for: on the bowl, or (sphere) one metre from
   // the centre.
   cv::Vec3d surfacePoint(const cv::Point2d& panoramaPixel) const;
@@ -109,6 +111,9 @@ class PanoramaProjector {
   const PanoramaSettings& settings() const { return settings_; }
 
  private:
+  // Where camera `camera` sees a camera-frame point, as cameraPixel() says.
+  std::optional<cv::Point2d> visiblePixel(std::size_t camera, const cv::Vec3d& pointCamera) const;
+
   PanoramaSettings settings_;
   static constexpr int kBodyMargin = 2;
   std::vector<CameraModel> models_;
@@ -121,7 +126,8 @@ class PanoramaProjector {
 using LutProgress = std::function<void(double)>;
 
 // Builds the LUT row-parallel on `pool`. Throws RigError naming a camera that sees none of the
-// panorama, and std::invalid_argument for a rig of more than 254 cameras.
+// panorama, and std::invalid_argument for a rig of more than kMaxCameras
+// (common/camera_limit.hpp).
 PanoramaLut buildPanoramaLut(const Rig& rig, const PanoramaSettings& settings, WorkPool& pool,
                              const LutProgress& progress = {});
 

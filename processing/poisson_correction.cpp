@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 #include <fmt/format.h>
 
+#include "common/camera_limit.hpp"
 #include "common/work_pool.hpp"
 #include "processing/poisson_correction_state.hpp"
 
@@ -76,11 +78,15 @@ const std::vector<std::string>& PoissonColourCorrection::notes() const {
 
 const CorrectionDomain& PoissonColourCorrection::domain() const { return active_->domain; }
 
+// Which cameras are present is a bitmask (configurationFor's key); the rig's LUT holds at most
+// kMaxCameras (buildPanoramaLut), so every camera has its bit.
+static_assert(kMaxCameras <= 32, "a std::uint32_t camera bitmask holds every camera");
+
 PoissonColourCorrection::Configuration& PoissonColourCorrection::configurationFor(
     std::uint32_t presentCameras) {
   auto& configuration = configurations_[presentCameras];
   if (configuration) return *configuration;
-  std::array<bool, 32> present{};
+  std::array<bool, kMaxCameras> present{};
   for (std::size_t c = 0; c < rig_.cameras.size(); ++c) present[c] = (presentCameras >> c) & 1U;
   configuration = std::make_unique<Configuration>();
   configuration->domain =
@@ -99,6 +105,7 @@ PoissonColourCorrection::Configuration& PoissonColourCorrection::configurationFo
     state.dirichlet.assign(blocks * 3, 0.0f);
     state.rhs.assign(region.system.unknowns() * 3, 0.0f);
     state.solution.assign(region.system.unknowns() * 3, 0.0f);
+    state.otherSolution.assign(region.system.unknowns() * 3, 0.0f);
     configuration->regions.push_back(std::move(state));
   }
   configuration->slots.assign(configuration->domain.slots * 3, 0.0f);
@@ -173,11 +180,28 @@ int PoissonColourCorrection::update(std::span<const cv::Mat> frames) {
   followLostCameras(frames);
   gatherSeams(frames);
   Configuration& active = *active_;
-  for (auto& state : active.regions) state.iterations = 0;
-  solveRegions({});
-  if (dropWorseningSeams()) {
-    solveRegions(std::span(resolve_.data(), active.regions.size()));
+  for (auto& state : active.regions) {
+    state.iterations = 0;
+    // Solved twice last frame: `solution` holds the field without the dropped data, and the
+    // field with all of it, the warm start of the first solve, waits in `otherSolution`.
+    if (state.solvedTwice) std::swap(state.solution, state.otherSolution);
   }
+  solveRegions({});
+  const bool dropped = dropWorseningSeams();
+  for (std::size_t r = 0; r < active.regions.size(); ++r) {
+    RegionState& state = active.regions[r];
+    const bool twice = dropped && resolve_[r] != 0;
+    if (twice) {
+      // The second solve starts from last frame's second solve, if there was one.
+      if (state.solvedTwice) {
+        std::swap(state.solution, state.otherSolution);
+      } else {
+        state.otherSolution = state.solution;  // same size: no allocation
+      }
+    }
+    state.solvedTwice = twice;
+  }
+  if (dropped) solveRegions(std::span(resolve_.data(), active.regions.size()));
 
   int iterations = 0;
   for (std::size_t r = 0; r < active.regions.size(); ++r) {

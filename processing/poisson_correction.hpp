@@ -11,7 +11,8 @@
 // distance from that mean.
 //
 // On real rigs the seam data is made robust (seam_statistics.hpp: trimmed means of usable samples,
-// filtered along each seam, from the ground and never from the vehicle's body), the field is
+// filtered along each seam, from the ground and never from the vehicle's body; the far ground,
+// past the bowl's floor, as one band with its own median: correction_domain.hpp), the field is
 // bounded to gains in [minGain, maxGain], and one rule stands above the rest: correction never
 // makes a seam worse than none. After each solve, every seam's step (its typical block's: the
 // target's levels against the source's as the field next to the seam leaves them) is compared
@@ -117,6 +118,9 @@ class PoissonColourCorrection {
   Configuration& configurationFor(std::uint32_t presentCameras);
   void followLostCameras(std::span<const cv::Mat> frames);
   void gatherSeams(std::span<const cv::Mat> frames);
+  // Gives the seam's blocks past the bowl's floor one value, their median (of each channel).
+  void farGroundAsOneBand(const CorrectionRegion& region, const CorrectionSeam& seam,
+                          RegionState& state);
   void solveRegions(std::span<const std::uint8_t> which);
   // Drops the data of seams the solved field makes worse; true when any was dropped.
   bool dropWorseningSeams();

@@ -26,6 +26,12 @@ struct PoissonColourCorrection::RegionState {
   std::vector<float> dirichlet;
   std::vector<float> rhs;
   std::vector<float> solution;  // 3 per unknown; the warm start of the next frame
+  // Where a seam's data is dropped the region is solved twice a frame, with its data and without
+  // the dropped part. Each solve warm-starts from its own kind of the frame before: `solution`
+  // and `otherSolution` swap, so that neither starts from the other's field (an iterative solver
+  // would then need most of a cold solve's iterations, twice a frame). `solvedTwice`: last frame.
+  std::vector<float> otherSolution;
+  bool solvedTwice = false;
   int iterations = 0;
 };
 

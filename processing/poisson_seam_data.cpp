@@ -2,6 +2,7 @@
 // seam worse than none (poisson_correction.hpp says what they do and why).
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -30,6 +31,13 @@ constexpr std::size_t kMinimumSegmentBlocks = 4;
 
 // A seam needs this share of its blocks measured to be matched at all; with fewer it keeps gain 1.
 constexpr double kMinimumMeasuredShare = 0.25;
+// The far ground (seam blocks past the bowl's floor) gets one value per seam, the median of its
+// measured blocks, when it has at least this many.
+constexpr std::size_t kMinimumFarBlocks = 4;
+// ... and when its median is within this of the near ground's (each channel): a factor of 1.5
+// (log), or 40 levels (additive). Light falling off towards a lens's edge differs by less.
+constexpr float kFarBandLogSpread = 0.405465f;  // log(1.5)
+constexpr float kFarBandLevelSpread = 40.0f;
 
 }  // namespace
 
@@ -38,6 +46,44 @@ void PoissonColourCorrection::noteOnce(std::vector<std::uint8_t>& said, std::siz
   if (said[seam] != 0) return;
   said[seam] = 1;
   changes_.push_back(std::move(note));
+}
+
+void PoissonColourCorrection::farGroundAsOneBand(const CorrectionRegion& region,
+                                                 const CorrectionSeam& seam, RegionState& state) {
+  // The far ground is seen near the edge of each lens, through the ground plane's last metres of
+  // calibration accuracy and past whatever stands on it: block by block its data scatter, while
+  // the cameras' light falls off smoothly there. One median over the band outvotes the scatter
+  // and still gives the far ground its own gain. Unless it is far from the near ground's: then
+  // the far ground is mostly something standing on it (a wall near the car, seen differently by
+  // the two cameras), and the near ground's median is carried out to it instead.
+  float* values = stepScratch_.data();  // free until dropWorseningSeams()
+  std::array<float, 3> far{};
+  std::array<float, 3> near{};
+  bool haveNear = true;
+  for (std::size_t c = 0; c < 3; ++c) {
+    for (const bool beyond : {true, false}) {
+      std::size_t count = 0;
+      for (const auto k : seam.blocks) {
+        if (region.dirichlet[k].beyondFloor != beyond || state.measuredValid[k] == 0) continue;
+        values[count++] = state.measured[static_cast<std::size_t>(k) * 3 + c];
+      }
+      if (beyond && count < kMinimumFarBlocks) return;  // the running median as it is
+      if (!beyond && count < kMinimumFarBlocks) haveNear = false;
+      (beyond ? far : near)[c] = count == 0 ? 0.0f : medianOf(values, count);
+    }
+  }
+  const float spread =
+      settings_.field == CorrectionField::kMultiplicative ? kFarBandLogSpread : kFarBandLevelSpread;
+  bool plausible = true;
+  for (std::size_t c = 0; c < 3; ++c) {
+    plausible = plausible && (!haveNear || std::abs(far[c] - near[c]) <= spread);
+  }
+  const std::array<float, 3>& band = plausible ? far : near;
+  for (const auto k : seam.blocks) {
+    if (!region.dirichlet[k].beyondFloor || state.filteredValid[k] == 0) continue;
+    for (std::size_t c = 0; c < 3; ++c)
+      state.filtered[static_cast<std::size_t>(k) * 3 + c] = band[c];
+  }
 }
 
 void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames) {
@@ -78,6 +124,7 @@ void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames) {
     if (frames[region.source].empty() || frames[seam.target].empty()) continue;
     medianAlongSeam(seam.blocks, state.measured, state.measuredValid, kSeamHalfWindow, window_,
                     state.filtered, state.filteredValid);
+    farGroundAsOneBand(region, seam, state);
     cv::Vec3f sourceLevel(0, 0, 0);
     for (const auto k : seam.blocks) {
       if (state.measuredValid[k] == 0) continue;

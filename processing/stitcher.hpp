@@ -41,8 +41,10 @@ class Stitcher {
   WorkPool& pool_;
   // Where each camera index's pixels start this frame; index kUnseen points at a 2x2 image of the
   // unseen colour, so unseen pixels need no branch.
-  std::array<const std::uint8_t*, 256> sources_{};
-  std::array<std::size_t, 256> rowBytes_{};
+  // Indexed by a tap's camera byte as it is, kUnseen included: no bounds check per pixel.
+  static constexpr std::size_t kCameraByteValues = std::size_t{1} << (8 * sizeof(LutTap::camera));
+  std::array<const std::uint8_t*, kCameraByteValues> sources_{};
+  std::array<std::size_t, kCameraByteValues> rowBytes_{};
   cv::Mat unseen_;
   std::vector<std::pair<int, int>> seenSpans_;  // per row: [begin, end) columns to sample
 };

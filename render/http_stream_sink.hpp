@@ -54,7 +54,7 @@ struct HttpStreamSettings {
   bool operator==(const HttpStreamSettings&) const = default;
 };
 
-class HttpStreamSink final : public FrameSink {
+class HttpStreamSink final : public FrameSink, public ViewPage {
  public:
   explicit HttpStreamSink(HttpStreamSettings settings);  // listens at once
   ~HttpStreamSink() override;                            // stops the server if finish() did not
@@ -72,11 +72,12 @@ class HttpStreamSink final : public FrameSink {
   int port() const;  // the bound port (the chosen one when settings.port is 0)
   // The JSON object served as /status.json; the page shows `fps` (number), `frames` (number),
   // `cameras` ({"front": "ok", ...}) and any other key as text.
-  void setStatus(std::string json);
+  void setStatus(std::string json) override;
   // The view last asked for by POST /view, once; nullopt if none since the last call.
-  std::optional<std::string> takeViewRequest();
+  std::optional<std::string> takeViewRequest() override;
   // The view shown now, when it was switched another way (surroundctl): the page marks it.
-  void setActiveView(std::string name);
+  void setActiveView(std::string name) override;
+  ViewPage* page() override { return this; }
 
  private:
   struct Impl;

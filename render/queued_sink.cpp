@@ -92,6 +92,10 @@ std::string QueuedSink::describe() const {
              : fmt::format("{}; {} pictures dropped (output too slow)", sink_->describe(), drops);
 }
 
+bool QueuedSink::wantsFrame(std::chrono::nanoseconds streamTime) const {
+  return sink_->wantsFrame(streamTime);
+}
+
 std::uint64_t QueuedSink::dropped() const {
   const std::lock_guard lock(mutex_);
   return dropped_;

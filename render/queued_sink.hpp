@@ -8,8 +8,10 @@
 //
 // Threads: consume() and finish() are called by the pipeline thread; the wrapped sink's consume()
 // runs on the worker, its finish() and describe() on the caller after the worker has ended. The
-// queue below is all they share. A failure on the worker is rethrown by the next consume() or by
-// finish(), so the pipeline drops the output as it would any other.
+// queue below is all they share, besides the wrapped sink's wantsFrame() and page(), which are
+// asked on the caller while the worker may be in its consume() (FrameSink's contract). A failure on
+// the worker is rethrown by the next consume() or by finish(), so the pipeline drops the output as
+// it would any other.
 
 #include <condition_variable>
 #include <cstdint>
@@ -34,6 +36,9 @@ class QueuedSink final : public FrameSink {
   void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) override;
   void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) override;
   std::string describe() const override;
+  // The wrapped sink's: a picture nobody wants is neither made nor queued.
+  bool wantsFrame(std::chrono::nanoseconds streamTime) const override;
+  ViewPage* page() override { return sink_->page(); }
 
   std::uint64_t dropped() const override;
 

@@ -1,6 +1,7 @@
+#include "render/snapshot_sink.hpp"
+
 #include <fmt/format.h>
 
-#include "render/frame_sink.hpp"
 #include "render/image_file.hpp"
 
 namespace surroundd::render {

@@ -1,9 +1,9 @@
+#include "render/video_sink.hpp"
+
 #include <algorithm>
 #include <charconv>
 
 #include <fmt/format.h>
-
-#include "render/frame_sink.hpp"
 
 namespace surroundd::render {
 namespace {

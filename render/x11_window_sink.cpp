@@ -238,27 +238,42 @@ void X11WindowSink::consume(const cv::Mat& bgr, std::chrono::nanoseconds /*strea
                                   window_->displayName(), bgr.cols, bgr.rows, settings_.size.width,
                                   settings_.size.height));
   }
+  const std::lock_guard lock(xlib_);
   window_->handleEvents();
   if (window_->open() && window_->show(bgr)) ++framesShown_;
+  open_ = window_->open();
 }
 
 bool X11WindowSink::wantsFrame(std::chrono::nanoseconds /*streamTime*/) const {
   // Reading the window's events only learns what the user did; the answer is the sink's state.
-  window_->handleEvents();
-  return window_->open();
+  // While another thread shows a frame, that call reads them.
+  const std::unique_lock lock(xlib_, std::try_to_lock);
+  if (lock.owns_lock()) {
+    window_->handleEvents();
+    open_ = window_->open();
+  }
+  return open_;
 }
 
 void X11WindowSink::finish(const cv::Mat& /*lastFrame*/, std::chrono::nanoseconds /*lastTime*/) {
+  const std::lock_guard lock(xlib_);
   window_->handleEvents();
 }
 
 std::string X11WindowSink::describe() const {
+  const std::lock_guard lock(xlib_);
   return fmt::format("window on {} ({} frames{})", window_->displayName(), framesShown_,
                      window_->stopReason());
 }
 
-unsigned long X11WindowSink::windowId() const { return window_->id(); }
+unsigned long X11WindowSink::windowId() const {
+  const std::lock_guard lock(xlib_);
+  return window_->id();
+}
 
-bool X11WindowSink::sharedMemory() const { return window_->sharedMemory(); }
+bool X11WindowSink::sharedMemory() const {
+  const std::lock_guard lock(xlib_);
+  return window_->sharedMemory();
+}
 
 }  // namespace surroundd::render

@@ -14,12 +14,16 @@
 // Xlib's default of exit(1) on X errors is replaced for this sink's connection (see
 // xlib_display.hpp).
 //
-// Threading: used from the pipeline thread only. wantsFrame() handles the window's pending events
-// (close, expose) without blocking, so a window stays responsive between frames that are shown.
+// Threading: consume() and finish() from one thread at a time (the pipeline's, or a QueuedSink's);
+// wantsFrame() from any thread: it handles the window's pending events (close, expose) without
+// blocking, so a window stays responsive between frames that are shown, and leaves that to
+// consume() while one is being shown.
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -59,7 +63,10 @@ class X11WindowSink final : public FrameSink {
   class XlibWindow;  // the connection, the window and its picture (keeps Xlib out of this header)
 
   X11WindowSettings settings_;
+  // Xlib's connection is used by one thread at a time: this guards window_ after construction.
+  mutable std::mutex xlib_;
   std::unique_ptr<XlibWindow> window_;
+  mutable std::atomic<bool> open_{true};  // the window's state when last looked at
   std::uint64_t framesShown_ = 0;
 };
 

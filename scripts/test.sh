@@ -1,10 +1,104 @@
 #!/bin/sh
 # Installs what is missing, builds everything with warnings as errors, and runs the whole test suite.
+#
+# --sanitizers (CI passes it): then also the whole suite built with AddressSanitizer + UBSan (the
+# `asan` preset; what is left out says why below), and the threaded parts (the work pool, capture,
+# the pipeline, its outputs' queues and servers, the control server, the service) built with
+# ThreadSanitizer (the `tsan` preset).
+# --minimal: then also builds the `minimal` preset (every optional part left out: X11, DRM, HTTP,
+# libcamera) and runs the tests that apply to it; those of left-out parts are not run (configure
+# lists them).
+# Each phase's time is printed at the end.
 set -eu
 cd "$(dirname "$0")/.."
+sanitizers=no
+minimal=no
+for argument in "$@"; do
+  case "$argument" in
+    --sanitizers) sanitizers=yes ;;
+    --minimal) minimal=yes ;;
+    *) echo "usage: scripts/test.sh [--sanitizers] [--minimal]" >&2; exit 2 ;;
+  esac
+done
+
+timings=""
+phase_start=0
+begin() { phase_start=$(date +%s); echo "test: $1"; }
+end() { timings="$timings
+  $1: $(($(date +%s) - phase_start)) s"; }
+
+begin "dependencies"
 scripts/install-deps.sh
+end "dependencies"
+begin "ci build"
 cmake --preset ci
 cmake --build --preset ci
 # The browser test's driver (playwright-core, from the npm registry; it drives Debian's chromium).
 npm ci --prefix tests/browser --no-audit --no-fund --loglevel=error
+end "ci build"
+begin "ci suite"
 ctest --preset ci -j2
+end "ci suite"
+
+if [ "$sanitizers" = yes ]; then
+  here="$(pwd)"
+  # LeakSanitizer and TSan suppressions for third-party libraries only; each says why.
+  export LSAN_OPTIONS="suppressions=$here/tests/sanitizers/lsan.supp:print_suppressions=0"
+  export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+  export ASAN_OPTIONS="detect_leaks=1:strict_init_order=1:detect_stack_use_after_return=1"
+  export TSAN_OPTIONS="suppressions=$here/tests/sanitizers/tsan.supp:halt_on_error=1:second_deadlock_stack=1"
+
+  begin "asan build"
+  cmake --preset asan
+  cmake --build --preset asan
+  end "asan build"
+  begin "asan suite"
+  # Mesa's llvmpipe driver keeps some allocations in its own static data, and eglTerminate()
+  # unloads it: LeakSanitizer then no longer sees those references and reports the blocks as
+  # leaked from an "<unknown module>", which no suppression can name. Loaded with every process,
+  # the driver stays mapped to the end and what it holds stays reachable; ASan is told that a
+  # library loaded before its runtime is meant.
+  dri="/usr/lib/$(gcc -print-multiarch)/dri/swrast_dri.so"
+  [ -e "$dri" ] || dri=""
+  # Left out: the browser tests (Chromium and its node driver are not instrumented; the server
+  # side of the page runs under ASan in http_stream_sink_test and end_to_end_test) and lintian's
+  # verdict on the .deb (it judges a release package; the ci suite runs it).
+  LD_PRELOAD="$dri" ASAN_OPTIONS="$ASAN_OPTIONS:verify_asan_link_order=0" \
+    ctest --preset asan -j2 -LE '^browser$' -E '^Packaging\.TheDebPassesLintian$'
+  end "asan suite"
+
+  # Threads: the work pool, capture (camera streams, the synchronizer, camera health), every test
+  # that runs the pipeline (replays, faults, recordings, output files and retries, its report), the
+  # output queue and HTTP server, the control server and the whole service. Left out: the
+  # libcamera test (no camera here: it only checks a message, and libcamera's own threads are not
+  # instrumented) and the v4l2loopback test (skipped without the kernel module).
+  tsan_tests="work_pool_test synchronizer_test file_source_test v4l2_source_test
+    camera_health_test queued_sink_test http_stream_sink_test replay_test fault_replay_test
+    fault_isolation_test output_retry_test output_files_test recording_test still_rig_test
+    pipeline_report_test control_server_test service_notifier_test service_test end_to_end_test"
+  begin "tsan build"
+  # Only these tests and the programs they run are built; their recordings are made by the ci
+  # build's generator (checked under ASan above), so it need not be built a third time.
+  cmake --preset tsan -DSURROUNDD_FIXTURE_SYNTH="$here/build/ci/tools/synth/surround-synth"
+  # shellcheck disable=SC2086 # the list is meant to split into words
+  cmake --build --preset tsan --target $tsan_tests surroundd surroundctl
+  end "tsan build"
+  begin "tsan suite"
+  # shellcheck disable=SC2086 # the list is meant to split into words
+  labels=$(echo $tsan_tests | tr ' ' '|')
+  ctest --preset tsan -j2 -L "^($labels)\$"
+  end "tsan suite"
+fi
+
+if [ "$minimal" = yes ]; then
+  begin "minimal build"
+  cmake --preset minimal
+  cmake --build --preset minimal
+  end "minimal build"
+  begin "minimal suite"
+  # The package is the full build's concern (tested above).
+  ctest --preset minimal -j2 --label-exclude packaging
+  end "minimal suite"
+fi
+
+echo "test: phase times:$timings"

@@ -1,9 +1,18 @@
 # Synthetic recordings shared by tests, made by the project's own generator once per test run.
 # surroundd_fixture(name ARGS...) adds a setup test that writes ${SURROUNDD_FIXTURE_DIR}/<name>;
 # tests that need it list FIXTURES <name>.
+#
+# SURROUNDD_FIXTURE_SYNTH: another build's surround-synth makes them instead of this build's, so a
+# build of a few tests (the tsan preset's in scripts/test.sh) need not build the generator too.
+set(SURROUNDD_FIXTURE_SYNTH "" CACHE FILEPATH
+    "surround-synth that makes the test recordings (empty: this build's)")
 function(surroundd_fixture name)
+  set(synth surround-synth)
+  if(SURROUNDD_FIXTURE_SYNTH)
+    set(synth ${SURROUNDD_FIXTURE_SYNTH})
+  endif()
   add_test(NAME fixture_${name}
-           COMMAND surround-synth --out ${SURROUNDD_FIXTURE_DIR}/${name} --force ${ARGN})
+           COMMAND ${synth} --out ${SURROUNDD_FIXTURE_DIR}/${name} --force ${ARGN})
   set_tests_properties(fixture_${name} PROPERTIES FIXTURES_SETUP ${name} LABELS fixtures)
 endfunction()
 

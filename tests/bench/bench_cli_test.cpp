@@ -18,10 +18,11 @@ const std::string kRecording = std::string(SURROUNDD_FIXTURE_DIR) + "/synth_smal
 
 TEST(BenchCli, StitchReportsTimingsAndAccuracyAsJson) {
   const testing::TempDir dir;
+  // The JSON on stdout; the log (the pipeline's warnings) on stderr.
   testing::ChildProcess bench({SURROUND_BENCH, "stitch", "--json", "--repeats", "3", kRecording},
-                              dir / "out.txt");
+                              dir / "log.txt", {}, dir / "out.json");
   ASSERT_EQ(bench.wait(), 0) << bench.output();
-  const YAML::Node report = YAML::Load(bench.output())["stitch"][0];
+  const YAML::Node report = YAML::Load(bench.standardOutput())["stitch"][0];
   EXPECT_EQ(report["input"].as<std::string>(), "synth_small");
   EXPECT_EQ(report["panorama"][0].as<int>(), 512);
   EXPECT_GT(report["lut_build_s"].as<double>(), 0);
@@ -44,9 +45,9 @@ TEST(BenchCli, PipelineReportsFrameRatesStagesAndTheBaselineAsJson) {
   const testing::TempDir dir;
   testing::ChildProcess bench({SURROUND_BENCH, "pipeline", "--json", "--repeats", "1", "--size",
                                "320x240", "--view", "top", kRecording},
-                              dir / "out.txt");
+                              dir / "log.txt", {}, dir / "out.json");
   ASSERT_EQ(bench.wait(), 0) << bench.output();
-  const YAML::Node report = YAML::Load(bench.output())["pipeline"];
+  const YAML::Node report = YAML::Load(bench.standardOutput())["pipeline"];
   EXPECT_EQ(report["view"].as<std::string>(), "top");
   EXPECT_THAT(report["renderer"].as<std::string>(), HasSubstr("OpenGL ES 3"));
   const YAML::Node input = report["inputs"][0];

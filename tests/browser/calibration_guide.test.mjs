@@ -13,16 +13,9 @@
 // Environment: CHROMIUM, the browser to drive (default /usr/bin/chromium).
 
 import { readFileSync } from "node:fs";
-import { chromium } from "playwright-core";
+import { Failure, check, logger, runInChromium } from "./guide_test_support.mjs";
 
-const startedAt = Date.now();
-class Failure extends Error {}
-function check(condition, message) {
-  if (!condition) throw new Failure(message);
-}
-function log(message) {
-  console.log(`calibration_guide: [${((Date.now() - startedAt) / 1000).toFixed(1)} s] ${message}`);
-}
+const log = logger("calibration_guide");
 
 // One number of a YAML line "key: value" (the lens block is flat).
 function yamlNumber(text, key) {
@@ -100,22 +93,4 @@ if (!url || !lensFile || !rigFile) {
   console.error("usage: node calibration_guide.test.mjs URL LENS_FILE TRUE_RIG");
   process.exit(2);
 }
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM || "/usr/bin/chromium",
-  headless: true,
-  args: ["--disable-dev-shm-usage"],
-});
-const timer = setTimeout(() => {
-  console.error("calibration_guide: FAIL: gave up after 90 s");
-  process.exit(1);
-}, 90000);
-try {
-  await run(url, lensFile, rigFile, browser);
-  console.log("calibration_guide: PASS");
-} catch (error) {
-  console.error(`calibration_guide: FAIL: ${error instanceof Failure ? error.message : error.stack}`);
-  process.exitCode = 1;
-} finally {
-  clearTimeout(timer);
-  await browser.close();
-}
+await runInChromium("calibration_guide", 90, (browser) => run(url, lensFile, rigFile, browser));

@@ -15,6 +15,7 @@
 #include "processing/calibration_error.hpp"
 #include "processing/calibration_targets.hpp"
 #include "processing/rig.hpp"
+#include "tools/synth/calibration_mat.hpp"
 #include "tools/synth/calibration_scenes.hpp"
 #include "tools/synth/recording_plan.hpp"
 #include "tools/synth/target_renderer.hpp"
@@ -116,12 +117,7 @@ inline PoseError poseError(const processing::Pose& solved, const processing::Pos
 
 // A pose a few centimetres and degrees off: what a rig file says before calibration.
 inline processing::Pose nominal(const processing::Pose& truth) {
-  processing::Pose pose = truth;
-  pose.position += cv::Vec3d(0.04, -0.03, 0.05);
-  const auto angles = processing::mountAnglesFromRotation(truth.rotation);
-  pose.rotation = processing::rotationFromMountAngles(
-      {angles.yawDeg + 2.0, angles.pitchDeg - 1.5, angles.rollDeg + 1.0});
-  return pose;
+  return synth::mountMeasuredByHand(truth);
 }
 
 }  // namespace surroundd::calibration::testing

@@ -1,9 +1,13 @@
 #pragma once
 // An in-process V4L2 device for tests: it answers the ioctls the V4L2 source makes the way a
-// driver does (formats and sizes to enumerate, MMAP buffers, a queue), produces frames of a
+// driver does (formats and sizes to enumerate, MMAP buffers, a queue), through the single-planar
+// API (UVC) or only the multi-planar one (i.MX, Rockchip, TI: V4L2_CAP_VIDEO_CAPTURE_MPLANE, with
+// NV12M's luma and chroma in two buffers and lines padded to the driver's stride, refusing the
+// other API's buffer type), produces frames of a
 // synthetic picture in the negotiated format with monotonic timestamps, and fails on request:
 // unplugged (ENODEV, then open fails until plugged back), stalled (poll times out without
-// waiting), corrupt MJPEG.
+// waiting), corrupt MJPEG. A fault can also be scheduled before streaming starts (corruptFrames,
+// unplugAtFrame), so that a test can leave the device to a capture thread without touching it.
 //
 // The test keeps a FakeV4l2Device::State to steer the device after handing the device to a
 // source.
@@ -12,6 +16,7 @@
 #include <cstring>
 #include <deque>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -50,6 +55,12 @@ inline std::vector<std::uint8_t> packedYuv(const cv::Mat& bgr, bool yuyv) {
   return out;
 }
 
+inline std::string fourccName(std::uint32_t fourcc) {
+  std::string name(4, ' ');
+  for (std::size_t i = 0; i < 4; ++i) name[i] = static_cast<char>((fourcc >> (8 * i)) & 0xff);
+  return name;
+}
+
 inline std::vector<std::uint8_t> nv12(const cv::Mat& bgr) {
   cv::Mat i420;
   cv::cvtColor(bgr, i420, cv::COLOR_BGR2YUV_I420);
@@ -74,9 +85,16 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
     std::vector<Mode> modes;
     std::vector<v4l2_queryctrl> controls;
     std::vector<v4l2_control> controlsSet;
+    bool multiplanar = false;       // only the multi-planar API
+    std::uint32_t linePadding = 0;  // bytes after each line of a raw format, multi-planar only
     bool plugged = true;
-    int stalledPolls = 0;        // the next polls time out
-    bool corruptNext = false;    // the next MJPEG frame is cut short
+    int stalledPolls = 0;      // the next polls time out
+    bool corruptNext = false;  // the next MJPEG frame is cut short
+    int corruptFrames = 0;     // the next this many MJPEG frames are cut short
+    // Once this many frames are produced the device is unplugged; the next `failedOpens` opens
+    // fail, and the one after plugs it back.
+    std::uint64_t unplugAtFrame = std::numeric_limits<std::uint64_t>::max();
+    int failedOpens = 0;
     bool exportsDmabuf = false;  // VIDIOC_EXPBUF answers (with /dev/null descriptors)
     int opens = 0;
     std::uint64_t produced = 0;
@@ -88,6 +106,14 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
   explicit FakeV4l2Device(std::shared_ptr<State> state) : state_(std::move(state)) {}
 
   int open(const std::string&) override {
+    if (!state_->plugged && state_->failedOpens > 0) {
+      --state_->failedOpens;
+      if (state_->failedOpens == 0 && state_->unplugAtFrame == state_->produced) {
+        state_->plugged = true;  // the scheduled unplugging is over after this failed open
+        state_->unplugAtFrame = std::numeric_limits<std::uint64_t>::max();
+      }
+      return ENOENT;
+    }
     if (!state_->plugged) return ENOENT;
     ++state_->opens;
     open_ = true;
@@ -101,8 +127,12 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
   }
   void* map(std::size_t length, std::int64_t offset) override {
     const auto index = static_cast<std::size_t>(offset >> 16);
-    if (index >= buffers_.size() || buffers_[index].size() != length) return nullptr;
-    return buffers_[index].data();
+    const auto plane = static_cast<std::size_t>((offset >> 12) & 0xf);
+    if (index >= buffers_.size() || plane >= buffers_[index].size() ||
+        buffers_[index][plane].size() != length) {
+      return nullptr;
+    }
+    return buffers_[index][plane].data();
   }
   void unmap(void*, std::size_t) override {}
   int waitReadable(std::chrono::milliseconds) override {
@@ -117,17 +147,22 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
   int ioctl(unsigned long request, void* argument) override {
     if (!open_) return EBADF;
     if (!state_->plugged) return ENODEV;
+    const std::uint32_t type =
+        state_->multiplanar ? V4L2_BUF_TYPE_VIDEO_CAPTURE_MPLANE : V4L2_BUF_TYPE_VIDEO_CAPTURE;
     switch (request) {
       case VIDIOC_QUERYCAP: {
         auto* caps = static_cast<v4l2_capability*>(argument);
         *caps = {};
         std::strcpy(reinterpret_cast<char*>(caps->driver), "fake");
         std::strcpy(reinterpret_cast<char*>(caps->card), "Fake camera");
-        caps->capabilities = V4L2_CAP_VIDEO_CAPTURE | V4L2_CAP_STREAMING;
+        caps->capabilities =
+            V4L2_CAP_STREAMING |
+            (state_->multiplanar ? V4L2_CAP_VIDEO_CAPTURE_MPLANE : V4L2_CAP_VIDEO_CAPTURE);
         return 0;
       }
       case VIDIOC_ENUM_FMT: {
         auto* description = static_cast<v4l2_fmtdesc*>(argument);
+        if (description->type != type) return EINVAL;
         const auto fourccs = distinctFourccs();
         if (description->index >= fourccs.size()) return EINVAL;
         description->pixelformat = fourccs[description->index];
@@ -147,29 +182,12 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
         }
         return EINVAL;
       }
-      case VIDIOC_S_FMT: {
-        auto& pix = static_cast<v4l2_format*>(argument)->fmt.pix;
-        // Like a driver: an unsupported request is adjusted to the first mode, not refused.
-        Mode mode = state_->modes.front();
-        for (const auto& m : state_->modes) {
-          if (m.fourcc == pix.pixelformat &&
-              m.size == cv::Size(static_cast<int>(pix.width), static_cast<int>(pix.height))) {
-            mode = m;
-          }
-        }
-        mode_ = mode;
-        pix.pixelformat = mode.fourcc;
-        pix.width = static_cast<std::uint32_t>(mode.size.width);
-        pix.height = static_cast<std::uint32_t>(mode.size.height);
-        pix.bytesperline = mode.fourcc == V4L2_PIX_FMT_NV12 || mode.fourcc == V4L2_PIX_FMT_MJPEG
-                               ? pix.width
-                               : pix.width * 2;
-        pix.sizeimage = frameBytes();
-        return 0;
-      }
+      case VIDIOC_S_FMT:
+        return setFormat(*static_cast<v4l2_format*>(argument), type);
       case VIDIOC_G_PARM:
       case VIDIOC_S_PARM: {
         auto* parameters = static_cast<v4l2_streamparm*>(argument);
+        if (parameters->type != type) return EINVAL;
         parameters->parm.capture.capability = V4L2_CAP_TIMEPERFRAME;
         parameters->parm.capture.timeperframe = {1, 30};
         return 0;
@@ -189,33 +207,60 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
         return 0;
       case VIDIOC_REQBUFS: {
         const auto* wanted = static_cast<v4l2_requestbuffers*>(argument);
-        buffers_.assign(wanted->count, std::vector<std::uint8_t>(frameBytes()));
+        if (wanted->type != type) return EINVAL;
+        buffers_.assign(wanted->count, {});
+        for (auto& planes : buffers_) {
+          for (std::uint32_t p = 0; p < planeCount(); ++p) planes.emplace_back(planeBytes(p));
+        }
         queue_.clear();
         return 0;
       }
       case VIDIOC_QUERYBUF: {
         auto* buffer = static_cast<v4l2_buffer*>(argument);
-        if (buffer->index >= buffers_.size()) return EINVAL;
-        buffer->length = static_cast<std::uint32_t>(buffers_[buffer->index].size());
-        buffer->m.offset = buffer->index << 16;
+        if (buffer->type != type || buffer->index >= buffers_.size()) return EINVAL;
+        const auto& planes = buffers_[buffer->index];
+        if (!state_->multiplanar) {
+          buffer->length = static_cast<std::uint32_t>(planes[0].size());
+          buffer->m.offset = buffer->index << 16;
+          return 0;
+        }
+        if (buffer->m.planes == nullptr || buffer->length < planes.size()) return EINVAL;
+        buffer->length = static_cast<std::uint32_t>(planes.size());
+        for (std::uint32_t p = 0; p < planes.size(); ++p) {
+          buffer->m.planes[p].length = static_cast<std::uint32_t>(planes[p].size());
+          buffer->m.planes[p].m.mem_offset = (buffer->index << 16) | (p << 12);
+        }
         return 0;
       }
       case VIDIOC_EXPBUF: {
         if (!state_->exportsDmabuf) return ENOTTY;
-        static_cast<v4l2_exportbuffer*>(argument)->fd = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+        auto* exported = static_cast<v4l2_exportbuffer*>(argument);
+        if (exported->type != type || exported->plane >= planeCount()) return EINVAL;
+        exported->fd = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
         return 0;
       }
-      case VIDIOC_QBUF:
-        queue_.push_back(static_cast<v4l2_buffer*>(argument)->index);
+      case VIDIOC_QBUF: {
+        const auto* buffer = static_cast<v4l2_buffer*>(argument);
+        if (buffer->type != type) return EINVAL;
+        if (state_->multiplanar && (buffer->m.planes == nullptr || buffer->length < planeCount())) {
+          return EINVAL;
+        }
+        queue_.push_back(buffer->index);
         return 0;
-      case VIDIOC_DQBUF:
-        return dequeue(*static_cast<v4l2_buffer*>(argument));
+      }
+      case VIDIOC_DQBUF: {
+        auto* buffer = static_cast<v4l2_buffer*>(argument);
+        if (buffer->type != type) return EINVAL;
+        if (state_->multiplanar && (buffer->m.planes == nullptr || buffer->length < planeCount())) {
+          return EINVAL;
+        }
+        return dequeue(*buffer);
+      }
       case VIDIOC_STREAMON:
-        streaming_ = true;
-        return 0;
       case VIDIOC_STREAMOFF:
-        streaming_ = false;
-        queue_.clear();
+        if (*static_cast<int*>(argument) != static_cast<int>(type)) return EINVAL;
+        streaming_ = request == VIDIOC_STREAMON;
+        if (!streaming_) queue_.clear();
         return 0;
       default:
         return ENOTTY;
@@ -231,36 +276,133 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
     return fourccs;
   }
 
-  std::uint32_t frameBytes() const {
-    const auto pixels = static_cast<std::uint32_t>(mode_.size.area());
-    if (mode_.fourcc == V4L2_PIX_FMT_NV12) return pixels * 3 / 2;
-    if (mode_.fourcc == V4L2_PIX_FMT_MJPEG) return pixels * 3;  // room for any JPEG of it
-    return pixels * 2;
+  int setFormat(v4l2_format& format, std::uint32_t type) {
+    if (format.type != type) return EINVAL;
+    const bool multi = state_->multiplanar;
+    const std::uint32_t fourcc = multi ? format.fmt.pix_mp.pixelformat : format.fmt.pix.pixelformat;
+    const cv::Size size = multi ? cv::Size(static_cast<int>(format.fmt.pix_mp.width),
+                                           static_cast<int>(format.fmt.pix_mp.height))
+                                : cv::Size(static_cast<int>(format.fmt.pix.width),
+                                           static_cast<int>(format.fmt.pix.height));
+    // Like a driver: an unsupported request is adjusted to the first mode, not refused.
+    Mode mode = state_->modes.front();
+    for (const auto& m : state_->modes) {
+      if (m.fourcc == fourcc && m.size == size) mode = m;
+    }
+    mode_ = mode;
+    const auto width = static_cast<std::uint32_t>(mode.size.width);
+    const auto height = static_cast<std::uint32_t>(mode.size.height);
+    if (!multi) {
+      auto& pix = format.fmt.pix;
+      pix.pixelformat = mode.fourcc;
+      pix.width = width;
+      pix.height = height;
+      pix.bytesperline = bytesPerLine(0);
+      pix.sizeimage = planeBytes(0);
+      return 0;
+    }
+    auto& pix = format.fmt.pix_mp;
+    pix.pixelformat = mode.fourcc;
+    pix.width = width;
+    pix.height = height;
+    pix.num_planes = static_cast<std::uint8_t>(planeCount());
+    for (std::uint32_t p = 0; p < planeCount(); ++p) {
+      pix.plane_fmt[p].bytesperline = bytesPerLine(p);
+      pix.plane_fmt[p].sizeimage = planeBytes(p);
+    }
+    return 0;
+  }
+
+  bool mjpeg() const { return mode_.fourcc == V4L2_PIX_FMT_MJPEG; }
+  std::uint32_t planeCount() const { return mode_.fourcc == V4L2_PIX_FMT_NV12M ? 2 : 1; }
+  std::uint32_t padding() const {
+    return state_->multiplanar && !mjpeg() ? state_->linePadding : 0;
+  }
+  std::uint32_t bytesPerLine(std::uint32_t /*plane*/) const {
+    const auto width = static_cast<std::uint32_t>(mode_.size.width);
+    const bool packed = mode_.fourcc == V4L2_PIX_FMT_YUYV || mode_.fourcc == V4L2_PIX_FMT_UYVY;
+    return (packed ? width * 2 : width) + padding();
+  }
+  std::uint32_t planeRows(std::uint32_t plane) const {
+    const auto height = static_cast<std::uint32_t>(mode_.size.height);
+    if (mode_.fourcc == V4L2_PIX_FMT_NV12) return height * 3 / 2;
+    if (mode_.fourcc == V4L2_PIX_FMT_NV12M) return plane == 0 ? height : height / 2;
+    return height;
+  }
+  std::uint32_t planeBytes(std::uint32_t plane) const {
+    if (mjpeg()) return static_cast<std::uint32_t>(mode_.size.area()) * 3;  // room for any JPEG
+    return bytesPerLine(plane) * planeRows(plane);
+  }
+
+  // `bytes` (rows of `width` bytes, back to back) laid out with the driver's stride.
+  std::vector<std::uint8_t> strided(const std::vector<std::uint8_t>& bytes, std::uint32_t width,
+                                    std::uint32_t rows) const {
+    if (padding() == 0) return bytes;
+    std::vector<std::uint8_t> out(static_cast<std::size_t>(width + padding()) * rows, 0xAA);
+    for (std::uint32_t r = 0; r < rows; ++r) {
+      std::memcpy(out.data() + static_cast<std::size_t>(r) * (width + padding()),
+                  bytes.data() + static_cast<std::size_t>(r) * width, width);
+    }
+    return out;
+  }
+
+  // The frame's bytes, plane by plane.
+  std::vector<std::vector<std::uint8_t>> frameBytes(const cv::Mat& picture) {
+    const auto width = static_cast<std::uint32_t>(picture.cols);
+    const auto height = static_cast<std::uint32_t>(picture.rows);
+    if (mode_.fourcc == V4L2_PIX_FMT_YUYV || mode_.fourcc == V4L2_PIX_FMT_UYVY) {
+      return {strided(packedYuv(picture, mode_.fourcc == V4L2_PIX_FMT_YUYV), width * 2, height)};
+    }
+    if (mode_.fourcc == V4L2_PIX_FMT_NV12) return {strided(nv12(picture), width, height * 3 / 2)};
+    if (mode_.fourcc == V4L2_PIX_FMT_NV12M) {
+      const std::vector<std::uint8_t> both = nv12(picture);
+      const std::size_t luma = static_cast<std::size_t>(width) * height;
+      return {
+          strided({both.begin(), both.begin() + static_cast<std::ptrdiff_t>(luma)}, width, height),
+          strided({both.begin() + static_cast<std::ptrdiff_t>(luma), both.end()}, width,
+                  height / 2)};
+    }
+    std::vector<std::uint8_t> bytes;
+    cv::imencode(".jpg", picture, bytes, {cv::IMWRITE_JPEG_QUALITY, 95});
+    if (state_->corruptNext || state_->corruptFrames > 0) {
+      bytes.resize(bytes.size() / 3);  // a frame cut short on the wire
+      state_->corruptNext = false;
+      state_->corruptFrames = std::max(state_->corruptFrames - 1, 0);
+    }
+    return {bytes};
   }
 
   int dequeue(v4l2_buffer& buffer) {
     if (!streaming_ || queue_.empty()) return EAGAIN;
+    if (state_->produced == state_->unplugAtFrame) {
+      state_->plugged = false;
+      return ENODEV;
+    }
     const std::uint32_t index = queue_.front();
     queue_.pop_front();
     const std::uint64_t frame = state_->produced++;
-    const cv::Mat picture = state_->picture(frame, mode_.size);
-    std::vector<std::uint8_t> bytes;
-    if (mode_.fourcc == V4L2_PIX_FMT_YUYV || mode_.fourcc == V4L2_PIX_FMT_UYVY) {
-      bytes = packedYuv(picture, mode_.fourcc == V4L2_PIX_FMT_YUYV);
-    } else if (mode_.fourcc == V4L2_PIX_FMT_NV12) {
-      bytes = nv12(picture);
-    } else {
-      cv::imencode(".jpg", picture, bytes, {cv::IMWRITE_JPEG_QUALITY, 95});
-      if (state_->corruptNext) {
-        bytes.resize(bytes.size() / 3);  // a frame cut short on the wire
-        state_->corruptNext = false;
-      }
+    const auto planes = frameBytes(state_->picture(frame, mode_.size));
+    for (std::size_t p = 0; p < planes.size(); ++p) {
+      std::memcpy(buffers_[index][p].data(), planes[p].data(), planes[p].size());
     }
-    std::memcpy(buffers_[index].data(), bytes.data(), bytes.size());
+    v4l2_plane* planeInfo = buffer.m.planes;
+    const std::uint32_t length = buffer.length;
+    const std::uint32_t type = buffer.type;
     buffer = {};
+    buffer.type = type;
     buffer.index = index;
-    buffer.bytesused = static_cast<std::uint32_t>(bytes.size());
     buffer.flags = V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC;
+    if (state_->multiplanar) {
+      buffer.m.planes = planeInfo;
+      buffer.length = length;
+      for (std::size_t p = 0; p < planes.size(); ++p) {
+        planeInfo[p] = {};
+        planeInfo[p].bytesused = static_cast<std::uint32_t>(planes[p].size());
+        planeInfo[p].length = static_cast<std::uint32_t>(buffers_[index][p].size());
+      }
+    } else {
+      buffer.bytesused = static_cast<std::uint32_t>(planes[0].size());
+    }
     const std::int64_t us =
         state_->firstTimestampUs + static_cast<std::int64_t>(frame) * state_->periodUs;
     buffer.timestamp = {us / 1'000'000, us % 1'000'000};
@@ -271,7 +413,7 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
   bool open_ = false;
   bool streaming_ = false;
   Mode mode_{};
-  std::vector<std::vector<std::uint8_t>> buffers_;
+  std::vector<std::vector<std::vector<std::uint8_t>>> buffers_;  // per buffer, per plane
   std::deque<std::uint32_t> queue_;
 };
 

@@ -153,6 +153,34 @@ TEST_F(ConfigTest, AnOcamLensRefusesWhatItDoesNotTake) {
               HasSubstr("rig.cameras[1].lens.affine: only an ocam lens takes this key"));
 }
 
+// --check-config said "good" for these, then the camera saw a pinpoint and start failed
+// (issue 18.11).
+TEST_F(ConfigTest, DistortionNoLensHasIsRefusedNamingTheCameraAndCoefficient) {
+  expectOneError("distortion: [0.01, 0, 0, 0]", "distortion: [1e300, 0, 0, 0]",
+                 {"rig.cameras[1].lens.distortion",
+                  "camera 'left': k1 = 1e+300 is no lens's "
+                  "distortion (expected within -1000 to 1000)"});
+  expectOneError("distortion: [0.01, 0, 0, 0]", "distortion: [0.01, 0, 0, -2e3]",
+                 {"camera 'left': k4 = -2000"});
+  expectOneError("cx_px: 319.5, cy_px: 179.5}",
+                 "cx_px: 319.5, cy_px: 179.5, distortion: [0, 0, 0, 0, 1e300]}",
+                 {"rig.cameras[0].lens.distortion", "camera 'front': k3 = 1e+300"});
+  // Within the bounds, but no lens: the picture's edge would be 7 degrees off axis, not 47.
+  expectOneError("cx_px: 319.5, cy_px: 179.5}",
+                 "cx_px: 319.5, cy_px: 179.5, distortion: [900, 0, 0, 0, 0]}",
+                 {"rig.cameras[0].lens.distortion",
+                  "camera 'front': with this distortion the "
+                  "picture's edge is"});
+  // Strong, real distortion passes: a wide pinhole's barrel and a fisheye's terms.
+  EXPECT_TRUE(errorsOf(configWith("cx_px: 319.5, cy_px: 179.5}",
+                                  "cx_px: 319.5, cy_px: 179.5, distortion: [-0.3, 0.1, 0.001, "
+                                  "-0.001, -0.02]}"))
+                  .empty());
+  EXPECT_TRUE(
+      errorsOf(configWith("distortion: [0.01, 0, 0, 0]", "distortion: [-0.05, 0.02, -0.01, 0.002]"))
+          .empty());
+}
+
 TEST_F(ConfigTest, ALensFieldCutByItsPolynomialIsNamedWithItsCameraAndAngle) {
   const Config plain = loadConfig(configWith("", ""));
   for (const auto& camera : plain.cameras) EXPECT_FALSE(lensFieldCutWarning(camera.calibration));

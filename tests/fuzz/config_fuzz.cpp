@@ -6,7 +6,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
 #include <string>
 
 #include "daemon/config.hpp"
@@ -25,11 +24,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const auto config =
         surroundd::daemon::loadConfigText(std::string(surroundd::fuzz::asText(data, size)), file);
     surroundd::fuzz::checkAcceptedCameras(config.cameras);
-    if (config.cameras.empty() || config.panorama.widthPx < 1 || config.panorama.heightPx < 1 ||
-        !(config.panorama.elevationTopDeg > config.panorama.elevationBottomDeg) ||
-        config.render.widthPx < 1 || config.render.heightPx < 1) {
-      std::abort();
-    }
+    FUZZ_CHECK(!config.cameras.empty());
+    FUZZ_CHECK(config.panorama.widthPx >= 1 && config.panorama.heightPx >= 1);
+    FUZZ_CHECK(config.panorama.elevationTopDeg > config.panorama.elevationBottomDeg);
+    FUZZ_CHECK(config.render.widthPx >= 1 && config.render.heightPx >= 1);
   } catch (const surroundd::daemon::ConfigError&) {
     // the documented answer to a bad config
   }

@@ -3,7 +3,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
 
 #include "daemon/control_protocol.hpp"
 #include "tests/fuzz/fuzz_support.hpp"
@@ -12,10 +11,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using surroundd::daemon::ControlReply;
   using surroundd::daemon::ControlRequest;
   const auto parsed = surroundd::daemon::parseControlRequest(surroundd::fuzz::asText(data, size));
-  if (parsed.error.empty() && parsed.request.kind == ControlRequest::Kind::kView &&
-      parsed.request.argument.empty()) {
-    std::abort();  // a view request names its view
-  }
+  // A view request names its view.
+  FUZZ_CHECK(!parsed.error.empty() || parsed.request.kind != ControlRequest::Kind::kView ||
+             !parsed.request.argument.empty());
   const auto reply = parsed.error.empty() ? ControlReply::success(parsed.request.argument)
                                           : ControlReply::failure(parsed.error);
   (void)surroundd::daemon::encodeReply(reply);

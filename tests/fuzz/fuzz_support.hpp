@@ -3,6 +3,7 @@
 // logging (a target that logs each input runs a hundred times slower).
 
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -30,6 +31,13 @@ inline const std::filesystem::path& scratchFolder() {
   return folder;
 }
 
+// A promise of the code under test that an input broke: says which, then aborts, so that libFuzzer
+// keeps the input as a finding.
+[[noreturn]] inline void brokenPromise(const char* promise, const char* file, int line) {
+  std::fprintf(stderr, "%s:%d: broken: %s\n", file, line, promise);
+  std::abort();
+}
+
 inline void quietLogs() { spdlog::set_level(spdlog::level::off); }
 
 inline std::string_view asText(const std::uint8_t* data, std::size_t size) {
@@ -43,3 +51,8 @@ inline void writeFile(const std::filesystem::path& path, std::string_view bytes)
 }
 
 }  // namespace surroundd::fuzz
+
+// FUZZ_CHECK(what the code promises), in the spirit of gtest's EXPECT_ but fatal: a fuzz target
+// has one input at a time and nothing to go on with. (A macro, for the promise's own text.)
+#define FUZZ_CHECK(promise) \
+  ((promise) ? (void)0 : ::surroundd::fuzz::brokenPromise(#promise, __FILE__, __LINE__))

@@ -7,7 +7,6 @@
 #include <cctype>
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -50,9 +49,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using surroundd::render::isAllowedHost;
   using surroundd::render::isSameOrigin;
   const bool allowed = isAllowedHost(host, allowedNames);
-  if (isAllowedHost(host, {}) && (!allowed || !isLocalhostOrAddress(host))) std::abort();
-  if (isAllowedHost(upper(host), allowedNames) != allowed) std::abort();
-  if (isSameOrigin(origin, host) != isSameOrigin(upper(origin), host)) std::abort();
-  if (!isSameOrigin("http://" + std::string(host), host)) std::abort();
+  FUZZ_CHECK(!isAllowedHost(host, {}) || (allowed && isLocalhostOrAddress(host)));
+  FUZZ_CHECK(isAllowedHost(upper(host), allowedNames) == allowed);
+  FUZZ_CHECK(isSameOrigin(origin, host) == isSameOrigin(upper(origin), host));
+  FUZZ_CHECK(isSameOrigin("http://" + std::string(host), host));
   return 0;
 }

@@ -5,7 +5,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
 #include <span>
 #include <string>
 
@@ -36,12 +35,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   cv::Mat bgr(height, width, CV_8UC3);
   const auto* const buffer = bgr.data;
   const bool decoded = decoder.decode(jpeg, bgr, error);
-  if (bgr.data != buffer || bgr.rows != height || bgr.cols != width) std::abort();
-  if (!decoded && error.empty()) std::abort();  // a refusal says why
+  FUZZ_CHECK(bgr.data == buffer && bgr.rows == height && bgr.cols == width);
+  FUZZ_CHECK(decoded || !error.empty());  // a refusal says why
   error.clear();
   cv::Mat smaller(height / 2 + 1, width / 2 + 1, CV_8UC3);
   const bool decodedSmaller = decoder.decode(jpeg, smaller, error);
-  if (decoded && decodedSmaller) std::abort();  // a picture of another size must be refused
-  if (!decodedSmaller && error.empty()) std::abort();
+  FUZZ_CHECK(!(decoded && decodedSmaller));  // a picture of another size must be refused
+  FUZZ_CHECK(decodedSmaller || !error.empty());
   return 0;
 }

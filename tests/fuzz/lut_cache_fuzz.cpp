@@ -31,10 +31,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (lookup.lut) {
     // What the stitcher relies on: a tap per pixel, blend rows that cover the blend taps.
     const auto& lut = *lookup.lut;
-    if (lut.taps.size() !=
-        static_cast<std::size_t>(lut.size.width) * static_cast<std::size_t>(lut.size.height)) {
-      std::abort();
-    }
+    FUZZ_CHECK(lut.taps.size() == static_cast<std::size_t>(lut.size.width) *
+                                      static_cast<std::size_t>(lut.size.height));
   }
   return 0;
 }

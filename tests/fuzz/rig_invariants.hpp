@@ -3,10 +3,10 @@
 // daemon (camera model, LUT, mesh) takes these for granted and checks none of them again.
 
 #include <cmath>
-#include <cstdlib>
 #include <span>
 
 #include "daemon/rig_yaml.hpp"
+#include "tests/fuzz/fuzz_support.hpp"
 
 namespace surroundd::fuzz {
 
@@ -39,13 +39,12 @@ inline bool poseIsSound(const processing::Pose& pose) {
   return finite(pose.position[0]) && finite(pose.position[1]) && finite(pose.position[2]);
 }
 
-// Aborts (a finding) when an accepted camera breaks what the daemon relies on.
+// A finding when an accepted camera breaks what the daemon relies on.
 inline void checkAcceptedCameras(std::span<const daemon::RigCamera> cameras) {
   for (const auto& camera : cameras) {
-    if (camera.calibration.name.empty() || !intrinsicsAreSound(camera.calibration.intrinsics) ||
-        !poseIsSound(camera.calibration.pose)) {
-      std::abort();
-    }
+    FUZZ_CHECK(!camera.calibration.name.empty());
+    FUZZ_CHECK(intrinsicsAreSound(camera.calibration.intrinsics));
+    FUZZ_CHECK(poseIsSound(camera.calibration.pose));
   }
 }
 

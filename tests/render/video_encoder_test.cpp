@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "common/ffmpeg_util.hpp"
-#include "render/frame_sink.hpp"
+#include "render/video_sink.hpp"
 #include "tests/support/stream_receiver.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/support/test_support.hpp"

@@ -1,6 +1,8 @@
 #pragma once
 // Runs one of the project's executables as a child process, with its stderr captured to a file, so
 // that tests can check exit codes, messages and signal handling the way a user would see them.
+// Its stdout goes to the same file, or to a file of its own for a program whose stdout is data
+// (JSON) that its log lines must not be mixed into.
 
 #include <filesystem>
 #include <fstream>
@@ -19,8 +21,8 @@ class ChildProcess {
  public:
   // `environment`: NAME=VALUE entries added to the child's environment.
   ChildProcess(std::vector<std::string> arguments, std::filesystem::path stderrFile,
-               std::vector<std::string> environment = {})
-      : stderrFile_(std::move(stderrFile)) {
+               std::vector<std::string> environment = {}, std::filesystem::path stdoutFile = {})
+      : stderrFile_(std::move(stderrFile)), stdoutFile_(std::move(stdoutFile)) {
     std::vector<char*> argv;
     for (auto& argument : arguments) argv.push_back(argument.data());
     argv.push_back(nullptr);
@@ -28,7 +30,11 @@ class ChildProcess {
     if (pid_ == 0) {
       const int fd = ::open(stderrFile_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       ::dup2(fd, STDERR_FILENO);
-      ::dup2(fd, STDOUT_FILENO);
+      if (stdoutFile_.empty()) {
+        ::dup2(fd, STDOUT_FILENO);
+      } else {
+        ::dup2(::open(stdoutFile_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644), STDOUT_FILENO);
+      }
       for (auto& entry : environment) ::putenv(entry.data());
       ::execv(argv[0], argv.data());
       ::_exit(127);
@@ -62,15 +68,21 @@ class ChildProcess {
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   }
 
-  std::string output() const {
-    std::ifstream file(stderrFile_);
+  // What it wrote to stderr (and stdout, unless that has its own file).
+  std::string output() const { return contents(stderrFile_); }
+  // What it wrote to stdout, when that has its own file.
+  std::string standardOutput() const { return contents(stdoutFile_); }
+
+ private:
+  static std::string contents(const std::filesystem::path& path) {
+    std::ifstream file(path);
     std::stringstream text;
     text << file.rdbuf();
     return text.str();
   }
 
- private:
   std::filesystem::path stderrFile_;
+  std::filesystem::path stdoutFile_;
   pid_t pid_ = -1;
   bool exited_ = false;
 };

@@ -11,9 +11,13 @@
 #include "processing/poisson_correction.hpp"
 #include "processing/stitcher.hpp"
 #include "tools/bench/seam_measures.hpp"
+#include "tools/bench/timing.hpp"
 
 namespace surroundd::bench {
 namespace {
+
+// Turns of the per-frame timing (medians).
+constexpr int kTimingRepeats = 21;
 
 std::vector<cv::Mat> firstFrames(const daemon::Config& config) {
   std::vector<cv::Mat> frames;
@@ -65,6 +69,11 @@ void reportRigColour(const RigColourInput& input, WorkPool& pool,
   processing::PoissonColourCorrection correction(rig, settings, lut, colour, pool);
   correction.update(frames);
   correction.apply(poisson);
+  // The colour stage per frame, as the pipeline runs it: seam data and solve (warm-started from
+  // the frame before), then upsampling and applying the field.
+  cv::Mat scratch = raw.clone();
+  const auto stageMs = interleavedMedians(
+      {[&] { correction.update(frames); }, [&] { correction.apply(scratch); }}, kTimingRepeats);
 
   int masked = 0;
   for (const auto& camera : rig.cameras) masked += camera.bodyMask.empty() ? 0 : 1;
@@ -122,6 +131,10 @@ void reportRigColour(const RigColourInput& input, WorkPool& pool,
         seam.clampedBlocks, seam.droppedBlocks, seam.stepUncorrected, seam.stepCorrected,
         seam.dropped ? " (all dropped: it would have got worse)" : "");
   }
+  fmt::print(
+      "  Poisson per frame, {} thread(s): seam data + solve {:.2f} ms, upsample and apply {:.2f} "
+      "ms\n",
+      pool.threads(), stageMs[0], stageMs[1]);
   for (const auto& note : correction.notes()) fmt::print("    note: {}\n", note);
   for (const auto& note : correction.notesOfLastUpdate()) fmt::print("    note: {}\n", note);
   if (!pictures.empty()) {

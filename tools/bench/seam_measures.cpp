@@ -8,6 +8,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "processing/ground_top_view.hpp"
+
 namespace surroundd::bench {
 namespace {
 
@@ -124,33 +126,15 @@ std::optional<SeamAlignment> alignmentAt(const processing::Rig& rig,
   std::array<cv::Mat, 2> patches;
   for (int k = 0; k < 2; ++k) {
     const std::size_t camera = k == 0 ? seam.left : seam.right;
-    const auto& calibration = rig.cameras[camera];
-    const processing::CameraModel model(calibration.intrinsics);
-    cv::Mat mapX(side, side, CV_32F, cv::Scalar(-1));
-    cv::Mat mapY(side, side, CV_32F, cv::Scalar(-1));
-    int seen = 0;
-    for (int y = 0; y < side; ++y) {
-      for (int x = 0; x < side; ++x) {
-        // Patch rows run along -x of the vehicle, columns along -y: a top view, front up.
-        const cv::Vec3d ground(centre.x + (side / 2.0 - y) * kPatchPixelM,
-                               centre.y + (side / 2.0 - x) * kPatchPixelM, 0);
-        const auto pixel = model.project(calibration.pose.toCamera(ground));
-        if (!pixel || !model.inImage(*pixel)) continue;
-        const cv::Mat& body = calibration.bodyMask;
-        if (!body.empty() && body.at<std::uint8_t>(static_cast<int>(std::lround(pixel->y)),
-                                                   static_cast<int>(std::lround(pixel->x))) != 0) {
-          continue;
-        }
-        mapX.at<float>(y, x) = static_cast<float>(pixel->x);
-        mapY.at<float>(y, x) = static_cast<float>(pixel->y);
-        ++seen;
-      }
-    }
-    if (seen < kMinimumSeen * side * side) return std::nullopt;
+    // Patch rows run along -x of the vehicle, columns along -y: a top view, front up.
+    const auto sampling =
+        processing::groundSampling(rig.cameras[camera], {centre, kPatchPixelM, {side, side}});
+    if (sampling.seen < kMinimumSeen * side * side) return std::nullopt;
     cv::Mat grey;
     cv::cvtColor(frames[camera], grey, cv::COLOR_BGR2GRAY);
     cv::Mat patch;
-    cv::remap(grey, patch, mapX, mapY, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+    cv::remap(grey, patch, sampling.mapX, sampling.mapY, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+              cv::Scalar(0));
     patch.convertTo(patches[static_cast<std::size_t>(k)], CV_32F);
   }
   cv::Mat window;

@@ -1,5 +1,6 @@
 #include "tools/calibrate/calibrate_options.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 
@@ -82,45 +83,17 @@ it was and the command fails.
 
 ExtrinsicsOptions parseExtrinsics(std::span<const std::string_view> arguments) {
   ExtrinsicsOptions o;
-  parseOptions(
-      arguments,
-      {{"--rig", [&](auto v) { o.rig = std::string(v); }},
-       {"--camera", [&](auto v) { o.camera = std::string(v); }},
-       {"--image", [&](auto v) { o.image = std::string(v); }},
-       {"--markers", [&](auto v) { o.markers = std::string(v); }},
-       {"--points", [&](auto v) { o.points = std::string(v); }},
-       {"--out", [&](auto v) { o.out = std::string(v); }},
-       {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
-       {"--inlier-px",
-        [&](auto v) {
-          o.inlierPx = parseDouble("--inlier-px", v, 0.1, 100, "pixels from 0.1 to 100");
-        }},
-       {"--mat", [&](auto v) { o.mat = std::string(v); }},
-       {"--images", [&](auto v) { o.images = std::string(v); }},
-       {"--min-corners",
-        [&](auto v) {
-          o.limits.minCorners =
-              static_cast<int>(parseDouble("--min-corners", v, 6, 100000, "a count from 6"));
-        }},
-       {"--max-rms-px",
-        [&](auto v) {
-          o.limits.maxRmsPx = parseDouble("--max-rms-px", v, 0.01, 100, "pixels from 0.01 to 100");
-        }},
-       {"--max-shift-m",
-        [&](auto v) {
-          o.limits.maxShiftM =
-              parseDouble("--max-shift-m", v, 0.001, 100, "metres from 0.001 to 100");
-        }},
-       {"--max-turn-deg",
-        [&](auto v) {
-          o.limits.maxTurnDeg =
-              parseDouble("--max-turn-deg", v, 0.01, 180, "degrees from 0.01 to 180");
-        }},
-       {"--max-seam-cm",
-        [&](auto v) {
-          o.limits.maxSeamCm = parseDouble("--max-seam-cm", v, 0.01, 1000, "centimetres from 0.01");
-        }}},
-      {{"--update-rig", [&](auto) { o.updateRig = true; }}});
+  Handlers valued = matLimitHandlers(o.limits, o.inlierPx);
+  valued.merge(Handlers{{"--rig", [&](auto v) { o.rig = std::string(v); }},
+                        {"--camera", [&](auto v) { o.camera = std::string(v); }},
+                        {"--image", [&](auto v) { o.image = std::string(v); }},
+                        {"--markers", [&](auto v) { o.markers = std::string(v); }},
+                        {"--points", [&](auto v) { o.points = std::string(v); }},
+                        {"--out", [&](auto v) { o.out = std::string(v); }},
+                        {"--residuals", [&](auto v) { o.residuals = std::string(v); }},
+                        {"--mat", [&](auto v) { o.mat = std::string(v); }},
+                        {"--images", [&](auto v) { o.images = std::string(v); }}});
+  parseOptions(arguments, valued, {{"--update-rig", [&](auto) { o.updateRig = true; }}});
   if (o.rig.empty()) throw UsageError("--rig: missing (the rig file with the camera's lens)");
   if (o.mat) {
     if (!o.camera.empty() || !o.image.empty() || o.markers || o.points || o.residuals) {
@@ -160,6 +133,35 @@ bool asksForHelp(std::span<const std::string_view> arguments) {
 }
 
 }  // namespace
+
+Handlers matLimitHandlers(processing::MatLimits& limits, double& inlierPx) {
+  return {
+      {"--inlier-px",
+       [&](auto v) {
+         inlierPx = parseDouble("--inlier-px", v, 0.1, 100, "pixels from 0.1 to 100");
+       }},
+      {"--min-corners",
+       [&](auto v) {
+         limits.minCorners =
+             static_cast<int>(parseDouble("--min-corners", v, 6, 100000, "a count from 6"));
+       }},
+      {"--max-rms-px",
+       [&](auto v) {
+         limits.maxRmsPx = parseDouble("--max-rms-px", v, 0.01, 100, "pixels from 0.01 to 100");
+       }},
+      {"--max-shift-m",
+       [&](auto v) {
+         limits.maxShiftM = parseDouble("--max-shift-m", v, 0.001, 100, "metres from 0.001 to 100");
+       }},
+      {"--max-turn-deg",
+       [&](auto v) {
+         limits.maxTurnDeg =
+             parseDouble("--max-turn-deg", v, 0.01, 180, "degrees from 0.01 to 180");
+       }},
+      {"--max-seam-cm", [&](auto v) {
+         limits.maxSeamCm = parseDouble("--max-seam-cm", v, 0.01, 1000, "centimetres from 0.01");
+       }}};
+}
 
 double parseDouble(std::string_view option, std::string_view text, double min, double max,
                    std::string_view expected) {
@@ -216,7 +218,10 @@ Command parseArguments(std::span<const std::string_view> arguments) {
     return parseMask(rest);
   }
   if (subcommand == "guide") {
-    if (asksForHelp(rest)) return HelpRequest{fmt::format("{}\n{}", kGuideUsage, kUpdateRigUsage)};
+    if (asksForHelp(rest)) {
+      return HelpRequest{fmt::format("{}\n{}\n{}", kGuideUsage, kMatGuideUsage, kUpdateRigUsage)};
+    }
+    if (std::find(rest.begin(), rest.end(), "--mat") != rest.end()) return parseMatGuide(rest);
     return parseGuide(rest);
   }
   throw UsageError(
@@ -227,10 +232,11 @@ Command parseArguments(std::span<const std::string_view> arguments) {
 
 std::string usage() {
   return fmt::format(
-      "surround-calibrate: camera calibration for surroundd.\n\n{}\n{}\n{}\n{}\n{}\n{}\n"
+      "surround-calibrate: camera calibration for surroundd.\n\n{}\n{}\n{}\n{}\n{}\n{}\n{}\n"
       "exit status: 0 done, 1 calibration failed (too little in the images), 2 bad arguments or "
       "input files\n",
-      kIntrinsicsUsage, kGuideUsage, kExtrinsicsUsage, kUpdateRigUsage, kImportUsage, kMaskUsage);
+      kIntrinsicsUsage, kGuideUsage, kMatGuideUsage, kExtrinsicsUsage, kUpdateRigUsage,
+      kImportUsage, kMaskUsage);
 }
 
 }  // namespace surroundd::calibrate

@@ -21,6 +21,7 @@
 #include "tools/calibrate/guide_options.hpp"
 #include "tools/calibrate/import_options.hpp"
 #include "tools/calibrate/intrinsics_options.hpp"
+#include "tools/calibrate/mat_guide_options.hpp"
 
 namespace surroundd::calibrate {
 
@@ -56,8 +57,8 @@ struct HelpRequest {
   std::string text;
 };
 
-using Command = std::variant<IntrinsicsOptions, GuideOptions, ExtrinsicsOptions, ImportOptions,
-                             MaskOptions, HelpRequest>;
+using Command = std::variant<IntrinsicsOptions, GuideOptions, MatGuideOptions, ExtrinsicsOptions,
+                             ImportOptions, MaskOptions, HelpRequest>;
 
 // `arguments` excludes the program name. Throws UsageError.
 Command parseArguments(std::span<const std::string_view> arguments);
@@ -72,6 +73,13 @@ void parseOptions(std::span<const std::string_view> arguments, const Handlers& v
 // and `valued`/`flags` besides; `pictureFolder`: --images is required, otherwise refused.
 IntrinsicsOptions parseLensOptions(std::span<const std::string_view> arguments, Handlers valued,
                                    const Handlers& flags, bool pictureFolder);
+// The mat calibration's limits (--min-corners, --max-rms-px, --max-shift-m, --max-turn-deg,
+// --max-seam-cm) and --inlier-px, of extrinsics --mat and guide --mat.
+Handlers matLimitHandlers(processing::MatLimits& limits, double& inlierPx);
+// A guide's camera request and page: --size WxH (sets `sizeGiven`), --fps, --listen ADDR:PORT; of
+// guide and guide --mat. Defined in guide_options.cpp.
+Handlers cameraAndPageHandlers(cv::Size& size, bool& sizeGiven, double& fps, std::string& address,
+                               int& port);
 // A number in [min, max]; UsageError naming the option and `expected` otherwise.
 double parseDouble(std::string_view option, std::string_view text, double min, double max,
                    std::string_view expected);

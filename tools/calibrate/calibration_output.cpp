@@ -103,11 +103,15 @@ std::string headerOf(const std::string& text) {
   return header;
 }
 
-// The rig document again, with `comment` beside `key` of the camera named `camera`. Only the
-// path down to that camera is walked; every other node is emitted as it was read (its keys, their
-// order and flow or block style).
-std::string emitRig(const YAML::Node& document, const std::string& camera, const std::string& key,
-                    const std::string& comment) {
+// The rig document again, with `comment` beside `key` of each camera named in `cameras`. Only
+// the paths down to those cameras are walked; every other node is emitted as it was read (its
+// keys, their order and flow or block style).
+std::string emitRig(const YAML::Node& document, std::span<const std::string> cameras,
+                    const std::string& key, const std::string& comment) {
+  const auto edited = [&](const YAML::Node& entry) {
+    return entry.IsMap() && entry["name"] &&
+           std::ranges::find(cameras, entry["name"].Scalar()) != cameras.end();
+  };
   const auto styled = [](YAML::Emitter& out, const YAML::Node& node) {
     if (node.Style() == YAML::EmitterStyle::Flow) out << YAML::Flow;
   };
@@ -123,7 +127,7 @@ std::string emitRig(const YAML::Node& document, const std::string& camera, const
     styled(out, top.second);
     out << YAML::BeginSeq;
     for (const auto& entry : top.second) {
-      if (!entry.IsMap() || !entry["name"] || entry["name"].Scalar() != camera) {
+      if (!edited(entry)) {
         out << entry;
         continue;
       }
@@ -165,34 +169,48 @@ bool sameCalibration(const processing::CameraCalibration& a,
   return same;
 }
 
-// Replaces the `key` block (lens or mount) of one camera in a rig file with `fields`, editing the
-// YAML document itself so that every other key stays, and the file's header comment with it.
-// `change` makes the calibration the rig must read back to; a result that does not is refused.
-template <typename Change>
-void updateRig(const std::filesystem::path& rig, const std::string& camera, const std::string& key,
-               const Fields& fields, Change change, std::string_view comment) {
+// One camera's new `key` block: its fields as written, and the change they make to its
+// calibration (what the rig must read back to).
+struct RigEdit {
+  std::string camera;
+  Fields fields;
+  std::function<void(processing::CameraCalibration&)> change;
+};
+
+// Replaces the `key` block (lens or mount) of each edited camera in a rig file, editing the YAML
+// document itself so that every other key stays, and the file's header comment with it. All the
+// edits go into one file written beside and renamed: the rig takes all of them or none. A result
+// that does not read back to the changed calibrations is refused.
+void updateRig(const std::filesystem::path& rig, const std::string& key,
+               std::span<const RigEdit> edits, std::string_view comment) {
   const auto before = daemon::loadRigFile(rig);  // a rig that does not load is not edited
   auto expected = before;
-  const auto it = std::find_if(expected.begin(), expected.end(),
-                               [&](const auto& c) { return c.calibration.name == camera; });
-  if (it == expected.end()) rigCamera(rig, camera);  // throws the message naming the cameras
-  change(it->calibration);
+  std::vector<std::string> cameras;
+  cameras.reserve(edits.size());
+  for (const auto& edit : edits) {
+    const auto it = std::find_if(expected.begin(), expected.end(),
+                                 [&](const auto& c) { return c.calibration.name == edit.camera; });
+    if (it == expected.end()) rigCamera(rig, edit.camera);  // throws the message naming them
+    edit.change(it->calibration);
+    cameras.push_back(edit.camera);
+  }
 
   std::ifstream in(rig);
   const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   YAML::Node document = YAML::Load(text);
-  YAML::Node replacement = YAML::Load(block(key, "", fields))[key];
   for (auto entry : document["cameras"]) {
-    if (entry.IsMap() && entry["name"] && entry["name"].Scalar() == camera) {
-      entry[key] = replacement;
+    for (const auto& edit : edits) {
+      if (entry.IsMap() && entry["name"] && entry["name"].Scalar() == edit.camera) {
+        entry[key] = YAML::Load(block(key, "", edit.fields))[key];
+      }
     }
   }
-  // One line beside the block: yaml-cpp keeps no comment of the document, so this one is all the
+  // One line beside each block: yaml-cpp keeps no comment of the document, so this one is all the
   // record the rig has of where the values came from. The block is written in block style, so
   // that its values do not drop to the line below the comment as a flow map's would.
   std::string note(comment);
   std::ranges::replace(note, '\n', ' ');
-  const std::string updated = headerOf(text) + emitRig(document, camera, key, note);
+  const std::string updated = headerOf(text) + emitRig(document, cameras, key, note);
 
   writeAtomically(rig, updated, [&](const std::filesystem::path& written) {
     const auto refuse = [&](const std::string& why) {
@@ -255,16 +273,28 @@ void writeMountBlocks(const std::filesystem::path& file,
 
 void updateRigLens(const std::filesystem::path& rig, const std::string& camera,
                    const processing::Intrinsics& lens, std::string_view comment) {
-  updateRig(
-      rig, camera, "lens", lensFields(lens),
-      [&](processing::CameraCalibration& c) { c.intrinsics = lens; }, comment);
+  const RigEdit edit{camera, lensFields(lens),
+                     [&](processing::CameraCalibration& c) { c.intrinsics = lens; }};
+  updateRig(rig, "lens", {&edit, 1}, comment);
 }
 
 void updateRigMount(const std::filesystem::path& rig, const std::string& camera,
                     const processing::Pose& pose, std::string_view comment) {
-  updateRig(
-      rig, camera, "mount", mountFields(pose),
-      [&](processing::CameraCalibration& c) { c.pose = pose; }, comment);
+  const std::pair<std::string, processing::Pose> mount{camera, pose};
+  updateRigMounts(rig, {&mount, 1}, comment);
+}
+
+void updateRigMounts(const std::filesystem::path& rig,
+                     std::span<const std::pair<std::string, processing::Pose>> mounts,
+                     std::string_view comment) {
+  std::vector<RigEdit> edits;
+  edits.reserve(mounts.size());
+  for (const auto& mount : mounts) {
+    const processing::Pose& pose = mount.second;
+    edits.push_back({mount.first, mountFields(pose),
+                     [&pose](processing::CameraCalibration& c) { c.pose = pose; }});
+  }
+  updateRig(rig, "mount", edits, comment);
 }
 
 processing::CameraCalibration rigCamera(const std::filesystem::path& rig,

@@ -40,6 +40,11 @@ void updateRigLens(const std::filesystem::path& rig, const std::string& camera,
                    const processing::Intrinsics& lens, std::string_view comment);
 void updateRigMount(const std::filesystem::path& rig, const std::string& camera,
                     const processing::Pose& pose, std::string_view comment);
+// Several cameras' mounts in one edit of the rig file: it takes all of them or, when one cannot
+// be written, none (the file is replaced once, by rename).
+void updateRigMounts(const std::filesystem::path& rig,
+                     std::span<const std::pair<std::string, processing::Pose>> mounts,
+                     std::string_view comment);
 
 // The camera of that name in a rig file; UsageError listing the names when there is none.
 processing::CameraCalibration rigCamera(const std::filesystem::path& rig,

@@ -41,4 +41,29 @@ std::optional<std::filesystem::path> findPicture(const std::filesystem::path& fo
   return matches.front();
 }
 
+std::filesystem::path requirePicture(const std::filesystem::path& folder,
+                                     const std::string& camera) {
+  auto file = findPicture(folder, camera);
+  if (!file) {
+    throw UsageError(fmt::format(
+        "--images: {} holds no picture of camera '{}' (looked for {}.png, .jpg, .jpeg, .bmp, "
+        ".tif, .tiff)",
+        folder.string(), camera, camera));
+  }
+  return *file;
+}
+
+void checkPictureSize(const std::filesystem::path& file, cv::Size size,
+                      const processing::CameraCalibration& camera,
+                      const std::filesystem::path& rig) {
+  const cv::Size lens = camera.intrinsics.imageSize;
+  if (size != lens) {
+    throw UsageError(fmt::format(
+        "--images: {} is {}x{}, but camera '{}' in {} has a {}x{} lens; calibrate the intrinsics "
+        "at this resolution first",
+        file.string(), size.width, size.height, camera.name, rig.string(), lens.width,
+        lens.height));
+  }
+}
+
 }  // namespace surroundd::calibrate

@@ -1,48 +1,20 @@
 #include "tools/calibrate/guide_command.hpp"
 
-#include <atomic>
-#include <csignal>
-#include <thread>
-
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
-#include "capture/file_source.hpp"
-#include "capture/v4l2_source.hpp"
+#include "capture/source_recovery.hpp"
 #include "processing/calibration_error.hpp"
 #include "render/http_stream_sink.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 #include "tools/calibrate/calibration_output.hpp"
+#include "tools/calibrate/guide_io.hpp"
 #include "tools/calibrate/guide_page.hpp"
 #include "tools/calibrate/guide_session.hpp"
 #include "tools/calibrate/guide_state_json.hpp"
 
 namespace surroundd::calibrate {
 namespace {
-
-std::atomic<bool> stopRequested{false};
-extern "C" void onStopSignal(int /*signal*/) { stopRequested = true; }
-
-// A file that keeps failing is not a camera that may come back: after this many faults in a row
-// the replay counts as ended. A device is retried for ever (it reopens with backoff).
-constexpr int kFileFaultsToEnd = 30;
-
-std::unique_ptr<capture::FrameSource> openCamera(const GuideOptions& options) {
-  try {
-    if (options.device) {
-      capture::V4l2Settings settings;
-      settings.device = *options.device;
-      settings.size = options.size;
-      settings.fps = options.fps;
-      return std::make_unique<capture::V4l2Source>("guide", settings);
-    }
-    return std::make_unique<capture::FileSource>(
-        "guide", capture::FileSourceSettings{*options.file, options.fps, options.loop,
-                                             capture::Pacing::kRealtime});
-  } catch (const capture::CaptureError& error) {
-    throw UsageError(fmt::format("{}: {}", options.device ? "--device" : "--file", error.what()));
-  }
-}
 
 // The frame as the page shows it: kept views' outlines thin, the board found now with its corners
 // (green when kept, amber when not).
@@ -82,20 +54,13 @@ std::vector<std::string> writeLens(const GuideOptions& options, const GuideSessi
   return written;
 }
 
-// A recording is a session to watch: after its first frame it waits for the page to open (its
-// picture stream to be asked for: HttpStreamSink then wants frames again), so that the page sees
-// the session from its start. A poll: the sink has no call that waits.
-void waitForPage(const render::HttpStreamSink& page) {
-  while (!stopRequested && !page.wantsFrame({})) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-}
-
 }  // namespace
 
 void runGuide(const GuideOptions& options, std::ostream& log) {
   if (options.lens.updateRig) rigCamera(*options.lens.updateRig, options.lens.camera);
-  auto camera = openCamera(options);
+  auto camera = openGuideCamera(
+      "guide", {options.device, options.file, options.size, options.fps, options.loop},
+      options.device ? "--device" : "--file");
   GuideSettings settings;
   settings.board = options.lens.board;
   settings.model = options.lens.model;
@@ -104,39 +69,29 @@ void runGuide(const GuideOptions& options, std::ostream& log) {
   GuideSession session(settings);
   GuideRunState run;
 
-  render::HttpStreamSettings http;
-  http.address = options.address;
-  http.port = options.port;
-  http.page = guidePage();
-  http.statusPath = "/state.json";
-  try {
-    http.validate();
-  } catch (const std::invalid_argument& error) {
-    throw UsageError(fmt::format("--listen: {}", error.what()));
-  }
-  render::HttpStreamSink page(http);
+  const auto served = serveGuidePage(options.address, options.port, guidePage());
+  render::HttpStreamSink& page = *served;
   page.setStatus(guideStateJson(session, run));
   log << fmt::format("guide page: http://{}:{}/ (reading {}; Ctrl-C stops)\n", options.address,
                      page.port(), sourceName(options))
       << std::flush;
 
-  std::signal(SIGINT, onStopSignal);
-  std::signal(SIGTERM, onStopSignal);
+  stopOnSignals();
   capture::Frame frame;
   frame.image = cv::Mat(camera->frameSize(), CV_8UC3);
   cv::Mat gray;
   std::optional<capture::Timestamp> start;
-  int faults = 0;
   bool written = false;
-  while (!stopRequested && !run.ended) {
-    const auto status = camera->read(frame);
-    if (status == capture::ReadStatus::kEndOfStream ||
-        (status == capture::ReadStatus::kFault && options.file && ++faults >= kFileFaultsToEnd)) {
+  // The daemon's policy for every camera: faults counted and logged with rate limiting, a lost
+  // device reopened with backoff, for as long as the guide runs.
+  capture::SourceRecovery recovery("guide", {});
+  while (!stopRequested() && !run.ended) {
+    const auto status = recovery.read(*camera, frame, waitUnlessStopped);
+    if (status == capture::ReadStatus::kEndOfStream) {
       run.ended = true;
     } else if (status == capture::ReadStatus::kFault) {
       run.error = fmt::format("{}: {}", sourceName(options), camera->lastError());
     } else {
-      faults = 0;
       run.error.clear();
       if (!start) start = frame.timestamp;
       run.streamTime = frame.timestamp - *start;
@@ -172,9 +127,7 @@ void runGuide(const GuideOptions& options, std::ostream& log) {
     log << std::flush;
   }
   if (run.ended) log << "the recording ended; the page stays up until Ctrl-C\n" << std::flush;
-  // The page keeps showing the result until the user stops it. A poll, not a synchronisation:
-  // nothing waits on anything but the signal.
-  while (!stopRequested) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  waitForStop();
   page.finish({}, run.streamTime);
   if (!session.passed() || run.written.empty()) {
     throw processing::CalibrationError(

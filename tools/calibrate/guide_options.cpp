@@ -42,7 +42,7 @@ and shows GET /stream.mjpg.
 
 namespace {
 
-cv::Size parseSize(std::string_view text) {
+cv::Size parseFrameSize(std::string_view text) {
   int w = 0, h = 0;
   const auto x = text.find('x');
   const auto a = std::from_chars(text.data(), text.data() + std::min(x, text.size()), w);
@@ -55,36 +55,41 @@ cv::Size parseSize(std::string_view text) {
   return {w, h};
 }
 
+void parseListen(std::string_view text, std::string& address, int& port) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string_view::npos || colon == 0) {
+    throw UsageError(
+        fmt::format("--listen: expected ADDRESS:PORT (e.g. 127.0.0.1:8080), got '{}'", text));
+  }
+  address = std::string(text.substr(0, colon));
+  port = static_cast<int>(
+      parseDouble("--listen", text.substr(colon + 1), 0, 65535, "a port from 0 to 65535"));
+}
+
 }  // namespace
+
+Handlers cameraAndPageHandlers(cv::Size& size, bool& sizeGiven, double& fps, std::string& address,
+                               int& port) {
+  return {{"--size",
+           [&](auto v) {
+             size = parseFrameSize(v);
+             sizeGiven = true;
+           }},
+          {"--fps",
+           [&](auto v) {
+             fps = parseDouble("--fps", v, 0.1, 1000, "frames per second from 0.1 to 1000");
+           }},
+          {"--listen", [&](auto v) { parseListen(v, address, port); }}};
+}
 
 GuideOptions parseGuide(std::span<const std::string_view> arguments) {
   GuideOptions o;
   bool size = false;
-  o.lens = parseLensOptions(
-      arguments,
-      {{"--device", [&](auto v) { o.device = std::string(v); }},
-       {"--file", [&](auto v) { o.file = std::string(v); }},
-       {"--size",
-        [&](auto v) {
-          o.size = parseSize(v);
-          size = true;
-        }},
-       {"--fps",
-        [&](auto v) {
-          o.fps = parseDouble("--fps", v, 0.1, 1000, "frames per second from 0.1 to 1000");
-        }},
-       {"--listen",
-        [&](std::string_view v) {
-          const auto colon = v.rfind(':');
-          if (colon == std::string_view::npos || colon == 0) {
-            throw UsageError(
-                fmt::format("--listen: expected ADDRESS:PORT (e.g. 127.0.0.1:8080), got '{}'", v));
-          }
-          o.address = std::string(v.substr(0, colon));
-          o.port = static_cast<int>(
-              parseDouble("--listen", v.substr(colon + 1), 0, 65535, "a port from 0 to 65535"));
-        }}},
-      {{"--loop", [&](auto) { o.loop = true; }}}, false);
+  Handlers valued = cameraAndPageHandlers(o.size, size, o.fps, o.address, o.port);
+  valued.merge(Handlers{{"--device", [&](auto v) { o.device = std::string(v); }},
+                        {"--file", [&](auto v) { o.file = std::string(v); }}});
+  o.lens = parseLensOptions(arguments, std::move(valued),
+                            {{"--loop", [&](auto) { o.loop = true; }}}, false);
   if (o.device.has_value() == o.file.has_value()) {
     throw UsageError("--device or --file: give one camera (a V4L2 device, or a recording)");
   }

@@ -1,36 +1,66 @@
 #include "tools/calibrate/guide_page.hpp"
 
+#include <fmt/format.h>
+
 namespace surroundd::calibrate {
 
-std::string_view guidePage() {
-  return R"page(<!doctype html>
+std::string guidePageFrom(std::string_view title, std::string_view style, std::string_view body,
+                          std::string_view script) {
+  // The frame both pages share: a dark page, a header with #phase, #hints and the verdict in the
+  // same colours, and the poll of /state.json that hands each state to the page's show().
+  return fmt::format(R"page(<!doctype html>
 <html lang="en">
 <head>
 <meta charset="utf-8">
 <meta name="viewport" content="width=device-width, initial-scale=1">
-<title>surround-calibrate guide</title>
+<title>{}</title>
 <link rel="icon" href="data:,">
 <style>
-  :root { color-scheme: dark; font-family: system-ui, sans-serif; }
-  body { margin: 0; background: #111; color: #ddd; }
-  header { display: flex; gap: 1.5em; align-items: center; padding: .4em 1em; background: #222; }
-  h1 { font-size: 1.1em; margin: 0; }
-  main { display: grid; grid-template-columns: minmax(0, 3fr) minmax(16em, 1fr); gap: 1em;
+  :root {{ color-scheme: dark; font-family: system-ui, sans-serif; }}
+  body {{ margin: 0; background: #111; color: #ddd; }}
+  header {{ display: flex; gap: 1.5em; align-items: center; padding: .4em 1em; background: #222; }}
+  h1 {{ font-size: 1.1em; margin: 0; }}
+  h2 {{ font-size: 1em; margin: .8em 0 .3em; color: #aaa; }}
+  ul {{ margin: 0; padding-left: 1.2em; }}
+  #hints li {{ color: #fc6; }}
+  #verdict[data-state="pass"] {{ color: #6e6; font-weight: bold; }}
+  #verdict[data-state="fail"] {{ color: #f77; }}
+  #error {{ color: #f77; }}
+  #phase[data-phase="passed"] {{ color: #6e6; }}
+{}</style>
+</head>
+<body>
+{}<script>
+"use strict";
+const $ = (id) => document.getElementById(id);
+{}
+async function poll() {{
+  try {{
+    const response = await fetch("state.json", {{ cache: "no-store" }});
+    if (response.ok) show(await response.json());
+  }} catch (error) {{
+    $("phase").textContent = "no answer from surround-calibrate";
+  }}
+  setTimeout(poll, 300);
+}}
+poll();
+</script>
+</body>
+</html>
+)page",
+                     title, style, body, script);
+}
+
+std::string_view guidePage() {
+  static const std::string kPage = guidePageFrom(
+      "surround-calibrate guide",
+      R"style(  main { display: grid; grid-template-columns: minmax(0, 3fr) minmax(16em, 1fr); gap: 1em;
          padding: 1em; }
   #live { width: 100%; background: #000; display: block; }
   #coverage { width: 100%; background: #000; display: block; margin-top: .5em; }
-  h2 { font-size: 1em; margin: .8em 0 .3em; color: #aaa; }
-  ul { margin: 0; padding-left: 1.2em; }
-  #hints li { color: #fc6; }
   #views li { font-size: .9em; }
-  #verdict[data-state="pass"] { color: #6e6; font-weight: bold; }
-  #verdict[data-state="fail"] { color: #f77; }
-  #error { color: #f77; }
-  #phase[data-phase="passed"] { color: #6e6; }
-</style>
-</head>
-<body>
-<header><h1>Guided calibration</h1><span id="board"></span><span id="phase" data-phase="">
+)style",
+      R"body(<header><h1>Guided calibration</h1><span id="board"></span><span id="phase" data-phase="">
 connecting&hellip;</span><span id="progress"></span></header>
 <main>
 <section>
@@ -45,10 +75,8 @@ connecting&hellip;</span><span id="progress"></span></header>
   <h2>Views kept</h2><ol id="views"></ol>
 </aside>
 </main>
-<script>
-"use strict";
-const $ = (id) => document.getElementById(id);
-const colours = ["#4c8", "#48c", "#c84", "#c4c", "#8c4", "#4cc", "#cc4", "#84c"];
+)body",
+      R"script(const colours = ["#4c8", "#48c", "#c84", "#c4c", "#8c4", "#4cc", "#cc4", "#84c"];
 
 function list(element, items, text) {
   element.replaceChildren(...items.map((item) => {
@@ -113,20 +141,8 @@ function show(state) {
   drawCoverage(state);
 }
 
-async function poll() {
-  try {
-    const response = await fetch("state.json", { cache: "no-store" });
-    if (response.ok) show(await response.json());
-  } catch (error) {
-    $("phase").textContent = "no answer from surround-calibrate";
-  }
-  setTimeout(poll, 300);
-}
-poll();
-</script>
-</body>
-</html>
-)page";
+)script");
+  return kPage;
 }
 
 }  // namespace surroundd::calibrate

@@ -5,10 +5,16 @@
 // #coverage (a canvas; data-covered is the covered share in percent), #hints (one li each),
 // #verdict (data-state none / pass / fail), #written, #error.
 
+#include <string>
 #include <string_view>
 
 namespace surroundd::calibrate {
 
 std::string_view guidePage();
+
+// A guide page: `style` (CSS rules), `body` (HTML) and `script` (JavaScript defining show(state),
+// which the page calls with each /state.json) in the frame both guide pages share.
+std::string guidePageFrom(std::string_view title, std::string_view style, std::string_view body,
+                          std::string_view script);
 
 }  // namespace surroundd::calibrate

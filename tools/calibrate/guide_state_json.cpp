@@ -8,12 +8,6 @@ namespace {
 
 double seconds(std::chrono::nanoseconds t) { return std::chrono::duration<double>(t).count(); }
 
-std::string stringArray(const std::vector<std::string>& items) {
-  std::string json = "[";
-  for (std::size_t i = 0; i < items.size(); ++i) json += (i ? ", " : "") + jsonString(items[i]);
-  return json + "]";
-}
-
 const char* outcomeName(FrameOutcome outcome) {
   switch (outcome) {
     case FrameOutcome::kAccepted:
@@ -63,8 +57,8 @@ std::string verdictJson(const GuideSolve& solve) {
   return fmt::format(
       R"({{"passed": {}, "failures": {}, "rmsPx": {:.4f}, "fx": {:.3f}, "fy": {:.3f}, )"
       R"("cx": {:.3f}, "cy": {:.3f}, "views": {}, "leftOut": {}, "fieldOfViewDeg": {:.1f}}})",
-      solve.verdict.passed, stringArray(solve.verdict.failures), solve.result.rmsPx, lens.fx,
-      lens.fy, lens.cx, lens.cy, solve.result.views.size(), stringArray(solve.leftOut),
+      solve.verdict.passed, jsonStringArray(solve.verdict.failures), solve.result.rmsPx, lens.fx,
+      lens.fy, lens.cx, lens.cy, solve.result.views.size(), jsonStringArray(solve.leftOut),
       solve.field.fullDeg);
 }
 
@@ -83,6 +77,12 @@ std::string jsonString(std::string_view text) {
     }
   }
   return json + "\"";
+}
+
+std::string jsonStringArray(const std::vector<std::string>& items) {
+  std::string json = "[";
+  for (std::size_t i = 0; i < items.size(); ++i) json += (i ? ", " : "") + jsonString(items[i]);
+  return json + "]";
 }
 
 std::string guideStateJson(const GuideSession& session, const GuideRunState& run) {
@@ -109,10 +109,10 @@ std::string guideStateJson(const GuideSession& session, const GuideRunState& run
       seconds(run.streamTime), views,
       session.imageSize().area() > 0 ? coverageJson(session.coverage(), settings.limits.minCoverage)
                                      : "null",
-      settings.limits.minViews, stringArray(session.hints()), outcomeName(run.last.outcome),
+      settings.limits.minViews, jsonStringArray(session.hints()), outcomeName(run.last.outcome),
       jsonString(run.last.note), solve ? verdictJson(*solve) : "null",
       session.passed() ? fmt::format("{:.3f}", seconds(session.passedAt())) : "null",
-      stringArray(run.written), jsonString(run.error));
+      jsonStringArray(run.written), jsonString(run.error));
 }
 
 }  // namespace surroundd::calibrate

@@ -34,5 +34,7 @@ std::string guideStateJson(const GuideSession& session, const GuideRunState& run
 
 // `text` as a JSON string, quotes included.
 std::string jsonString(std::string_view text);
+// `items` as a JSON array of strings.
+std::string jsonStringArray(const std::vector<std::string>& items);
 
 }  // namespace surroundd::calibrate

@@ -16,6 +16,7 @@
 #include "tools/calibrate/import_command.hpp"
 #include "tools/calibrate/intrinsics_command.hpp"
 #include "tools/calibrate/mask_command.hpp"
+#include "tools/calibrate/mat_guide_command.hpp"
 
 namespace {
 
@@ -35,6 +36,8 @@ int run(const std::vector<std::string_view>& arguments) {
       runIntrinsics(*intrinsics, std::cout);
     } else if (const auto* guide = std::get_if<GuideOptions>(&command)) {
       runGuide(*guide, std::cout);
+    } else if (const auto* matGuide = std::get_if<MatGuideOptions>(&command)) {
+      runMatGuide(*matGuide, std::cout);
     } else if (const auto* import = std::get_if<ImportOptions>(&command)) {
       runImport(*import, std::cout);
     } else if (const auto* mask = std::get_if<MaskOptions>(&command)) {

@@ -161,4 +161,13 @@ std::string matYaml(const processing::MatLayout& mat, std::string_view comment) 
   return std::string(out.c_str()) + "\n";
 }
 
+processing::Pose mountMeasuredByHand(const processing::Pose& truth) {
+  processing::Pose pose = truth;
+  pose.position += cv::Vec3d(0.04, -0.03, 0.05);
+  const auto angles = processing::mountAnglesFromRotation(truth.rotation);
+  pose.rotation = processing::rotationFromMountAngles(
+      {angles.yawDeg + 2.0, angles.pitchDeg - 1.5, angles.rollDeg + 1.0});
+  return pose;
+}
+
 }  // namespace surroundd::synth

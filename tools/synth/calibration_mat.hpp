@@ -29,6 +29,11 @@ processing::MatLayout groundMatAroundRig(std::span<const processing::CameraCalib
 // The mat's prints as ground markers, for the renderer.
 processing::MarkerLayout printsOf(const processing::MatLayout& mat);
 
+// A mount a few centimetres and degrees off `truth` (4, -3, 5 cm; yaw +2, pitch -1.5, roll +1
+// degrees): what a rig file says before calibration, as measured by hand. The mat calibration
+// starts from it and must find `truth`.
+processing::Pose mountMeasuredByHand(const processing::Pose& truth);
+
 // The layout as surround-calibrate extrinsics --mat reads it (tools/calibrate/marker_file.hpp),
 // `comment` on top.
 std::string matYaml(const processing::MatLayout& mat, std::string_view comment);

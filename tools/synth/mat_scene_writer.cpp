@@ -56,13 +56,20 @@ void writeMatScene(const SynthOptions& options, std::ostream& log) {
                        fmt::format("Written by surround-synth from {} (seed {}): the exact "
                                    "calibration of the cameras that took the mat's pictures.",
                                    options.rig.filename().string(), options.seed));
+  // The rig as its user has it before calibrating: the same lenses, the mounts measured by hand.
+  for (auto& camera : rig) camera.calibration.pose = mountMeasuredByHand(camera.calibration.pose);
+  daemon::writeRigFile(
+      options.out / "nominal-rig.yaml", rig,
+      "Written by surround-synth: the rig.yaml of these pictures with each mount a "
+      "few centimetres and degrees off, as measured by hand before calibration.");
   std::ofstream(options.out / "mat.yaml")
       << matYaml(mat, fmt::format("The calibration mat surround-synth laid around {}: board "
                                   "centres and yaws on the ground, vehicle frame (x forward, y "
                                   "left, metres).",
                                   options.rig.filename().string()));
-  log << fmt::format("wrote {}: {} pictures of a mat of {} boards, mat.yaml, rig.yaml\n",
-                     options.out.string(), plan.cameras.size(), mat.boards.size());
+  log << fmt::format(
+      "wrote {}: {} pictures of a mat of {} boards, mat.yaml, rig.yaml, nominal-rig.yaml\n",
+      options.out.string(), plan.cameras.size(), mat.boards.size());
 }
 
 }  // namespace surroundd::synth

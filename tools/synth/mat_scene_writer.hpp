@@ -2,7 +2,8 @@
 // surround-synth --calibration-mat: what a calibration session on a production line gives, with
 // the truth. Writes into --out one picture per camera of a calibration mat laid around the rig
 // (NAME.png, rendered with TargetRenderer through the camera's lens and photometrics), the mat's
-// layout (mat.yaml) and the rig that rendered them (rig.yaml, the exact poses).
+// layout (mat.yaml), the rig that rendered them (rig.yaml, the exact poses) and the same rig with
+// each mount a few centimetres and degrees off (nominal-rig.yaml, where a calibration starts).
 
 #include <ostream>
 

@@ -1,0 +1,34 @@
+// The `display` output: a screen driven through DRM/KMS (render::DrmDisplaySink), whose page flips
+// wait for vblank on a thread of their own behind a queue.
+#include "daemon/built_in_outputs.hpp"
+#include "render/drm_display_sink.hpp"
+
+namespace surroundd::daemon {
+namespace {
+
+// A screen shows the newest picture: one may wait for the next vblank.
+constexpr std::size_t kDisplayQueue = 1;
+
+void readDisplay(YamlObject& item, OutputConfig& o) {
+  o.device = item.string("device", "");
+  o.connector = item.string("connector", o.connector);
+}
+
+std::unique_ptr<render::FrameSink> openDisplay(const OutputConfig& output,
+                                               const OutputContext& context) {
+  return queuedSink(std::make_unique<render::DrmDisplaySink>(
+                        render::DrmDisplaySettings{output.device, output.connector}),
+                    context, kDisplayQueue);
+}
+
+}  // namespace
+
+OutputType displayOutputType() {
+  OutputType type;
+  type.name = "display";
+  type.readSettings = readDisplay;
+  type.openPictureSink = openDisplay;
+  return type;
+}
+
+}  // namespace surroundd::daemon

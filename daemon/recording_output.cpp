@@ -1,0 +1,47 @@
+// The `recording` output: every camera's own stream into a folder, with a rig file that replays
+// it (RigRecorder).
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "daemon/built_in_outputs.hpp"
+#include "daemon/rig_recorder.hpp"
+
+namespace surroundd::daemon {
+namespace {
+
+void readRecording(YamlObject& item, OutputConfig& o) {
+  o.path = item.outputPath("path").value_or("");
+  if (item.has("stream")) {
+    item.error("stream", "a recording writes every camera's own stream; it takes no 'stream'");
+  }
+  o.lossless = item.boolean("lossless", o.lossless);
+  o.crf = item.integer("crf", o.crf, 0, 51);
+  std::error_code ec;
+  if (!o.path.empty() && std::filesystem::exists(o.path, ec) &&
+      !std::filesystem::is_directory(o.path, ec)) {
+    item.error("path", fmt::format("expected a folder for the recording, got the file '{}'",
+                                   o.path.string()));
+  }
+}
+
+std::unique_ptr<CameraFramesSink> openRecording(const OutputConfig& output,
+                                                const OutputContext& context) {
+  return std::make_unique<RigRecorder>(
+      RecordingSettings{output.path, output.lossless, output.crf, output.preset}, *context.cameras,
+      context.nominalFps);
+}
+
+}  // namespace
+
+OutputType recordingOutputType() {
+  OutputType type;
+  type.name = "recording";
+  type.input = OutputInput::kCameraFrames;
+  type.readSettings = readRecording;
+  type.pathUse = [](const OutputConfig&) { return OutputPathUse::kFolder; };
+  type.openCameraFramesSink = openRecording;
+  return type;
+}
+
+}  // namespace surroundd::daemon

@@ -1,0 +1,22 @@
+// Built instead of guide_command.cpp and mat_guide_command.cpp where SURROUNDD_WITH_HTTP is off: the guide's page needs the
+// HTTP server.
+#include <stdexcept>
+
+#include "tools/calibrate/guide_command.hpp"
+#include "tools/calibrate/mat_guide_command.hpp"
+
+namespace surroundd::calibrate {
+namespace {
+
+[[noreturn]] void refuse() {
+  throw std::runtime_error(
+      "surround-calibrate guide: this build has no HTTP server for its page (configure with "
+      "-DSURROUNDD_WITH_HTTP=ON; needs libmicrohttpd-dev and libturbojpeg0-dev)");
+}
+
+}  // namespace
+
+void runGuide(const GuideOptions& /*options*/, std::ostream& /*log*/) { refuse(); }
+void runMatGuide(const MatGuideOptions& /*options*/, std::ostream& /*log*/) { refuse(); }
+
+}  // namespace surroundd::calibrate
