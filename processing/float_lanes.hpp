@@ -1,8 +1,10 @@
 #pragma once
 // Four floats (or two doubles) per operation, through the GCC/Clang vector extensions, for the
 // Poisson solvers' loops over grid rows. The project builds with -O2, where GCC 12 does not
-// vectorize loops; these lower to SSE2 on x86-64 and NEON on AArch64 from one source. Loads and
-// stores go through memcpy: any alignment, no aliasing questions.
+// vectorize loops; these lower to SSE2 on x86-64 and NEON on AArch64 from one source, with the
+// same results on both: each lane is rounded as the scalar operation is, and -ffp-contract=off
+// (CMakeLists.txt) keeps AArch64 from fusing a * b + c. Loads and stores go through memcpy: any
+// alignment, no aliasing questions.
 
 #include <cstring>
 
