@@ -79,7 +79,11 @@ Stitcher::Stitcher(const PanoramaLut& lut, WorkPool& pool)
   }
 }
 
-void Stitcher::stitch(std::span<const cv::Mat> frames, cv::Mat& panorama) {
+void Stitcher::stitch(std::span<const cv::Mat> frames, cv::Mat& panorama, KernelPath path) {
+  if (!kernelPathBuilt(path)) {
+    throw std::invalid_argument(
+        fmt::format("stitch: this build has no {} kernels", kernelPathName(path)));
+  }
   if (frames.size() != lut_.cameraSizes.size()) {
     throw std::invalid_argument(fmt::format("stitch: {} frames for a LUT of {} cameras",
                                             frames.size(), lut_.cameraSizes.size()));
@@ -96,11 +100,16 @@ void Stitcher::stitch(std::span<const cv::Mat> frames, cv::Mat& panorama) {
   }
   panorama.create(lut_.size, CV_8UC3);
   // Chunks of rows, several per thread: rows cost unevenly (blend bands, memory locality).
+  auto rows = &Stitcher::stitchRows<KernelPath::kPortable>;
+#if defined(__SSE2__)
+  if (path == KernelPath::kSse2) rows = &Stitcher::stitchRows<KernelPath::kSse2>;
+#endif
   pool_.parallelFor(
-      lut_.size.height, [&](int first, int last) { stitchRows(first, last, panorama); },
+      lut_.size.height, [&](int first, int last) { (this->*rows)(first, last, panorama); },
       pool_.threads() * 8);
 }
 
+template <KernelPath kPath>
 void Stitcher::stitchRows(int first, int last, cv::Mat& panorama) const {
   // Locals, not members: stores through the byte pointer `row` could alias any member, which
   // would make the compiler reload them for every pixel.
@@ -119,37 +128,39 @@ void Stitcher::stitchRows(int first, int last, cv::Mat& panorama) const {
     const int spillEnd = end == width ? width - 1 : end;
     int u = begin;
 #if defined(__SSE2__)
-    for (; u + 2 <= spillEnd; u += 2) {
-      // The source pixels of a panorama row lie along a curve through the camera image that the
-      // hardware prefetcher does not follow: ask for them ahead (measured: a third faster at
-      // 1080p; per pixel beats once per cache line, which needs a branch or misses lines).
-      for (int k = 0; k < 2; ++k) {
-        if (u + k + kPrefetchAhead < end) {
-          const LutTap ahead = taps[u + k + kPrefetchAhead];
-          const std::uint8_t* at =
-              sources[ahead.camera] + static_cast<std::size_t>(ahead.offset) * 3;
-          __builtin_prefetch(at);
-          __builtin_prefetch(at + rowBytes[ahead.camera]);
+    if constexpr (kPath == KernelPath::kSse2) {
+      for (; u + 2 <= spillEnd; u += 2) {
+        // The source pixels of a panorama row lie along a curve through the camera image that the
+        // hardware prefetcher does not follow: ask for them ahead (measured: a third faster at
+        // 1080p; per pixel beats once per cache line, which needs a branch or misses lines).
+        for (int k = 0; k < 2; ++k) {
+          if (u + k + kPrefetchAhead < end) {
+            const LutTap ahead = taps[u + k + kPrefetchAhead];
+            const std::uint8_t* at =
+                sources[ahead.camera] + static_cast<std::size_t>(ahead.offset) * 3;
+            __builtin_prefetch(at);
+            __builtin_prefetch(at + rowBytes[ahead.camera]);
+          }
         }
+        const LutTap a = taps[u];
+        const LutTap b = taps[u + 1];
+        const std::uint64_t pair = bilinearPair(sources[a.camera], rowBytes[a.camera], a,
+                                                sources[b.camera], rowBytes[b.camera], b);
+        const auto left = static_cast<std::uint32_t>(pair);
+        const auto right = static_cast<std::uint32_t>(pair >> 32);
+        std::memcpy(out(u), &left, 4);
+        std::memcpy(out(u + 1), &right, 4);
       }
-      const LutTap a = taps[u];
-      const LutTap b = taps[u + 1];
-      const std::uint64_t pair = bilinearPair(sources[a.camera], rowBytes[a.camera], a,
-                                              sources[b.camera], rowBytes[b.camera], b);
-      const auto left = static_cast<std::uint32_t>(pair);
-      const auto right = static_cast<std::uint32_t>(pair >> 32);
-      std::memcpy(out(u), &left, 4);
-      std::memcpy(out(u + 1), &right, 4);
     }
 #endif
     for (; u < spillEnd; ++u) {
       const LutTap tap = taps[u];
-      const std::uint32_t value = bilinear(sources[tap.camera], rowBytes[tap.camera], tap);
+      const std::uint32_t value = bilinear<kPath>(sources[tap.camera], rowBytes[tap.camera], tap);
       std::memcpy(out(u), &value, 4);
     }
     if (end == width && begin < end) {
       const LutTap tap = taps[width - 1];
-      const std::uint32_t value = bilinear(sources[tap.camera], rowBytes[tap.camera], tap);
+      const std::uint32_t value = bilinear<kPath>(sources[tap.camera], rowBytes[tap.camera], tap);
       std::memcpy(out(width - 1), &value, 3);
     }
     // What no camera sees, on either side of the span (whole rows above the cameras' view).
@@ -160,7 +171,7 @@ void Stitcher::stitchRows(int first, int last, cv::Mat& panorama) const {
     for (std::uint32_t b = lut_.blendRowBegin[v]; b < lut_.blendRowBegin[v + 1]; ++b) {
       const BlendTap& blend = lut_.blendTaps[b];
       const std::uint32_t other =
-          bilinear(sources[blend.tap.camera], rowBytes[blend.tap.camera], blend.tap);
+          bilinear<kPath>(sources[blend.tap.camera], rowBytes[blend.tap.camera], blend.tap);
       std::uint8_t* pixel = out(static_cast<int>(blend.pixel - rowFirstPixel));
       const std::uint32_t w = blend.tap.weight;
       for (int c = 0; c < 3; ++c) {
