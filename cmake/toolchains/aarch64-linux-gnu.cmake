@@ -1,7 +1,8 @@
 # Cross build for arm64 (aarch64) Linux with Debian's cross compiler (crossbuild-essential-arm64)
 # against a sysroot of Debian's arm64 packages: scripts/cross-arm64.sh makes one and passes it as
 # SURROUNDD_SYSROOT. Test programs run under qemu-user (qemu-user-static), which ctest and
-# gtest_discover_tests put in front of them.
+# gtest_discover_tests put in front of them, and testing::ChildProcess in front of the project's
+# programs that a test starts (tests/support/child_process.hpp).
 set(CMAKE_SYSTEM_NAME Linux)
 set(CMAKE_SYSTEM_PROCESSOR aarch64)
 
@@ -18,13 +19,16 @@ list(APPEND CMAKE_TRY_COMPILE_PLATFORM_VARIABLES SURROUNDD_SYSROOT)
 set(CMAKE_SYSROOT "${SURROUNDD_SYSROOT}")
 set(CMAKE_C_COMPILER aarch64-linux-gnu-gcc)
 set(CMAKE_CXX_COMPILER aarch64-linux-gnu-g++)
-set(CMAKE_CROSSCOMPILING_EMULATOR qemu-aarch64-static -L "${SURROUNDD_SYSROOT}")
 
 # Programs from the build machine, everything else from the sysroot only.
 set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
 set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
 set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)
 set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)
+
+# By its full path: tests start the project's programs through it with execv (no PATH search).
+find_program(SURROUNDD_QEMU_AARCH64 qemu-aarch64-static REQUIRED)
+set(CMAKE_CROSSCOMPILING_EMULATOR "${SURROUNDD_QEMU_AARCH64}" -L "${SURROUNDD_SYSROOT}")
 
 # pkg-config reads the sysroot's .pc files and prefixes their paths with it.
 set(ENV{PKG_CONFIG_DIR} "")
