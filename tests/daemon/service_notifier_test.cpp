@@ -67,10 +67,12 @@ TEST_F(ServiceNotifierTest, PingsTheWatchdogOnlyWhileFrameSetsKeepComing) {
   EXPECT_EQ(pingsIn(9000, 10000, true), 2);
 }
 
-// Every message until STOPPING=1, or until nothing comes for 2.5 s.
+// Every message until STOPPING=1, or until nothing comes for 2.5 s; the first (READY=1, once the
+// first frame set is through) may take up to 60 s, as under an emulator (scripts/cross-arm64.sh).
+// A reader that gave up early would leave surroundd blocked on a full socket.
 std::vector<std::string> messagesUntilStopping(testing::NotifySocket& socket) {
   std::vector<std::string> all;
-  for (int idle = 0; idle < 50;) {
+  for (int idle = 0; idle < (all.empty() ? 1200 : 50);) {
     const auto message = socket.receive();
     if (!message) {
       ++idle;
