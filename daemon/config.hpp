@@ -36,6 +36,9 @@ struct CaptureConfig {
   // drop its oldest picture): auto = only with live cameras; always also for replays (to see a
   // replay as a live rig would show it), never keeps every set.
   enum class LatestWins { kAuto, kAlways, kNever } latestWins = LatestWins::kAuto;
+  // The memory, in MiB (2^20 bytes), that the frames of every preloaded camera (`preload: true`)
+  // may take together; a camera that would go past it is refused at start, naming it.
+  int preloadMaxMb = 2048;
   // How every camera, whatever its kind, recovers from faults (capture/source_recovery.hpp):
   // reopening backoff, giving up, and how often repeated faults are logged.
   capture::RecoverySettings recovery;

@@ -80,6 +80,7 @@ void readCapture(YamlObject& section, CaptureConfig& c) {
                                 {{"auto", LatestWins::kAuto},
                                  {"always", LatestWins::kAlways},
                                  {"never", LatestWins::kNever}});
+  c.preloadMaxMb = section.integer("preload_max_mb", c.preloadMaxMb, 1, 1 << 20);
   auto& r = c.recovery;
   r.firstBackoff = std::chrono::milliseconds(
       section.integer("reopen_backoff_ms", static_cast<int>(r.firstBackoff.count()), 1, 60'000));

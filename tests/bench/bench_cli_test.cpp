@@ -12,6 +12,7 @@
 namespace surroundd {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 
 const std::string kRecording = std::string(SURROUNDD_FIXTURE_DIR) + "/synth_small";
@@ -68,6 +69,31 @@ TEST(BenchCli, PipelineReportsFrameRatesStagesAndTheBaselineAsJson) {
   EXPECT_GT(input["peak_mb"].as<double>(), 10);
 }
 
+// --input raw: the recording is preloaded as a camera's frames, and the capture threads' work per
+// frame is the conversion to BGR; the report says so, and every set still comes out.
+TEST(BenchCli, PipelineOnRawFramesSaysSoAndReportsTheConversion) {
+  const testing::TempDir dir;
+  testing::ChildProcess bench(
+      {SURROUND_BENCH, "pipeline", "--json", "--repeats", "1", "--size", "320x240", "--view", "top",
+       "--input", "raw", "--raw-format", "nv12", kRecording},
+      dir / "log.txt", {}, dir / "out.json");
+  ASSERT_EQ(bench.wait(), 0) << bench.output();
+  const YAML::Node report = YAML::Load(bench.standardOutput())["pipeline"];
+  EXPECT_EQ(report["input"].as<std::string>(), "raw-nv12");
+  const YAML::Node input = report["inputs"][0];
+  EXPECT_EQ(input["frame_sets"].as<int>(), 30);
+  EXPECT_GT(input["ms"]["convert"].as<double>(), 0);
+  EXPECT_FALSE(input["ms"]["decode"]);
+  EXPECT_NEAR(input["ratio"].as<double>(),
+              input["fps"].as<double>() / input["baseline_fps"].as<double>(), 1e-3);
+
+  testing::ChildProcess text({SURROUND_BENCH, "pipeline", "--repeats", "1", "--size", "320x240",
+                              "--view", "top", "--input", "raw", kRecording},
+                             dir / "text.txt");
+  ASSERT_EQ(text.wait(), 0) << text.output();
+  EXPECT_THAT(text.output(), AllOf(HasSubstr("input: raw-yuyv"), HasSubstr("convert+sync")));
+}
+
 TEST(BenchCli, BadCommandLinesAreUsageErrors) {
   const testing::TempDir dir;
   for (const auto& [arguments, message] :
@@ -78,6 +104,13 @@ TEST(BenchCli, BadCommandLinesAreUsageErrors) {
                   "--view needs top, 360, orbit or split"},
         std::pair{std::vector<std::string>{"pipeline", "--size", "641x480", kRecording},
                   "--size needs an even WIDTHxHEIGHT"},
+        std::pair{std::vector<std::string>{"pipeline", "--input", "h264", kRecording},
+                  "--input needs decode or raw"},
+        std::pair{std::vector<std::string>{"pipeline", "--input", "raw", "--raw-format", "uyvy",
+                                           kRecording},
+                  "--raw-format needs yuyv or nv12"},
+        std::pair{std::vector<std::string>{"pipeline", "--raw-format", "nv12", kRecording},
+                  "--raw-format goes with --input raw"},
         std::pair{std::vector<std::string>{"stitch", "--threads", "0", kRecording},
                   "--threads needs a number from 1 to 256"},
         std::pair{std::vector<std::string>{"stitch", "--fast", kRecording},

@@ -39,7 +39,7 @@ struct RecordingFigures {
   cv::Size panorama;
   RunFigures full;         // the run of median frame rate
   double baselineFps = 0;  // median
-  double decodeMs = 0;     // per camera frame, in the capture threads
+  double decodeMs = 0;     // per camera frame, in the capture threads: decode or raw conversion
 };
 
 double cpuSecondsSoFar() {
@@ -88,6 +88,9 @@ daemon::Config configFor(const std::filesystem::path& folder, const RecordingTru
   config.panorama.projection = options.projection;
   config.panorama.cacheDir = scratch / "lut-cache";
   config.colour.poisson.solver = options.solver;
+  if (options.input == BenchInput::kRaw) {
+    for (auto& camera : config.cameras) camera.preload = options.rawFormat;
+  }
   config.render.view = options.view;
   config.render.widthPx = options.outputSize.width;
   config.render.heightPx = options.outputSize.height;
@@ -150,6 +153,16 @@ constexpr std::array kStages{daemon::Stage::kSync,     daemon::Stage::kStitch,
                              daemon::Stage::kCorrect,  daemon::Stage::kRender,
                              daemon::Stage::kReadBack, daemon::Stage::kOutput};
 
+// The input's name in the report ("decode", "raw-yuyv", "raw-nv12") and what the capture threads
+// do per camera frame.
+std::string inputName(const PipelineBenchmarkOptions& options) {
+  if (options.input == BenchInput::kDecode) return "decode";
+  return options.rawFormat == capture::PixelLayout::kNv12 ? "raw-nv12" : "raw-yuyv";
+}
+const char* captureWork(const PipelineBenchmarkOptions& options) {
+  return options.input == BenchInput::kDecode ? "decode" : "convert";
+}
+
 void printText(const std::vector<RecordingFigures>& all, const PipelineBenchmarkOptions& options,
                int cores) {
   const auto& first = all.front().full.summary;
@@ -161,8 +174,16 @@ void printText(const std::vector<RecordingFigures>& all, const PipelineBenchmark
       processing::poissonSolverName(options.solver), render::toString(options.view),
       options.outputSize.width, options.outputSize.height, options.threads, cores, first.renderer,
       options.repeats);
-  fmt::print("{:<26} {:>7} {:>13} {:>7} {:>6} {:>8}\n", "input -> panorama", "FPS", "decode+sync",
-             "ratio", "CPU %", "peak MB");
+  if (options.input == BenchInput::kDecode) {
+    fmt::print("input: decode (each camera's H.264 video decoded as it plays)\n");
+  } else {
+    fmt::print(
+        "input: {} (each recording decoded once at start into memory as {} frames, converted to "
+        "BGR per frame as a V4L2 camera's are; peak MB includes them)\n",
+        inputName(options), capture::toString(options.rawFormat));
+  }
+  fmt::print("{:<26} {:>7} {:>13} {:>7} {:>6} {:>8}\n", "input -> panorama", "FPS",
+             fmt::format("{}+sync", captureWork(options)), "ratio", "CPU %", "peak MB");
   for (const auto& r : all) {
     fmt::print("{:<26} {:>7.1f} {:>9.1f} FPS {:>6.2f}x {:>6.0f} {:>8.0f}\n",
                fmt::format("4x{}x{} -> {}x{}", r.camera.width, r.camera.height, r.panorama.width,
@@ -171,9 +192,9 @@ void printText(const std::vector<RecordingFigures>& all, const PipelineBenchmark
                r.full.peakMegabytes);
   }
   fmt::print(
-      "\nmilliseconds per frame set (pipeline thread; decode runs in parallel, one thread "
-      "per camera, and is per camera frame)\n{:<8} {:>7}",
-      "input", "decode");
+      "\nmilliseconds per frame set (pipeline thread; {0} runs in parallel, one thread "
+      "per camera, and is per camera frame)\n{1:<8} {0:>7}",
+      captureWork(options), "input");
   for (const auto stage : kStages) fmt::print(" {:>9}", daemon::toString(stage));
   fmt::print("\n");
   for (const auto& r : all) {
@@ -182,27 +203,28 @@ void printText(const std::vector<RecordingFigures>& all, const PipelineBenchmark
     fmt::print("\n");
   }
   fmt::print(
-      "\n'ratio' is the full pipeline's frame rate over the decode+sync-only replay of the "
+      "\n'ratio' is the full pipeline's frame rate over the {}+sync-only replay of the "
       "same recording, run in turns with it.\n{}\n",
-      kPaperFigures);
+      captureWork(options), kPaperFigures);
 }
 
 void printJson(const std::vector<RecordingFigures>& all, const PipelineBenchmarkOptions& options,
                int cores) {
   fmt::print(
       "{{\"pipeline\": {{\"threads\": {}, \"cores\": {}, \"repeats\": {}, \"view\": \"{}\", "
-      "\"renderer\": \"{}\", \"inputs\": [",
-      options.threads, cores, options.repeats, render::toString(options.view),
+      "\"input\": \"{}\", \"renderer\": \"{}\", \"inputs\": [",
+      options.threads, cores, options.repeats, render::toString(options.view), inputName(options),
       all.front().full.summary.renderer);
   for (std::size_t i = 0; i < all.size(); ++i) {
     const auto& r = all[i];
     fmt::print(
         "{}\n  {{\"name\": \"{}\", \"camera\": [{}, {}], \"panorama\": [{}, {}], "
         "\"fps\": {:.3f}, \"baseline_fps\": {:.3f}, \"ratio\": {:.4f}, \"cpu_percent\": "
-        "{:.1f}, \"peak_mb\": {:.1f}, \"frame_sets\": {}, \"ms\": {{\"decode\": {:.3f}",
+        "{:.1f}, \"peak_mb\": {:.1f}, \"frame_sets\": {}, \"ms\": {{\"{}\": {:.3f}",
         i == 0 ? "" : ",", r.name, r.camera.width, r.camera.height, r.panorama.width,
         r.panorama.height, r.full.fps(), r.baselineFps, r.full.fps() / r.baselineFps,
-        cpuPercent(r.full, cores), r.full.peakMegabytes, r.full.summary.frameSets, r.decodeMs);
+        cpuPercent(r.full, cores), r.full.peakMegabytes, r.full.summary.frameSets,
+        captureWork(options), r.decodeMs);
     for (const auto stage : kStages) {
       fmt::print(", \"{}\": {:.3f}", daemon::toString(stage), stageMs(r.full, stage));
     }
