@@ -1,7 +1,7 @@
 // The `display` output: a screen driven through DRM/KMS (render::DrmDisplaySink), whose page flips
 // wait for vblank on a thread of their own behind a queue.
 #include "daemon/built_in_outputs.hpp"
-#include "render/drm_display_sink.hpp"
+#include "render/outputs/drm_display_sink.hpp"
 
 namespace surroundd::daemon {
 namespace {

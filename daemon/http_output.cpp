@@ -8,7 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "daemon/built_in_outputs.hpp"
-#include "render/http_stream_sink.hpp"
+#include "render/outputs/http_stream_sink.hpp"
 
 namespace surroundd::daemon {
 namespace {

@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "daemon/built_in_outputs.hpp"
-#include "render/queued_sink.hpp"
+#include "render/outputs/queued_sink.hpp"
 
 namespace surroundd::daemon {
 namespace {

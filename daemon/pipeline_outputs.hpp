@@ -22,7 +22,7 @@
 #include "daemon/camera_frames_sink.hpp"
 #include "daemon/config.hpp"
 #include "daemon/duration_histogram.hpp"
-#include "render/frame_sink.hpp"
+#include "render/outputs/frame_sink.hpp"
 #include "render/surround_view.hpp"
 
 namespace surroundd::daemon {

@@ -5,7 +5,7 @@
 
 #include "daemon/built_in_outputs.hpp"
 #include "daemon/output_files.hpp"
-#include "render/snapshot_sink.hpp"
+#include "render/outputs/snapshot_sink.hpp"
 
 namespace surroundd::daemon {
 namespace {

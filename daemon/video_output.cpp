@@ -6,7 +6,7 @@
 
 #include "daemon/built_in_outputs.hpp"
 #include "daemon/output_files.hpp"
-#include "render/video_sink.hpp"
+#include "render/outputs/video_sink.hpp"
 
 namespace surroundd::daemon {
 namespace {

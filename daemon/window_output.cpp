@@ -1,7 +1,7 @@
 // The `window` output: an X11 window on a desk (render::X11WindowSink), shown from a thread of its
 // own behind a queue.
 #include "daemon/built_in_outputs.hpp"
-#include "render/x11_window_sink.hpp"
+#include "render/outputs/x11_window_sink.hpp"
 
 namespace surroundd::daemon {
 namespace {

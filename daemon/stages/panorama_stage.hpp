@@ -12,11 +12,11 @@
 #include "common/work_pool.hpp"
 #include "daemon/config.hpp"
 #include "daemon/pipeline_stage.hpp"
-#include "processing/gain_compensation.hpp"
-#include "processing/panorama_lut.hpp"
-#include "processing/panorama_ownership.hpp"
-#include "processing/poisson_correction.hpp"
-#include "processing/stitcher.hpp"
+#include "processing/colour/gain_compensation.hpp"
+#include "processing/colour/poisson_correction.hpp"
+#include "processing/stitch/panorama_lut.hpp"
+#include "processing/stitch/panorama_ownership.hpp"
+#include "processing/stitch/stitcher.hpp"
 
 namespace surroundd::daemon {
 

@@ -17,7 +17,7 @@
 #include <sys/time.h>
 #include <unistd.h>
 
-#include "render/http_stream_sink.hpp"
+#include "render/outputs/http_stream_sink.hpp"
 #include "tests/fuzz/fuzz_support.hpp"
 
 namespace {

@@ -17,8 +17,8 @@
 #include <opencv2/core.hpp>
 
 #include "capture/pixel_conversion.hpp"
-#include "processing/panorama_lut.hpp"
-#include "processing/poisson_solver.hpp"
+#include "processing/colour/poisson_solver.hpp"
+#include "processing/stitch/panorama_lut.hpp"
 #include "render/view_camera.hpp"
 
 namespace surroundd::bench {
