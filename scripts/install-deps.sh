@@ -12,7 +12,7 @@ PACKAGES="
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
   libx11-dev libxext-dev xvfb libdrm-dev libgbm-dev
   libturbojpeg0-dev libcamera-dev libsystemd-dev
-  libgtest-dev libgmock-dev opencv-doc help2man lintian
+  libgtest-dev libgmock-dev opencv-doc help2man lintian python3
   libmicrohttpd-dev chromium
 "
 
