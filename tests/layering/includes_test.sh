@@ -26,19 +26,15 @@ trap 'rm -f "$report"' EXIT
 for folder in common capture processing processing/stitch processing/colour \
               processing/calibration render render/outputs; do
   permitted=$(allowed "$folder")
+  # Each project include "a/b/c.hpp" belongs to folder "a/b".
   for file in "$folder"/*.hpp "$folder"/*.cpp; do
-    [ -e "$file" ] || continue
-    # Each project include "a/b/c.hpp" belongs to folder "a/b".
-    grep -n '^#include "[a-z_/]*\.hpp"' "$file" | while IFS= read -r hit; do
-      line=${hit%%:*}
-      header=$(printf '%s\n' "$hit" | sed 's/.*#include "\([^"]*\)".*/\1/')
-      owner=$(dirname "$header")
-      case " $permitted " in
-        *" $owner "*) ;;
-        *) echo "$file:$line: includes $header: $folder may include only from: $permitted" ;;
-      esac
-    done
-  done
+    [ -e "$file" ] && grep -Hn '^#include "[a-z_/]*\.hpp"' "$file"
+  done | awk -v folder="$folder" -v permitted=" $permitted " '{
+    split($0, at, ":"); header = $0; sub(/^[^"]*"/, "", header); sub(/".*$/, "", header)
+    owner = header; sub(/\/[^\/]*$/, "", owner)
+    if (index(permitted, " " owner " ") == 0)
+      printf "%s:%s: includes %s: %s may include only from:%s\n", at[1], at[2], header, folder, permitted
+  }'
 done > "$report"
 if [ -s "$report" ]; then
   cat "$report"
