@@ -10,6 +10,7 @@
 #include "daemon/logging.hpp"
 #include "daemon/output_files.hpp"
 #include "daemon/output_type.hpp"
+#include "processing/colour/correction_domain.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -297,15 +298,12 @@ Config readConfig(const YAML::Node& document, const std::filesystem::path& file)
   readSection("pipeline", [&](YamlObject& s) { readPipeline(s, config.pipeline); });
   readSection("panorama", [&](YamlObject& s) { readPanorama(s, config.panorama); });
   readSection("colour_correction", [&](YamlObject& s) { readColour(s, config.colour); });
-  // The correction field is solved on blocks of 1 / scale pixels, which must tile the panorama.
-  const double blocksPerPixel = 1 / config.colour.poisson.scale;
-  const auto block = std::lround(blocksPerPixel);
-  if (std::abs(blocksPerPixel - static_cast<double>(block)) > 1e-9 ||
-      config.panorama.widthPx % block != 0 || config.panorama.heightPx % block != 0) {
-    const auto message = fmt::format(
-        "colour_correction.scale must be 1/N with N dividing the panorama's {}x{} pixels (e.g. "
-        "0.25 or 0.125), got {:g}",
-        config.panorama.widthPx, config.panorama.heightPx, config.colour.poisson.scale);
+  // The correction's blocks must tile the panorama (processing's rule, checked here first).
+  const cv::Size panorama(config.panorama.widthPx, config.panorama.heightPx);
+  if (!processing::correctionBlock(config.colour.poisson.scale, panorama)) {
+    const auto message =
+        fmt::format("colour_correction.scale {}",
+                    processing::correctionBlockProblem(config.colour.poisson.scale, panorama));
     if (auto section = root.object("colour_correction")) {
       section->error("scale", message);
     } else {
