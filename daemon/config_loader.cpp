@@ -143,7 +143,8 @@ OutputConfig readOutput(YamlObject& item) {
                                    type.leftOut));
     return o;
   }
-  type.readSettings(item, o);
+  type.keys.read(item, o);
+  if (type.readSettings) type.readSettings(item, o);
   item.finish();
   return o;
 }
