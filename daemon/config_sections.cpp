@@ -273,7 +273,8 @@ std::vector<SectionDocs> sectionDocs() {
           {"colour_correction", colourKeys().docs()},
           {"mesh", meshKeys().docs()},
           {"render", renderKeys().docs()},
-          {"control", controlKeys().docs()}};
+          {"control", controlKeys().docs()},
+          {"vehicle", vehicleKeys().docs()}};
 }
 
 }  // namespace surroundd::daemon

@@ -1,7 +1,7 @@
 #pragma once
 // The key tables (config_keys.hpp) of the config's sections, read by config_loader.cpp. Each
-// output type's own keys are in its registration (output_type.hpp); the rig and the vehicle are
-// read by rig_yaml.hpp and vehicle_yaml.hpp, shared with rig files.
+// output type's own keys are in its registration (output_type.hpp); the vehicle's in
+// vehicle_yaml.hpp, shared with rig files. The rig's cameras (rig_yaml.hpp) have no table yet.
 
 #include <string_view>
 #include <vector>
@@ -27,7 +27,8 @@ const ConfigKeys<OutputConfig>& outputKeys();
 double bowlRimRadiusM(const MeshConfig& mesh);
 double bowlRimHeightM(const MeshConfig& mesh);
 
-// Every section's table by its name in the file, for the reference config's test.
+// Every section's table by its name in the file (the vehicle's too), for the reference config's
+// test.
 struct SectionDocs {
   std::string_view name;
   std::vector<KeyDoc> keys;

@@ -84,10 +84,11 @@ class ReferenceParser {
     const auto textAt = line.find_first_not_of(' ', hash + 1);
     if (textAt == std::string::npos) return;
     const std::string text = line.substr(textAt);
-    if (text.starts_with('#')) {
-      addToLast(text.substr(1));  // a comment beside a key commented out, continued
-    } else if (textAt >= kBesideColumn) {
-      addToLast(text);
+    if (textAt >= kBesideColumn) {
+      // A comment beside a key, continued (its '#' after the '#' of a block commented out).
+      addToLast(text.starts_with('#') ? text.substr(1) : text);
+    } else if (text.starts_with('#')) {
+      takeComment(line, textAt);  // a key commented out inside a block commented out
     } else if (!takeKey(text)) {
       above_ += " " + text;
       last_.reset();
