@@ -1,6 +1,8 @@
 #pragma once
 // Everything surroundd is configured with: one YAML file, read and validated by loadConfig().
-// config/surroundd.reference.yaml documents every key with its default and unit.
+// A key's default is its field's initialiser here; its range, unit and doc are its row in its
+// section's table (config_sections.cpp, an output type's keys, vehicleKeys()); the reference
+// config, config/surroundd.reference.yaml, documents every key and is tested against both.
 //
 // The parts' settings are plain structs with units in their names; they are defined here until the
 // part that consumes them exists (processing/ and render/ never see YAML).

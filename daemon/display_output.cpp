@@ -9,11 +9,6 @@ namespace {
 // A screen shows the newest picture: one may wait for the next vblank.
 constexpr std::size_t kDisplayQueue = 1;
 
-void readDisplay(YamlObject& item, OutputConfig& o) {
-  o.device = item.string("device", "");
-  o.connector = item.string("connector", o.connector);
-}
-
 std::unique_ptr<render::FrameSink> openDisplay(const OutputConfig& output,
                                                const OutputContext& context) {
   return queuedSink(std::make_unique<render::DrmDisplaySink>(
@@ -26,7 +21,12 @@ std::unique_ptr<render::FrameSink> openDisplay(const OutputConfig& output,
 OutputType displayOutputType() {
   OutputType type;
   type.name = "display";
-  type.readSettings = readDisplay;
+  using Key = ConfigKey<OutputConfig>;
+  // Both default to the first connected screen: their values in the reference are examples.
+  type.keys = {
+      Key::text("device", &OutputConfig::device, "the DRM card", Shown::kExample),
+      Key::text("connector", &OutputConfig::connector, "the screen's connector", Shown::kExample),
+  };
   type.openPictureSink = openDisplay;
   return type;
 }

@@ -78,15 +78,32 @@ int firstColumn(const BlockGrid& grid, const std::vector<int>& blocks) {
 
 }  // namespace
 
+std::optional<int> correctionBlock(double scale, cv::Size panorama) {
+  if (!(scale > 0 && scale <= 1)) return std::nullopt;
+  const double side = 1 / scale;
+  const auto block = std::lround(side);
+  if (std::abs(side - static_cast<double>(block)) > 1e-9 || panorama.width % block != 0 ||
+      panorama.height % block != 0) {
+    return std::nullopt;
+  }
+  return static_cast<int>(block);
+}
+
+std::string correctionBlockProblem(double scale, cv::Size panorama) {
+  return fmt::format(
+      "must be 1/N with N dividing the panorama's {}x{} pixels (e.g. 0.25 or 0.125), got {:g}",
+      panorama.width, panorama.height, scale);
+}
+
 CorrectionDomain buildCorrectionDomain(const Rig& rig, const PanoramaSettings& settings,
                                        const PanoramaLut& lut, double scale, bool groundSeams,
                                        std::span<const bool> present) {
-  const int block = static_cast<int>(std::lround(1 / scale));
-  if (block < 1 || lut.size.width % block != 0 || lut.size.height % block != 0) {
-    throw std::invalid_argument(fmt::format(
-        "colour correction scale {:g} does not divide the {}x{} panorama into whole blocks", scale,
-        lut.size.width, lut.size.height));
+  const auto tiling = correctionBlock(scale, lut.size);
+  if (!tiling) {
+    throw std::invalid_argument("colour correction scale " +
+                                correctionBlockProblem(scale, lut.size));
   }
+  const int block = *tiling;
   CorrectionDomain domain;
   domain.block = block;
   domain.grid = {lut.size.width / block, lut.size.height / block};

@@ -22,6 +22,7 @@
 // data on both sides of its border.
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -81,9 +82,17 @@ struct CorrectionDomain {
   std::vector<std::string> notes;    // what was left out and why, for the log
 };
 
+// The field is solved on blocks of 1 / scale pixels, which must tile the panorama: the block's
+// side, or none when `scale` is not 1/N with N dividing both of `panorama`'s sides. The one rule
+// for the config's check and for buildCorrectionDomain's.
+std::optional<int> correctionBlock(double scale, cv::Size panorama);
+// Why correctionBlock() has none: "must be 1/N with N dividing the panorama's 2048x1024 pixels
+// (e.g. 0.25 or 0.125), got 0.3".
+std::string correctionBlockProblem(double scale, cv::Size panorama);
+
 // `present` (per camera; empty: all) leaves out missing cameras: a missing source's regions, and
 // the seams with a missing target, which become Neumann borders. Throws std::invalid_argument for
-// a scale that does not divide the panorama into whole blocks of at least 2 pixels.
+// a scale that correctionBlock() refuses.
 CorrectionDomain buildCorrectionDomain(const Rig& rig, const PanoramaSettings& settings,
                                        const PanoramaLut& lut, double scale, bool groundSeams,
                                        std::span<const bool> present = {});
