@@ -296,17 +296,13 @@ processing::Pose readMount(YamlObject& mount) {
     if (angles)
       mount.errorHere("give either yaw_deg/pitch_deg/roll_deg or quaternion_wxyz, not both");
     if (const auto q = mount.numbers("quaternion_wxyz", {4})) {
-      const double norm =
-          std::sqrt((*q)[0] * (*q)[0] + (*q)[1] * (*q)[1] + (*q)[2] * (*q)[2] + (*q)[3] * (*q)[3]);
+      const cv::Vec4d wxyz((*q)[0], (*q)[1], (*q)[2], (*q)[3]);
+      const double norm = cv::norm(wxyz);
       if (std::abs(norm - 1.0) > 1e-3) {
         mount.error("quaternion_wxyz",
                     fmt::format("expected a unit quaternion (a rotation), got norm {:.6g}", norm));
       } else {
-        const double w = (*q)[0] / norm, x = (*q)[1] / norm, y = (*q)[2] / norm, z = (*q)[3] / norm;
-        pose.rotation =
-            cv::Matx33d(1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-                        2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                        2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y));
+        pose.rotation = processing::rotationFromQuaternion(wxyz / norm);
       }
     }
   } else {

@@ -8,7 +8,7 @@ PACKAGES="
   build-essential cmake pkg-config ccache
   libopencv-dev libyaml-cpp-dev libspdlog-dev libfmt-dev zlib1g-dev
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
-  libsuitesparse-dev
+  libsuitesparse-dev libeigen3-dev
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
   libx11-dev libxext-dev xvfb libdrm-dev libgbm-dev
   libturbojpeg0-dev libcamera-dev libsystemd-dev
