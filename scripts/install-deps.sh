@@ -2,6 +2,7 @@
 # Installs the Debian 12 packages surroundd needs to build, test and run. Idempotent: installs only
 # what is missing and says what that is. Runs apt-get as root, or through sudo.
 # --fuzz: also clang and its sanitizer runtimes, for scripts/fuzz.sh (libFuzzer).
+# --soak: also gnuplot, for scripts/soak.sh's plot.
 set -eu
 
 PACKAGES="
@@ -16,9 +17,13 @@ PACKAGES="
   libmicrohttpd-dev chromium
 "
 
-if [ "${1:-}" = "--fuzz" ]; then
-  PACKAGES="$PACKAGES clang libclang-rt-dev"
-fi
+for argument in "$@"; do
+  case "$argument" in
+    --fuzz) PACKAGES="$PACKAGES clang libclang-rt-dev" ;;
+    --soak) PACKAGES="$PACKAGES gnuplot-nox" ;;
+    *) echo "usage: scripts/install-deps.sh [--fuzz] [--soak]" >&2; exit 2 ;;
+  esac
+done
 
 # Node.js drives the browser test; Debian's is enough where none is installed.
 if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then

@@ -4,7 +4,8 @@
 # reloaded (SIGHUP) every SOAK_RELOAD_S seconds. Every SOAK_SAMPLE_S seconds its resident memory,
 # open files (/proc/PID/fd) and threads go into out/soak/samples.csv; at the end a summary
 # compares the memory after warm-up (the first sample after the first reload) with the end, per
-# reload. Exits 1 if surroundd died or a reload was not taken.
+# reload; with gnuplot (scripts/install-deps.sh --soak) it also draws them in out/soak/soak.png.
+# Exits 1 if surroundd died or a reload was not taken.
 #
 #   scripts/soak.sh MINUTES
 #
@@ -170,5 +171,30 @@ awk -F, -v sent="$sent" -v taken="$taken" -v died="$died" '
     printf "open files: first %d, max %d, last %d; threads: first %d, max %d, last %d\n",
            fds[1], maxfd, fds[n], th[1], maxth, th[n]
   }' "$out/samples.csv"
+# The curves: memory on the left axis, open files and threads on the right, a mark at each reload.
+if command -v gnuplot >/dev/null 2>&1; then
+  gnuplot <<EOF
+set terminal pngcairo size 1200,600
+set output "$out/soak.png"
+set datafile separator ","
+set title "surroundd soak: ${minutes} min, a reload every ${reload_s} s"
+set xlabel "time (s)"
+set ylabel "resident memory (MB)"
+set y2label "open files, threads"
+set y2tics
+set ytics nomirror
+set yrange [0:*]
+set y2range [0:*]
+set key top left
+prev = 0
+plot "$out/samples.csv" every ::1 using 1:(\$3/1024) with linespoints title "RSS (MB)", \
+     "" every ::1 using 1:4 axes x1y2 with steps title "open files", \
+     "" every ::1 using 1:5 axes x1y2 with steps title "threads", \
+     "" every ::1 using 1:(\$2 != prev ? (prev = \$2, \$3/1024) : 1/0) with impulses lc "grey" title "reload"
+EOF
+  echo "plot: $out/soak.png"
+else
+  echo "soak: no plot (scripts/install-deps.sh --soak installs gnuplot)"
+fi
 echo "samples: $out/samples.csv; log: $out/surroundd.log"
 [ "$died" -eq 0 ] && [ "$taken" -ge $((sent - 1)) ]
