@@ -126,7 +126,7 @@ while [ "$(date +%s)" -lt "$end" ]; do
     status=$(cat "/proc/$pid/status" 2>/dev/null) || { died=1; break; }
     rss=$(echo "$status" | awk '/^VmRSS:/ {print $2}')
     threads=$(echo "$status" | awk '/^Threads:/ {print $2}')
-    fds=$(ls "/proc/$pid/fd" 2>/dev/null | wc -l)
+    fds=$(find "/proc/$pid/fd" -mindepth 1 -maxdepth 1 2>/dev/null | wc -l)
     reloads=$(grep -c "reload: starting the pipeline for the new config" "$out/surroundd.log" || true)
     echo "$((now - start)),$reloads,$rss,$fds,$threads" >> "$out/samples.csv"
     next_sample=$((next_sample + sample_s))
