@@ -2,6 +2,8 @@
 // good config (SIGHUP and `reload`), SIGTERM leaving playable files, and the watchdog going quiet
 // when a stage stalls. The rig replays the small synthetic recording in a loop, in real time.
 
+#include <algorithm>
+#include <functional>
 #include <regex>
 #include <thread>
 
@@ -237,6 +239,59 @@ TEST_F(ServiceTest, AStalledOutputStageStopsTheWatchdogPings) {
   EXPECT_EQ(messages.front().text, "READY=1");
   EXPECT_GE(std::ranges::count_if(messages, isPing), 1);
   EXPECT_TRUE(stopped) << "the watchdog pings went on while the output stage was stalled";
+}
+
+// (A short name: the notify socket's path, in a folder named after the test, must fit in 108
+// bytes.)
+TEST_F(ServiceTest, DegradedWhileNoOutputWorks) {
+  // Issue 18.3: a recorder whose only output had failed kept feeding the watchdog. Its folder is
+  // taken away (a file stands in its place, so every new segment fails to open, as on a full
+  // disk), then given back.
+  testing::NotifySocket notify(dir_ / "notify");
+  auto surroundd = start(
+      writeConfig(R"(  - {type: video, stream: mosaic, path: out/drive.mkv, segment_s: 0.5})"),
+      {"NOTIFY_SOCKET=" + (dir_ / "notify").string(), "WATCHDOG_USEC=200000"});
+  std::vector<testing::NotifySocket::Message> messages;
+  const auto isPing = [](const auto& m) { return m.text == "WATCHDOG=1"; };
+  const auto isDegraded = [](const auto& m) {
+    return m.text.starts_with("STATUS=degraded: every output has failed");
+  };
+  // Reads until `done` holds, at most 60 s (however slowly it runs: CI load, sanitizers).
+  const auto readUntil = [&](const std::function<bool()>& done) {
+    for (const auto deadline = std::chrono::steady_clock::now() + 60s;
+         !done() && std::chrono::steady_clock::now() < deadline && surroundd->running();) {
+      if (auto message = notify.receive()) messages.push_back(std::move(*message));
+    }
+    return done();
+  };
+  ASSERT_TRUE(readUntil([&] { return std::ranges::any_of(messages, isPing); }))
+      << surroundd->output();
+
+  std::filesystem::rename(dir_ / "out", dir_ / "out-taken");
+  dir_.write("out", "not a folder");
+  const auto taken = messages.size();
+  const auto since = [&](std::size_t from, const auto& what) {
+    return std::ranges::any_of(messages.begin() + static_cast<std::ptrdiff_t>(from), messages.end(),
+                               what);
+  };
+  // Degraded, and then no ping for 3 s (fifteen 200 ms watchdog periods).
+  const bool quiet = readUntil([&] {
+    if (!since(taken, isDegraded)) return false;
+    const auto lastPing = std::ranges::find_if(messages.rbegin(), messages.rend(), isPing);
+    return std::chrono::steady_clock::now() - lastPing->at > 3s;
+  });
+  ASSERT_TRUE(surroundd->running()) << surroundd->output();
+  EXPECT_TRUE(quiet) << "no degraded status, or the pings went on: " << surroundd->output();
+  EXPECT_THAT(surroundd->output(), HasSubstr("output still failing"));
+
+  // The folder is back: the next retry opens the output again and the pings resume.
+  std::filesystem::remove(dir_ / "out");
+  const auto back = messages.size();
+  EXPECT_TRUE(readUntil([&] { return since(back, isPing); })) << surroundd->output();
+  EXPECT_THAT(surroundd->output(), HasSubstr("works again"));
+  surroundd->signal(SIGTERM);
+  EXPECT_EQ(surroundd->wait(), 1) << "an output failed in this run: " << surroundd->output();
+  EXPECT_FALSE(std::filesystem::is_empty(dir_ / "out"));
 }
 
 }  // namespace
