@@ -185,10 +185,13 @@ const char* captureWork(const PipelineBenchmarkOptions& options) {
 // The figures the standards hold a surround view to, beside their limits. The replay runs as fast
 // as it can and waits for its slowest output, so its latency includes the wait in full queues: an
 // upper bound of a live rig's, where the newest set wins.
-void printAgainstLimits(const std::vector<RecordingFigures>& all) {
+void printAgainstLimits(const std::vector<RecordingFigures>& all,
+                        const PipelineBenchmarkOptions& options) {
   fmt::print(
       "\nagainst the limits (the run of median frame rate; the first picture from the pipeline's "
-      "start with a warm LUT cache, the first run's cold one beside it)\n");
+      "start with a warm LUT cache, the first run's cold one beside it{})\n",
+      options.input == BenchInput::kRaw ? "; the recordings' preload into memory counts in it"
+                                        : "");
   for (const auto& r : all) {
     fmt::print("{:<8} frame rate {}\n", r.name, daemon::frameRateWithLimit(r.full.fps()));
     fmt::print("{:<8} latency capture to output {}\n", r.name,
@@ -243,7 +246,7 @@ void printText(const std::vector<RecordingFigures>& all, const PipelineBenchmark
     for (const auto stage : kStages) fmt::print(" {:>9.2f}", stageMs(r.full, stage));
     fmt::print("\n");
   }
-  printAgainstLimits(all);
+  printAgainstLimits(all, options);
   fmt::print(
       "\n'ratio' is the full pipeline's frame rate over the {}+sync-only replay of the "
       "same recording, run in turns with it.\n{}\n",
