@@ -34,8 +34,9 @@ double nominalFpsOf(const std::vector<std::unique_ptr<capture::CameraStream>>& c
 
 }  // namespace
 
-Pipeline::Pipeline(const Config& config)
-    : cameras_(openCameras(config)),
+Pipeline::Pipeline(const Config& config, RunStart start)
+    : runStart_(start),
+      cameras_(openCameras(config)),
       synchronizer_(cameras_.size(),
                     std::chrono::duration_cast<capture::Timestamp>(
                         std::chrono::duration<double, std::milli>(config.capture.syncToleranceMs))),
@@ -107,6 +108,8 @@ PipelineReport Pipeline::report() const {
   }
   report.stages = times_.histograms();
   report.latency = outputs_.latency();
+  if (const auto first = outputs_.firstPictureAt()) report.startup = *first - runStart_.at;
+  report.startupFrom = runStart_.from;
   report.outputs = outputs_.count();
   report.failedOutputs = outputs_.failures();
   report.failedSets = failedSets_;
@@ -139,6 +142,7 @@ RunSummary Pipeline::run(const std::atomic<bool>& stop, PipelineObserver* observ
       }
     }
     if (summary.rebuild) break;
+    logFirstPicture();
     const auto now = Clock::now();
     outputs_.retry(now);
     const bool statusDue = now >= nextPageStatus_;
@@ -157,6 +161,13 @@ RunSummary Pipeline::run(const std::atomic<bool>& stop, PipelineObserver* observ
   summary.failedSets = failedSets_;
   summary.wallTime = Clock::now() - start_;
   return summary;
+}
+
+void Pipeline::logFirstPicture() {
+  const auto first = outputs_.firstPictureAt();
+  if (firstPictureLogged_ || !first) return;
+  firstPictureLogged_ = true;
+  spdlog::info("first picture out {}", startupWithLimits(*first - runStart_.at, runStart_.from));
 }
 
 bool Pipeline::dropFailedSet(const std::exception& error) {

@@ -82,7 +82,9 @@ class PipelineObserver {
 
 class Pipeline {
  public:
-  explicit Pipeline(const Config& config);
+  // `start`: where the run's start-up time (to its first picture out) counts from; by default,
+  // this construction, which opens the cameras and outputs and builds or loads the LUT.
+  explicit Pipeline(const Config& config, RunStart start = {});
   ~Pipeline();
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
@@ -119,7 +121,11 @@ class Pipeline {
   // Drops a set a stage failed on; true when the run should end for a rebuild.
   bool dropFailedSet(const std::exception& error);
   void finish(RunSummary& summary);
+  // Logs the start-up time once, when the first picture has gone out.
+  void logFirstPicture();
 
+  RunStart runStart_;  // first: it is taken before the cameras open
+  bool firstPictureLogged_ = false;
   std::vector<std::unique_ptr<capture::CameraStream>> cameras_;
   capture::Synchronizer synchronizer_;
   bool live_;        // V4L2 cameras: sets go without a late camera

@@ -62,7 +62,9 @@ void PipelineOutputs::handOver(PictureOutput& output, const cv::Mat& picture,
   guarded(output, [&] {
     output.sink->consume(picture, streamTime);
     output.latest = picture;
-    latency_.record(Clock::now() - origin);
+    const auto now = Clock::now();
+    latency_.record(now - origin);
+    if (!firstPictureAt_) firstPictureAt_ = now;
   });
 }
 

@@ -13,6 +13,7 @@
 #include <exception>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -98,6 +99,8 @@ class PipelineOutputs {
   std::uint64_t failures() const { return failures_; }
   std::uint64_t dropped() const;  // pictures outputs dropped because they fell behind
   const DurationHistogram& latency() const { return latency_; }
+  // When the first picture was handed to an output; empty before.
+  std::optional<Clock::time_point> firstPictureAt() const { return firstPictureAt_; }
 
  private:
   void open(PictureOutput& output);
@@ -109,6 +112,7 @@ class PipelineOutputs {
   std::vector<std::unique_ptr<CameraFramesSink>> recordings_;  // null once failed
   std::uint64_t failures_ = 0;
   DurationHistogram latency_;  // a set's capture to its picture handed to an output
+  std::optional<Clock::time_point> firstPictureAt_;
 };
 
 }  // namespace surroundd::daemon

@@ -39,7 +39,8 @@ constexpr std::string_view kUsage =
                 no correction, gains and Poisson, and the mean level
   pipeline      the whole daemon pipeline (the paper's tables 1 and 2): frames per second,
                 milliseconds per stage, CPU and peak memory, against a decode-only replay
-                (--input raw: convert-only)
+                (--input raw: convert-only); frame rate, latency and time to the first picture
+                (cold and warm LUT cache) beside their limits
   RECORDING     a surround-synth recording folder (with ground truth); scripts/bench.sh makes
                 4x480p, 720p and 1080p ones
   --threads N   worker threads (default 2); stitch measures 1 thread too

@@ -3,7 +3,9 @@
 // daemon pipeline (decode, sync, stitch, colour correction, surround render, read-back, H.264
 // encode) replays each recording as fast as possible; reported are frames per second,
 // milliseconds per stage, CPU utilization and peak memory, with the ratio against a baseline run
-// in turns with it: the same replay doing only decode and sync (the most any pipeline could do).
+// in turns with it: the same replay doing only decode and sync (the most any pipeline could do);
+// and the frame rate, capture-to-output latency and time to the first picture (cold and warm LUT
+// cache) beside the limits of ISO 16505 / IEC 63033-3 and FMVSS 111 (daemon/compliance_limits.hpp).
 //
 // Input: each camera's video decoded as it plays (kDecode, replay figures), or decoded once at
 // start into memory as YUYV or NV12 frames and converted to BGR per frame as a V4L2 camera's frames
