@@ -203,12 +203,12 @@ set y2tics
 set ytics nomirror
 set yrange [0:*]
 set y2range [0:*]
-set key top left
+set key below horizontal
 prev = 0
-plot "$out/samples.csv" every ::1 using 1:(\$3/1024) with linespoints title "RSS (MB)", \
+plot "$out/samples.csv" every ::1 using 1:(\$3/1024) with linespoints pt 7 ps 0.4 title "RSS (MB)", \
      "" every ::1 using 1:4 axes x1y2 with steps title "open files", \
      "" every ::1 using 1:5 axes x1y2 with steps title "threads", \
-     "" every ::1 using 1:(\$2 != prev ? (prev = \$2, \$3/1024) : 1/0) with impulses lc "grey" title "reload"
+     "" every ::1 using 1:(\$2 != prev ? (prev = \$2, 0) : 1/0) with points pt 9 lc "grey" title "reload"
 EOF
   echo "plot: $out/soak.png"
 else
