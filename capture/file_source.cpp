@@ -6,7 +6,6 @@
 #include <cmath>
 #include <optional>
 #include <string_view>
-#include <thread>
 
 #include <fmt/format.h>
 
@@ -95,7 +94,8 @@ struct FileSource::Impl {
   Timestamp loopOffset{0};       // added to timestamps after each loop so they keep increasing
   Timestamp firstTimestamp{0};
   Timestamp lastTimestamp{0};  // latest of this pass through the file, without loopOffset
-  std::optional<std::chrono::steady_clock::time_point> pacingStart;
+  ReplayPacer pacer{Pacing::kRealtime};
+  std::uint64_t frameCountHint = 0;
 
   std::string describe(std::string_view what, int error) const {
     return fmt::format("camera '{}': {} '{}': {}", camera, what, settings.path.string(),
@@ -114,7 +114,8 @@ struct FileSource::Impl {
   bool setUpConverter(const AVFrame& frame);
   Timestamp timestampOf(const AVFrame& frame) const;
   ReadStatus fault(std::string message);
-  void pace(Timestamp timestamp);
+  void pace(Timestamp timestamp) { pacer.waitFor(timestamp - firstTimestamp); }
+  std::uint64_t countFrames(const AVStream& stream) const;
 };
 
 void FileSource::Impl::open() {
@@ -173,6 +174,7 @@ void FileSource::Impl::open() {
     fail(fmt::format("needs a positive frame rate (sequence_fps), got {}", fps));
   }
   period = std::chrono::nanoseconds(std::llround(1e9 / fps));
+  frameCountHint = countFrames(*stream);
   lastTimestamp = -period;  // an untimed first frame is at 0
   packet.reset(av_packet_alloc());
   decoded.reset(av_frame_alloc());
@@ -240,11 +242,7 @@ bool FileSource::Impl::restart() {
   avcodec_flush_buffers(codec.get());
   draining = false;
   drainFailed = false;
-  // A whole number of nominal periods: the cameras of a rig loop by the same offset, whatever the
-  // jitter of their last frames' timestamps (which would otherwise pull them apart, pass by pass).
-  const auto periods = std::llround(static_cast<double>((lastTimestamp - firstTimestamp).count()) /
-                                    static_cast<double>(period.count()));
-  loopOffset += (periods + 1) * period;
+  loopOffset += loopShift(firstTimestamp, lastTimestamp, period);
   lastTimestamp = firstTimestamp - period;
   return true;
 }
@@ -313,12 +311,19 @@ ReadStatus FileSource::Impl::fault(std::string message) {
   return ReadStatus::kFault;
 }
 
-void FileSource::Impl::pace(Timestamp timestamp) {
-  if (settings.pacing != Pacing::kRealtime) return;
-  // Frame k is due (its timestamp - the first's) after the first read, on the steady clock.
-  const auto now = std::chrono::steady_clock::now();
-  if (!pacingStart) pacingStart = now - (timestamp - firstTimestamp);
-  std::this_thread::sleep_until(*pacingStart + (timestamp - firstTimestamp));
+std::uint64_t FileSource::Impl::countFrames(const AVStream& stream) const {
+  if (onePicture) return 1;
+  if (stream.nb_frames > 0) return static_cast<std::uint64_t>(stream.nb_frames);
+  // image2 counts a pattern's files in its duration; containers without a frame count (Matroska)
+  // state a duration, the stream's or the whole file's.
+  double seconds = 0;
+  if (stream.duration != AV_NOPTS_VALUE && stream.duration > 0) {
+    seconds = static_cast<double>(stream.duration) * av_q2d(stream.time_base);
+  } else if (format->duration != AV_NOPTS_VALUE && format->duration > 0) {
+    seconds = static_cast<double>(format->duration) / AV_TIME_BASE;
+  }
+  return static_cast<std::uint64_t>(
+      std::llround(seconds * 1e9 / static_cast<double>(period.count())));
 }
 
 bool isStillPicturePath(const std::filesystem::path& path) {
@@ -335,6 +340,7 @@ FileSource::FileSource(std::string cameraName, FileSourceSettings settings)
     : impl_(std::make_unique<Impl>()) {
   impl_->camera = std::move(cameraName);
   impl_->settings = std::move(settings);
+  impl_->pacer = ReplayPacer(impl_->settings.pacing);
   impl_->open();
 }
 
@@ -347,6 +353,8 @@ Timestamp FileSource::nominalPeriod() const { return impl_->period; }
 const std::string& FileSource::lastError() const { return impl_->lastError; }
 
 bool FileSource::repeatsOnePicture() const { return impl_->onePicture && impl_->settings.loop; }
+
+std::uint64_t FileSource::frameCountHint() const { return impl_->frameCountHint; }
 
 ReadStatus FileSource::read(Frame& out) {
   auto& s = *impl_;

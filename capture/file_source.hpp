@@ -18,10 +18,9 @@
 #include <string>
 
 #include "capture/frame_source.hpp"
+#include "capture/replay_clock.hpp"
 
 namespace surroundd::capture {
-
-enum class Pacing { kRealtime, kAsFastAsPossible };
 
 struct FileSourceSettings {
   std::filesystem::path path;  // video file, picture, or image-sequence pattern with a printf %d
@@ -51,6 +50,10 @@ class FileSource final : public FrameSource {
   const std::string& lastError() const override;
   // A still picture or a one-picture sequence that loops.
   bool repeatsOnePicture() const override;
+  // How many frames one pass holds as the file states it (a picture: 1; a video: its stream's frame
+  // count, else its duration over the frame period); 0 when it does not say. For sizing only: the
+  // frames that decode may be a few more or fewer.
+  std::uint64_t frameCountHint() const;
 
  private:
   struct Impl;  // FFmpeg state stays out of the header

@@ -6,6 +6,8 @@ find_package(yaml-cpp REQUIRED)
 find_package(spdlog REQUIRED)
 find_package(fmt REQUIRED)
 find_package(ZLIB REQUIRED)
+# Eigen (libeigen3-dev, headers only): the rig's rotations from mount angles and quaternions.
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 pkg_check_modules(FFMPEG REQUIRED IMPORTED_TARGET libavformat libavcodec libavutil libswscale)
 pkg_check_modules(SYSTEMD REQUIRED IMPORTED_TARGET libsystemd)  # sd_notify: readiness, watchdog
 

@@ -20,4 +20,7 @@ OutputType displayOutputType();    // a DRM/KMS screen (display_output.cpp)
 OutputType snapshotOutputType();   // a PNG snapshot (snapshot_output.cpp)
 OutputType recordingOutputType();  // the cameras' own streams and a rig file (recording_output.cpp)
 
+// The encoder's quality, one rule for every type that encodes (video_output.cpp).
+ConfigKey<OutputConfig> crfKey();
+
 }  // namespace surroundd::daemon

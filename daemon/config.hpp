@@ -1,6 +1,8 @@
 #pragma once
 // Everything surroundd is configured with: one YAML file, read and validated by loadConfig().
-// config/surroundd.reference.yaml documents every key with its default and unit.
+// A key's default is its field's initialiser here; its range, unit and doc are its row in its
+// section's table (config_sections.cpp, an output type's keys, vehicleKeys()); the reference
+// config, config/surroundd.reference.yaml, documents every key and is tested against both.
 //
 // The parts' settings are plain structs with units in their names; they are defined here until the
 // part that consumes them exists (processing/ and render/ never see YAML).
@@ -18,8 +20,8 @@
 #include "capture/source_recovery.hpp"
 #include "daemon/rig_yaml.hpp"
 #include "daemon/vehicle_yaml.hpp"
-#include "processing/panorama_lut.hpp"
-#include "processing/poisson_correction.hpp"
+#include "processing/colour/poisson_correction.hpp"
+#include "processing/stitch/panorama_lut.hpp"
 #include "processing/surround_mesh.hpp"
 #include "render/car_model.hpp"
 #include "render/egl_context.hpp"
@@ -36,6 +38,9 @@ struct CaptureConfig {
   // drop its oldest picture): auto = only with live cameras; always also for replays (to see a
   // replay as a live rig would show it), never keeps every set.
   enum class LatestWins { kAuto, kAlways, kNever } latestWins = LatestWins::kAuto;
+  // The memory, in MiB (2^20 bytes), that the frames of every preloaded camera (`preload: true`)
+  // may take together; a camera that would go past it is refused at start, naming it.
+  int preloadMaxMb = 2048;
   // How every camera, whatever its kind, recovers from faults (capture/source_recovery.hpp):
   // reopening backoff, giving up, and how often repeated faults are logged.
   capture::RecoverySettings recovery;

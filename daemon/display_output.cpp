@@ -1,18 +1,13 @@
 // The `display` output: a screen driven through DRM/KMS (render::DrmDisplaySink), whose page flips
 // wait for vblank on a thread of their own behind a queue.
 #include "daemon/built_in_outputs.hpp"
-#include "render/drm_display_sink.hpp"
+#include "render/outputs/drm_display_sink.hpp"
 
 namespace surroundd::daemon {
 namespace {
 
 // A screen shows the newest picture: one may wait for the next vblank.
 constexpr std::size_t kDisplayQueue = 1;
-
-void readDisplay(YamlObject& item, OutputConfig& o) {
-  o.device = item.string("device", "");
-  o.connector = item.string("connector", o.connector);
-}
 
 std::unique_ptr<render::FrameSink> openDisplay(const OutputConfig& output,
                                                const OutputContext& context) {
@@ -26,7 +21,12 @@ std::unique_ptr<render::FrameSink> openDisplay(const OutputConfig& output,
 OutputType displayOutputType() {
   OutputType type;
   type.name = "display";
-  type.readSettings = readDisplay;
+  using Key = ConfigKey<OutputConfig>;
+  // Both default to the first connected screen: their values in the reference are examples.
+  type.keys = {
+      Key::text("device", &OutputConfig::device, "the DRM card", Shown::kExample),
+      Key::text("connector", &OutputConfig::connector, "the screen's connector", Shown::kExample),
+  };
   type.openPictureSink = openDisplay;
   return type;
 }

@@ -8,7 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "daemon/built_in_outputs.hpp"
-#include "render/http_stream_sink.hpp"
+#include "render/outputs/http_stream_sink.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -38,10 +38,8 @@ void readListen(YamlObject& item, OutputConfig& o) {
   o.listenPort = port;
 }
 
-void readHttp(YamlObject& item, OutputConfig& o) {
-  readListen(item, o);
-  o.jpegQuality = item.integer("quality", o.jpegQuality, 1, 100);
-  o.allowedHosts = item.strings("allowed_hosts", 0, 32).value_or(std::vector<std::string>{});
+bool sameListen(const OutputConfig& a, const OutputConfig& b) {
+  return a.listenAddress == b.listenAddress && a.listenPort == b.listenPort;
 }
 
 // Two servers cannot listen on one port of one address (0.0.0.0 is every address).
@@ -76,7 +74,12 @@ std::unique_ptr<render::FrameSink> openHttp(const OutputConfig& output,
 OutputType httpOutputType() {
   OutputType type;
   type.name = "http";
-  type.readSettings = readHttp;
+  using Key = ConfigKey<OutputConfig>;
+  type.keys = {
+      Key::custom("listen", "the address and port it listens on", readListen, sameListen),
+      Key::integer("quality", &OutputConfig::jpegQuality, 1, 100, "JPEG quality"),
+      Key::names("allowed_hosts", &OutputConfig::allowedHosts, 0, 32, "host names it answers to"),
+  };
   type.conflict = sharesPort;
   type.openPictureSink = openHttp;
   return type;

@@ -16,6 +16,7 @@
 
 #include "daemon/config.hpp"
 #include "daemon/logging.hpp"
+#include "daemon/process_start.hpp"
 #include "daemon/rig_yaml.hpp"
 #include "daemon/service.hpp"
 
@@ -106,6 +107,7 @@ std::optional<Arguments> parseArguments(int argc, char** argv, bool& help) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const auto processStart = daemon::processStartTime();  // first: its fallback is "now"
   bool help = false;
   const auto arguments = parseArguments(argc, argv, help);
   if (!arguments) return help ? 0 : 2;
@@ -133,7 +135,8 @@ int main(int argc, char** argv) {
   installSignalHandlers();
 
   try {
-    daemon::Service service(std::move(config), signals, daemon::ServiceNotifier::fromEnvironment());
+    daemon::Service service(std::move(config), signals, daemon::ServiceNotifier::fromEnvironment(),
+                            processStart);
     return service.run();
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());

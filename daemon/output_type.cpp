@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "daemon/built_in_outputs.hpp"
-#include "render/queued_sink.hpp"
+#include "render/outputs/queued_sink.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -21,7 +21,8 @@ void add(Registry& registry, OutputType type) {
   }
   const bool opens = type.input == OutputInput::kPicture ? bool(type.openPictureSink)
                                                          : bool(type.openCameraFramesSink);
-  if (type.leftOut.empty() && (!opens || !type.readSettings)) {
+  const bool hasSchema = !type.keys.empty() || type.readSettings;
+  if (type.leftOut.empty() && (!opens || !hasSchema)) {
     throw std::logic_error(
         fmt::format("output type '{}' has no schema or no factory for its input", type.name));
   }

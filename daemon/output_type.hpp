@@ -1,8 +1,8 @@
 #pragma once
 // Output types: each kind of output (`type:` in the config) registers, in one place, its schema
-// (the keys it reads, with their defaults, units and ranges), its factory, and what it takes from
-// the pipeline. The config loader, the checks on output files and the pipeline know outputs only
-// through this registry, so adding an output is its own source file plus one line in
+// (the keys it reads, with their defaults, units and ranges, as a table), its factory, and what it
+// takes from the pipeline. The config loader, the checks on output files and the pipeline know
+// outputs only through this registry, so adding an output is its own source file plus one line in
 // builtInOutputTypes() (output_types.cpp) — or one registerOutputType() call, as tests do.
 //
 // A type left out of this build (a CMake option off, its library not found) is registered too,
@@ -21,8 +21,9 @@
 
 #include "daemon/camera_frames_sink.hpp"
 #include "daemon/config.hpp"
+#include "daemon/config_keys.hpp"
 #include "daemon/yaml_reader.hpp"
-#include "render/frame_sink.hpp"
+#include "render/outputs/frame_sink.hpp"
 
 namespace surroundd::daemon {
 
@@ -64,8 +65,12 @@ struct OutputType {
   // Empty when this build has the type; else how to build it in, e.g. "configure with
   // -DSURROUNDD_WITH_HTTP=ON (needs libmicrohttpd-dev and libturbojpeg0-dev)".
   std::string leftOut;
-  // The schema: reads the type's own keys of one `outputs:` entry into `output` (`type`, `stream`
-  // and `view` are read already), reporting each problem on `item`; the defaults are the fields'.
+  // The schema: the type's own keys of one `outputs:` entry (`type`, `stream` and `view` are read
+  // already), a table (config_keys.hpp) whose defaults are OutputConfig's fields; the reference
+  // config documents them.
+  ConfigKeys<OutputConfig> keys;
+  // Then what the table cannot say: its checks across keys, or, for a type without a table, its
+  // whole reading (into `output.other`). Each problem is reported on `item`.
   std::function<void(YamlObject& item, OutputConfig& output)> readSettings;
   // What its `path` is (kNone when it has none).
   std::function<OutputPathUse(const OutputConfig& output)> pathUse = [](const OutputConfig&) {

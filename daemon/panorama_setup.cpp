@@ -9,7 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "daemon/rig_yaml.hpp"
-#include "processing/panorama_lut_cache.hpp"
+#include "processing/stitch/panorama_lut_cache.hpp"
 
 namespace surroundd::daemon {
 namespace {

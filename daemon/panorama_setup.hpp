@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "daemon/config.hpp"
-#include "processing/panorama_lut.hpp"
+#include "processing/stitch/panorama_lut.hpp"
 #include "processing/surround_mesh.hpp"
 
 namespace surroundd {

@@ -1,5 +1,7 @@
 #pragma once
-// The pipeline: cameras -> synchronizer -> mosaic and/or panorama -> surround views -> outputs.
+// The pipeline: cameras -> synchronizer -> stages -> outputs. The stages (pipeline_stage.hpp:
+// camera health, recordings, the mosaic, the panorama, the surround views, the streams' outputs)
+// do the work on each frame set; the pipeline keeps their order, the clock and the report.
 //
 // Threads and bounded queues, stage by stage:
 //   capture   one thread per camera (CameraStream), a queue of capture.queue_frames each;
@@ -21,32 +23,27 @@
 
 #include <array>
 #include <atomic>
-#include <bitset>
 #include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "capture/camera_health.hpp"
 #include "capture/camera_stream.hpp"
 #include "capture/synchronizer.hpp"
-#include "common/camera_limit.hpp"
 #include "common/work_pool.hpp"
-#include "daemon/camera_frames_sink.hpp"
 #include "daemon/config.hpp"
+#include "daemon/pipeline_outputs.hpp"
 #include "daemon/pipeline_report.hpp"
-#include "processing/gain_compensation.hpp"
-#include "processing/panorama_ownership.hpp"
-#include "processing/poisson_correction.hpp"
-#include "processing/stitcher.hpp"
-#include "render/egl_context.hpp"
-#include "render/frame_sink.hpp"
-#include "render/mosaic.hpp"
-#include "render/surround_scene.hpp"
-#include "render/surround_view.hpp"
+#include "daemon/pipeline_stage.hpp"
+#include "daemon/stage_times.hpp"
 
 namespace surroundd::daemon {
+
+class CameraHealthStage;
+class MosaicStage;
+class PanoramaStage;
+class SurroundStage;
 
 struct RunSummary {
   std::uint64_t frameSets = 0;
@@ -85,7 +82,9 @@ class PipelineObserver {
 
 class Pipeline {
  public:
-  explicit Pipeline(const Config& config);
+  // `start`: where the run's start-up time (to its first picture out) counts from; by default,
+  // this construction, which opens the cameras and outputs and builds or loads the LUT.
+  explicit Pipeline(const Config& config, RunStart start = {});
   ~Pipeline();
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
@@ -100,102 +99,54 @@ class Pipeline {
 
   // From the pipeline thread (an observer), while it runs:
   // Switches every surround output to `view` (takes effect with the next frame set).
-  void setView(ViewKind view);
+  void setView(ViewKind view) { outputs_.setView(view); }
   PipelineReport report() const;
   // Whether any output (or recording) works: with none, the run records nothing (a full disk),
-  // and the service stops feeding the watchdog and says so in its status.
-  bool outputsWork() const;
-  // A failed output is opened again after kFirstOutputRetry, then after twice as long each time,
-  // up to kLastOutputRetry (a disk with room again, a display plugged back in).
-  static constexpr std::chrono::seconds kFirstOutputRetry{1};
-  static constexpr std::chrono::seconds kLastOutputRetry{60};
+  // and the service stops feeding the watchdog and says so in its status. A failed output is
+  // retried (PipelineOutputs).
+  bool outputsWork() const { return outputs_.anyWorks(); }
   // The newest picture handed to the first output that shows pictures (a surround view if there
   // is one); a header over the pipeline's buffer, valid until the next frame set. Empty before.
-  cv::Mat latestPicture() const;
+  cv::Mat latestPicture() const { return outputs_.latestPicture(); }
 
  private:
   using Clock = std::chrono::steady_clock;
-  struct Output {
-    OutputStream stream = OutputStream::kMosaic;
-    OutputConfig config;  // to open it again after a failure (its path: the one it writes now)
-    cv::Size size;
-    double nominalFps = 30;
-    std::unique_ptr<render::FrameSink> sink;  // null while it has failed
-    Clock::time_point nextRetry{};            // when failed: when it is opened again
-    std::chrono::seconds retryDelay{0};
-    std::unique_ptr<render::SurroundView> view;  // surround outputs
-    std::chrono::nanoseconds pendingTime{0};     // stream time of the view's pending picture
-    Clock::time_point pendingOrigin{};           // capture time of the pending picture's set
-    cv::Mat latest;                              // header over the picture last handed over
-  };
 
+  void openOutputs(const Config& config, const MosaicStage& mosaic, const PanoramaStage* panorama);
   void fillNeeds(const std::atomic<bool>& stop);
   // The next complete set; with latestWins_, the newest, the older ones counted as stale.
   std::optional<capture::FrameSet> nextSet(const std::atomic<bool>& stop);
   void process(const capture::FrameSet& set);
   Clock::time_point captureTimeOf(const capture::FrameSet& set) const;
-  void handOver(Output& output, const cv::Mat& picture, std::chrono::nanoseconds streamTime,
-                Clock::time_point origin);
-  void followHealth(const capture::FrameSet& set);
-  // Outputs with a page (FrameSink::page()): the views asked for, and the status once a second.
-  void followPages(Clock::time_point now);
-  void open(Output& output);  // throws what the sink's constructor throws
-  void retryOutputs(Clock::time_point now);
-  void renderSurround(const capture::FrameSet& set, Clock::time_point origin);
-  void deliverSurround();
+  // Drops a set a stage failed on; true when the run should end for a rebuild.
+  bool dropFailedSet(const std::exception& error);
   void finish(RunSummary& summary);
-  // Runs `step` on the output; an exception drops the output with a logged error.
-  template <typename Step>
-  void guarded(Output& output, Step&& step);
-  void timed(Stage stage, Clock::time_point& since);
-  void recordStages();  // this set's stage times into the histograms
-  const cv::Mat& imageOf(OutputStream stream) const;
-  bool shows(OutputStream stream) const;  // a working output shows it
-  void setUpColourCorrection(const Config& config, const processing::Rig& rig);
-  void setUpSurround(const Config& config);
+  // Logs the start-up time once, when the first picture has gone out.
+  void logFirstPicture();
 
+  RunStart runStart_;  // first: it is taken before the cameras open
+  bool firstPictureLogged_ = false;
   std::vector<std::unique_ptr<capture::CameraStream>> cameras_;
   capture::Synchronizer synchronizer_;
   bool live_;        // V4L2 cameras: sets go without a late camera
   bool latestWins_;  // stale sets are skipped, encoders drop their oldest picture
   capture::Timestamp lateAfter_;
-  capture::CameraHealthMonitor health_;
-  std::array<const char*, kMaxCameras> faults_{};  // per camera: what is wrong, or null
-  std::vector<capture::HealthChange> healthChanges_;
   WorkPool pool_;
-  render::Mosaic mosaic_;
-  cv::Mat canvas_;                                  // the composed mosaic; reused for every set
-  std::unique_ptr<processing::PanoramaLut> lut_;    // set when an output shows the panorama
-  std::unique_ptr<processing::Stitcher> stitcher_;  // borrows *lut_ and pool_
-  std::unique_ptr<processing::PoissonColourCorrection> poisson_;  // colour_correction: poisson
-  std::unique_ptr<processing::GainCompensation> gains_;           // colour_correction: gain
-  std::unique_ptr<processing::PanoramaOwnership> ownership_;      // marks faulty cameras
-  std::vector<cv::Mat> frames_;        // this set's images (headers only); empty where missing
-  std::vector<cv::Mat> stitchInputs_;  // the same, with black frames for missing cameras
-  std::vector<cv::Mat> blackFrames_;
-  cv::Mat panorama_;
-  // Surround outputs: the context first, so that it outlives the GL objects below.
-  std::unique_ptr<render::EglContext> gl_;
-  std::unique_ptr<render::SurroundScene> scene_;
-  std::size_t splitCamera_ = 0;
-  std::vector<Output> outputs_;
-  std::vector<std::unique_ptr<CameraFramesSink>> recorders_;          // null once failed
-  std::array<std::chrono::nanoseconds, kStageCount> stageTime_{};     // summed over the run
-  std::array<std::chrono::nanoseconds, kStageCount> setStageTime_{};  // this set's
-  std::bitset<kStageCount> setStagesRun_;
-  std::array<DurationHistogram, kStageCount> stageHistograms_;
-  DurationHistogram latency_;
+  // The stages, in their order; before the outputs, whose surround views need the surround
+  // stage's GL context to the end. The named ones are in the list too (for the report).
+  std::vector<std::unique_ptr<PipelineStage>> stages_;
+  CameraHealthStage* health_ = nullptr;
+  SurroundStage* surround_ = nullptr;  // when an output shows a surround view
+  PipelineOutputs outputs_;
+  StageTimes times_;
   std::uint64_t frameSets_ = 0;
   std::uint64_t staleDropped_ = 0;
   Clock::time_point start_{};
   Clock::time_point nextPageStatus_{};
-  std::uint64_t failedSinks_ = 0;
   std::uint64_t failedSets_ = 0;
   int failedInARow_ = 0;
   std::uint64_t unloggedFailures_ = 0;  // since the last logged one
   Clock::time_point lastFailureLog_{};
-  // Drops a set a stage failed on; true when the run should end for a rebuild.
-  bool dropFailedSet(const std::exception& error);
   std::optional<capture::Timestamp> firstTimestamp_;
   std::chrono::nanoseconds lastStreamTime_{0};
 };

@@ -1,17 +1,53 @@
 #include "daemon/pipeline_ends.hpp"
 
+#include <algorithm>
+#include <span>
+#include <utility>
+
 #include <spdlog/spdlog.h>
 
 #include "capture/file_source.hpp"
 #include "capture/libcamera_source.hpp"
+#include "capture/preloaded_source.hpp"
 #include "capture/v4l2_source.hpp"
 
 namespace surroundd::daemon {
+namespace {
+
+constexpr double kBytesPerMib = 1024.0 * 1024.0;
+
+// A file preloaded into memory, allowed what capture.preload_max_mb leaves after the cameras
+// preloaded before it (`before`: their names and bytes).
+std::unique_ptr<capture::PreloadedSource> openPreloaded(
+    const Config& config, const RigCamera& camera,
+    std::span<const std::pair<std::string, std::uint64_t>> before) {
+  capture::PreloadSettings settings;
+  settings.file = *camera.source;
+  settings.file.pacing = config.capture.pacing;
+  settings.format = *camera.preload;
+  const auto budget = static_cast<std::uint64_t>(config.capture.preloadMaxMb) << 20;
+  std::uint64_t used = 0;
+  std::string holders;
+  for (const auto& [name, bytes] : before) {
+    used += bytes;
+    holders += fmt::format("{}'{}' {:.1f} MiB", holders.empty() ? "" : ", ", name,
+                           static_cast<double>(bytes) / kBytesPerMib);
+  }
+  settings.maxBytes = budget - std::min(used, budget);
+  settings.maxBytesOrigin = fmt::format(
+      "capture.preload_max_mb: {} for every preloaded camera together{}",
+      config.capture.preloadMaxMb,
+      holders.empty() ? "" : fmt::format(", less what the cameras before it hold: {}", holders));
+  return std::make_unique<capture::PreloadedSource>(camera.calibration.name, settings);
+}
+
+}  // namespace
 
 std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& config) {
   // Each camera's queue, plus one frame waiting in the synchronizer and one being composed.
   const auto poolFrames = static_cast<std::size_t>(config.capture.queueFrames) + 2;
   std::vector<std::unique_ptr<capture::CameraStream>> cameras;
+  std::vector<std::pair<std::string, std::uint64_t>> preloadedBytes;  // per camera so far
   for (const auto& camera : config.cameras) {
     const auto& name = camera.calibration.name;
     std::unique_ptr<capture::FrameSource> source;
@@ -24,6 +60,13 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
       origin = fmt::format("{} ({})", camera.device->device.string(),
                            capture::toString(device->format()));
       source = std::move(device);
+    } else if (camera.preload) {
+      auto preloaded = openPreloaded(config, camera, preloadedBytes);
+      origin = fmt::format("{} (preloaded as {}, {:.1f} MiB)", camera.source->path.string(),
+                           capture::toString(*camera.preload),
+                           static_cast<double>(preloaded->bytes()) / kBytesPerMib);
+      preloadedBytes.emplace_back(name, preloaded->bytes());
+      source = std::move(preloaded);
     } else {
       auto settings = *camera.source;
       settings.pacing = config.capture.pacing;

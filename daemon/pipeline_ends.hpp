@@ -1,6 +1,7 @@
 #pragma once
-// The pipeline's cameras, opened from the config (file replay, V4L2, libcamera). Its outputs are
-// opened through their types' factories (output_type.hpp).
+// The pipeline's cameras, opened from the config (file replay, decoded as it plays or preloaded
+// into memory; V4L2, libcamera). Its outputs are opened through their types' factories
+// (output_type.hpp).
 //
 // Error policy: throws (CaptureError, std::runtime_error) with a message naming the camera, file or
 // device that could not be opened.

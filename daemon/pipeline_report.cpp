@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "daemon/compliance_limits.hpp"
+
 namespace surroundd::daemon {
 namespace {
 
@@ -14,6 +16,8 @@ double milliseconds(std::chrono::nanoseconds duration) {
 double seconds(std::chrono::nanoseconds duration) {
   return std::chrono::duration<double>(duration).count();
 }
+
+const char* verdict(bool met) { return met ? "met" : "not met"; }
 
 void family(std::string& out, std::string_view name, std::string_view type, std::string_view help) {
   fmt::format_to(std::back_inserter(out), "# HELP surroundd_{} {}\n# TYPE surroundd_{} {}\n", name,
@@ -39,6 +43,34 @@ const char* toString(Stage stage) {
   constexpr std::array<const char*, kStageCount> kNames{"sync",   "mosaic",    "stitch", "correct",
                                                         "render", "read-back", "output"};
   return kNames.at(static_cast<std::size_t>(stage));
+}
+
+const char* toString(StartupFrom from) {
+  constexpr std::array kNames{"process", "reload", "pipeline"};
+  return kNames.at(static_cast<std::size_t>(from));
+}
+
+std::string frameRateWithLimit(double framesPerSecond) {
+  return fmt::format("{:.1f} fps ({}: >= {:g} fps, {})", framesPerSecond,
+                     limits::kFrameRateAndLatencyStandard, limits::kMinFramesPerSecond,
+                     verdict(limits::frameRateMet(framesPerSecond)));
+}
+
+std::string latencyWithLimit(const DurationHistogram& latency) {
+  const auto p99 = latency.quantile(0.99);
+  return fmt::format("p50 {:.1f} ms  p99 {:.1f} ms ({}: p99 < {} ms, {})",
+                     milliseconds(latency.quantile(0.5)), milliseconds(p99),
+                     limits::kFrameRateAndLatencyStandard, limits::kMaxLatency.count(),
+                     verdict(limits::latencyMet(p99)));
+}
+
+std::string startupWithLimits(std::chrono::duration<double> startup, StartupFrom from) {
+  const auto exact = std::chrono::duration_cast<std::chrono::nanoseconds>(startup);
+  return fmt::format("{:.2f} s after the {} started ({}: <= {:.1f} s, {}; target <= {:.1f} s, {})",
+                     startup.count(), toString(from), limits::kFirstPictureStandard,
+                     seconds(limits::kMaxFirstPicture), verdict(limits::firstPictureMet(exact)),
+                     seconds(limits::kFirstPictureTarget),
+                     verdict(limits::firstPictureTargetMet(exact)));
 }
 
 std::string statusLine(const PipelineReport& report) {
@@ -71,11 +103,15 @@ std::string statusText(const PipelineReport& report) {
                    milliseconds(stage.quantile(0.99)), stage.count(),
                    static_cast<double>(stage.count()) / std::max(report.elapsed.count(), 1e-9));
   }
+  fmt::format_to(std::back_inserter(out), "frame rate: {}\n",
+                 frameRateWithLimit(report.framesPerSecond()));
   if (report.latency.count() > 0) {
-    fmt::format_to(
-        std::back_inserter(out), "latency capture to output: p50 {:.1f} ms  p99 {:.1f} ms\n",
-        milliseconds(report.latency.quantile(0.5)), milliseconds(report.latency.quantile(0.99)));
+    fmt::format_to(std::back_inserter(out), "latency capture to output: {}\n",
+                   latencyWithLimit(report.latency));
   }
+  fmt::format_to(std::back_inserter(out), "first picture: {}\n",
+                 report.startup ? startupWithLimits(*report.startup, report.startupFrom)
+                                : std::string("none yet"));
   for (std::size_t c = 0; c < report.cameras.size(); ++c) {
     const auto& camera = report.cameras[c];
     fmt::format_to(std::back_inserter(out),
@@ -106,7 +142,9 @@ std::string prometheusText(const PipelineReport& report) {
   std::string out;
   family(out, "frame_sets_total", "counter", "Frame sets that went through the pipeline.");
   fmt::format_to(std::back_inserter(out), "surroundd_frame_sets_total {}\n", report.frameSets);
-  family(out, "frames_per_second", "gauge", "Frame sets per second since the pipeline started.");
+  family(out, "frames_per_second", "gauge",
+         fmt::format("Frame sets per second since the pipeline started ({}: at least {:g}).",
+                     limits::kFrameRateAndLatencyStandard, limits::kMinFramesPerSecond));
   fmt::format_to(std::back_inserter(out), "surroundd_frames_per_second {:.3f}\n",
                  report.framesPerSecond());
   family(out, "stale_sets_dropped_total", "counter",
@@ -119,8 +157,20 @@ std::string prometheusText(const PipelineReport& report) {
             report.stages[s]);
   }
   family(out, "latency_seconds", "summary",
-         "From a frame set's capture (its oldest frame) to its picture handed to an output.");
+         fmt::format("From a frame set's capture (its oldest frame) to its picture handed to an "
+                     "output ({}: p99 below {:g}).",
+                     limits::kFrameRateAndLatencyStandard, seconds(limits::kMaxLatency)));
   summary(out, "latency_seconds", "", report.latency);
+  family(out, "startup_seconds", "gauge",
+         fmt::format("From the run's start (since: the process's, a reload's, or the pipeline's "
+                     "after a rebuild) to its first picture handed to an output; absent before "
+                     "({}: at most {:g}; target {:g}).",
+                     limits::kFirstPictureStandard, seconds(limits::kMaxFirstPicture),
+                     seconds(limits::kFirstPictureTarget)));
+  if (report.startup) {
+    fmt::format_to(std::back_inserter(out), "surroundd_startup_seconds{{since=\"{}\"}} {:.6f}\n",
+                   toString(report.startupFrom), report.startup->count());
+  }
 
   const auto perCamera = [&](std::string_view name, std::string_view type, std::string_view help,
                              const auto& value) {

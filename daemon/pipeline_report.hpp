@@ -6,6 +6,7 @@
 #include <array>
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,18 @@ namespace surroundd::daemon {
 enum class Stage { kSync, kMosaic, kStitch, kCorrect, kRender, kReadBack, kOutput, kCount };
 inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::kCount);
 const char* toString(Stage stage);
+
+// Where a run's start-up time (to its first picture out) counts from: the process's start (the
+// service's first run), a reload's acceptance (the gap a reload leaves in the pictures, the old
+// run's finalizing included), or the pipeline's construction (a rebuild after failures, the
+// benchmark, the tests).
+enum class StartupFrom { kProcess, kReload, kPipeline };
+const char* toString(StartupFrom from);  // "process", "reload", "pipeline"
+
+struct RunStart {
+  std::chrono::steady_clock::time_point at = std::chrono::steady_clock::now();
+  StartupFrom from = StartupFrom::kPipeline;
+};
 
 struct CameraReport {
   std::string name;
@@ -36,6 +49,9 @@ struct PipelineReport {
   std::vector<CameraReport> cameras;
   std::array<DurationHistogram, kStageCount> stages;  // per frame set that went through the stage
   DurationHistogram latency;  // a frame's capture to its picture handed to an output
+  // From the run's start to its first picture handed to an output; empty before.
+  std::optional<std::chrono::duration<double>> startup;
+  StartupFrom startupFrom = StartupFrom::kPipeline;
   std::size_t outputs = 0;
   std::uint64_t failedOutputs = 0;
   std::uint64_t failedSets = 0;     // frame sets a stage failed on (dropped)
@@ -49,11 +65,20 @@ struct PipelineReport {
 
 // "20.9 fps, 0 frames dropped by sync, mean skew 1.7 ms; front ok, right black, ..."
 std::string statusLine(const PipelineReport& report);
-// The status line, then one line per stage with p50/p99, the latency, and one line per camera.
+// The status line, then one line per stage with p50/p99, the frame rate, latency and first
+// picture beside their limits, and one line per camera.
 std::string statusText(const PipelineReport& report);
 // For the HTTP page: {"fps": .., "frames": .., "cameras": {"front": "ok", ..}, "latency_ms": ..,
 // "dropped_by_sync": ..}.
 std::string statusJson(const PipelineReport& report);
+// The figures beside their limits (compliance_limits.hpp), as the status and the benchmark print
+// them. "30.1 fps (ISO 16505 / IEC 63033-3: >= 30 fps, met)"
+std::string frameRateWithLimit(double framesPerSecond);
+// "p50 41.2 ms  p99 84.0 ms (ISO 16505 / IEC 63033-3: p99 < 200 ms, met)"
+std::string latencyWithLimit(const DurationHistogram& latency);
+// "0.62 s after the process started (FMVSS 111: <= 2.0 s, met; target <= 1.0 s, met)"
+std::string startupWithLimits(std::chrono::duration<double> startup, StartupFrom from);
+
 // Prometheus text exposition format (version 0.0.4), metric names prefixed surroundd_.
 std::string prometheusText(const PipelineReport& report);
 

@@ -10,13 +10,10 @@
 namespace surroundd::daemon {
 namespace {
 
-void readRecording(YamlObject& item, OutputConfig& o) {
-  o.path = item.outputPath("path").value_or("");
+void checkRecording(YamlObject& item, OutputConfig& o) {
   if (item.has("stream")) {
     item.error("stream", "a recording writes every camera's own stream; it takes no 'stream'");
   }
-  o.lossless = item.boolean("lossless", o.lossless);
-  o.crf = item.integer("crf", o.crf, 0, 51);
   std::error_code ec;
   if (!o.path.empty() && std::filesystem::exists(o.path, ec) &&
       !std::filesystem::is_directory(o.path, ec)) {
@@ -38,7 +35,13 @@ OutputType recordingOutputType() {
   OutputType type;
   type.name = "recording";
   type.input = OutputInput::kCameraFrames;
-  type.readSettings = readRecording;
+  using Key = ConfigKey<OutputConfig>;
+  type.keys = {
+      Key::requiredPath("path", &OutputConfig::path, "the folder written"),
+      Key::flag("lossless", &OutputConfig::lossless, "bit for bit"),
+      crfKey(),
+  };
+  type.readSettings = checkRecording;
   type.pathUse = [](const OutputConfig&) { return OutputPathUse::kFolder; };
   type.openCameraFramesSink = openRecording;
   return type;

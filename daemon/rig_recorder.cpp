@@ -22,6 +22,7 @@ RigRecorder::RigRecorder(RecordingSettings settings, std::vector<RigCamera> rig,
     // The replayed rig: the same calibration, its source this file.
     camera.device.reset();
     camera.libcamera.reset();
+    camera.preload.reset();  // the recording replays as a file, whatever the camera was
     camera.source = capture::FileSourceSettings{};
     camera.source->path = settings_.folder / (camera.calibration.name + ".mp4");
   }

@@ -18,7 +18,7 @@
 #include "capture/frame_set.hpp"
 #include "daemon/camera_frames_sink.hpp"
 #include "daemon/rig_yaml.hpp"
-#include "render/video_encoder.hpp"
+#include "render/outputs/video_encoder.hpp"
 
 namespace surroundd::daemon {
 

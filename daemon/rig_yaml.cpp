@@ -34,15 +34,48 @@ bool sequenceExists(const std::filesystem::path& pattern) {
   return false;
 }
 
+constexpr std::array<std::pair<std::string_view, capture::PixelLayout>, 2> kPreloadFormats{{
+    {"yuyv", capture::PixelLayout::kYuyv},
+    {"nv12", capture::PixelLayout::kNv12},
+}};
+
+// A file source's `preload` and `format`: the pixel format its frames are held in, or nullopt when
+// it is decoded as it plays.
+std::optional<capture::PixelLayout> readPreload(YamlObject& source) {
+  const bool preload = source.boolean("preload", false);
+  if (!preload && source.has("format")) {
+    source.error("format",
+                 "expected only with 'preload: true' (the pixel format preloaded frames "
+                 "are held in), got it without");
+    return std::nullopt;
+  }
+  if (!preload) return std::nullopt;
+  return source.choice(
+      "format", capture::PixelLayout::kYuyv,
+      std::span<const std::pair<std::string_view, capture::PixelLayout>>(kPreloadFormats));
+}
+
+// A live camera delivers its own frames: `preload` belongs to a file source only.
+void refusePreload(YamlObject& source, std::string_view kind) {
+  if (source.has("preload")) {
+    source.error("preload",
+                 fmt::format("expected only in a file source (a recording preloaded into "
+                             "memory), got it in a {} camera's",
+                             kind));
+  }
+}
+
 // A source whose file is wrong is still returned (its error is already recorded), so that the
 // camera is not reported a second time as having no source.
-capture::FileSourceSettings readSource(YamlObject& source) {
+capture::FileSourceSettings readSource(YamlObject& source,
+                                       std::optional<capture::PixelLayout>& preload) {
   capture::FileSourceSettings settings;
   const auto path = source.outputPath("file");
   // A still picture is a camera only if it repeats; a video or a sequence plays once by default.
   settings.loop = source.boolean("loop", path && capture::isStillPicturePath(*path));
   settings.sequenceFps =
       source.number("sequence_fps", 30.0, {0.0, 1000.0, true, "frames per second"});
+  preload = readPreload(source);
   source.finish();
   if (!path) return settings;
   settings.path = *path;
@@ -89,6 +122,7 @@ constexpr std::array<std::string_view, 8> kV4l2Controls{"exposure_auto",
 capture::V4l2Settings readDevice(YamlObject& source) {
   capture::V4l2Settings settings;
   settings.device = source.string("device", "");
+  refusePreload(source, "V4L2");
   settings.format = source.choice(
       "format", settings.format,
       std::span<const std::pair<std::string_view, capture::V4l2Format>>(kV4l2Formats));
@@ -111,6 +145,7 @@ capture::V4l2Settings readDevice(YamlObject& source) {
 capture::LibcameraSettings readLibcamera(YamlObject& source) {
   capture::LibcameraSettings settings;
   settings.camera = source.string("libcamera", "");
+  refusePreload(source, "libcamera");
   if (!capture::libcameraAvailable()) {
     source.error("libcamera",
                  "this surroundd is built without libcamera cameras: configure with "
@@ -261,17 +296,13 @@ processing::Pose readMount(YamlObject& mount) {
     if (angles)
       mount.errorHere("give either yaw_deg/pitch_deg/roll_deg or quaternion_wxyz, not both");
     if (const auto q = mount.numbers("quaternion_wxyz", {4})) {
-      const double norm =
-          std::sqrt((*q)[0] * (*q)[0] + (*q)[1] * (*q)[1] + (*q)[2] * (*q)[2] + (*q)[3] * (*q)[3]);
+      const cv::Vec4d wxyz((*q)[0], (*q)[1], (*q)[2], (*q)[3]);
+      const double norm = cv::norm(wxyz);
       if (std::abs(norm - 1.0) > 1e-3) {
         mount.error("quaternion_wxyz",
                     fmt::format("expected a unit quaternion (a rotation), got norm {:.6g}", norm));
       } else {
-        const double w = (*q)[0] / norm, x = (*q)[1] / norm, y = (*q)[2] / norm, z = (*q)[3] / norm;
-        pose.rotation =
-            cv::Matx33d(1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-                        2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                        2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y));
+        pose.rotation = processing::rotationFromQuaternion(wxyz / norm);
       }
     }
   } else {
@@ -339,7 +370,7 @@ std::vector<RigCamera> readRigCameras(YamlObject& rig) {
         camera.libcamera = readLibcamera(*source);
         camera.libcamera->size = calibration.intrinsics.imageSize;
       } else {
-        camera.source = readSource(*source);
+        camera.source = readSource(*source, camera.preload);
       }
     }
     if (auto mask = entry.object("body_mask")) {
@@ -412,6 +443,14 @@ void emitCamera(YAML::Emitter& out, const RigCamera& camera, const std::filesyst
     }
     if (camera.source->sequenceFps != capture::FileSourceSettings{}.sequenceFps) {
       out << YAML::Key << "sequence_fps" << YAML::Value << camera.source->sequenceFps;
+    }
+    if (camera.preload) {
+      out << YAML::Key << "preload" << YAML::Value << true;
+      for (const auto& [word, format] : kPreloadFormats) {
+        if (format == *camera.preload) {
+          out << YAML::Key << "format" << YAML::Value << std::string(word);
+        }
+      }
     }
     out << YAML::EndMap;
   }

@@ -59,8 +59,12 @@ void releaseFreedMemory() {
 
 }  // namespace
 
-Service::Service(Config config, ServiceSignals& signals, ServiceNotifier notifier)
-    : config_(std::move(config)), signals_(signals), notifier_(std::move(notifier)) {
+Service::Service(Config config, ServiceSignals& signals, ServiceNotifier notifier,
+                 std::chrono::steady_clock::time_point processStart)
+    : config_(std::move(config)),
+      nextStart_{processStart, StartupFrom::kProcess},
+      signals_(signals),
+      notifier_(std::move(notifier)) {
   const auto socket =
       config_.control.socket.empty() ? defaultControlSocket() : config_.control.socket;
   if (socket.empty()) {
@@ -76,7 +80,7 @@ int Service::run() {
   for (;;) {
     std::unique_ptr<Pipeline> pipeline;
     try {
-      pipeline = std::make_unique<Pipeline>(config_);
+      pipeline = std::make_unique<Pipeline>(config_, nextStart_);
     } catch (const std::exception& e) {
       if (!previous) {
         spdlog::critical("{}", e.what());
@@ -103,10 +107,16 @@ int Service::run() {
            std::chrono::steady_clock::now() < until && !signals_.stop;) {
         std::this_thread::sleep_for(std::chrono::milliseconds(100));
       }
-      if (!signals_.stop) continue;
+      if (!signals_.stop) {
+        nextStart_ = {};  // a rebuild counts from its own start, after the pause
+        continue;
+      }
     }
     if (!pending_ || signals_.stop) return summary.failedOutputs == 0 ? 0 : 1;
     previous = std::exchange(config_, *std::exchange(pending_, std::nullopt));
+    // The gap the reload leaves in the pictures: the old run's finalizing counts too. If the new
+    // config cannot start, the previous one's first picture still counts from here.
+    nextStart_ = {reloadedAt_, StartupFrom::kReload};
     ++reloads_;
     spdlog::info("reload: starting the pipeline for the new config (reload {})", reloads_);
   }
@@ -147,6 +157,7 @@ ControlReply Service::reload() {
       spdlog::warn("reload: control.socket changes only when surroundd restarts");
     }
     pending_ = std::move(fresh);
+    reloadedAt_ = std::chrono::steady_clock::now();
     endRun_ = true;
     return ControlReply::success("the new config is good; restarting the pipeline with it\n");
   } catch (const ConfigError& e) {

@@ -14,6 +14,7 @@
 // the signal handlers) and the control server's own thread (see ControlServer).
 
 #include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -32,8 +33,10 @@ struct ServiceSignals {
 
 class Service final : public PipelineObserver {
  public:
-  // Opens the control socket (throws std::runtime_error naming it if it cannot).
-  Service(Config config, ServiceSignals& signals, ServiceNotifier notifier);
+  // Opens the control socket (throws std::runtime_error naming it if it cannot). `processStart`:
+  // where the first run's start-up time counts from (processStartTime()).
+  Service(Config config, ServiceSignals& signals, ServiceNotifier notifier,
+          std::chrono::steady_clock::time_point processStart);
 
   // Runs until stopped or the cameras end. Exit code: 0, or 1 when the pipeline could not start
   // or an output failed.
@@ -50,6 +53,9 @@ class Service final : public PipelineObserver {
 
   Config config_;
   std::optional<Config> pending_;  // a good new config, started when the current run has ended
+  // Where the next run's start-up time counts from: the process's start, then the reload's.
+  RunStart nextStart_;
+  std::chrono::steady_clock::time_point reloadedAt_{};  // when pending_ was accepted
   int reloads_ = 0;
   int rebuilds_ = 0;  // in a row, without a frame set between: the pause before the next grows
   ServiceSignals& signals_;

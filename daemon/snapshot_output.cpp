@@ -5,14 +5,12 @@
 
 #include "daemon/built_in_outputs.hpp"
 #include "daemon/output_files.hpp"
-#include "render/snapshot_sink.hpp"
+#include "render/outputs/snapshot_sink.hpp"
 
 namespace surroundd::daemon {
 namespace {
 
-void readSnapshot(YamlObject& item, OutputConfig& o) {
-  o.path = item.outputPath("path").value_or("");
-  o.atSeconds = item.number("at_s", o.atSeconds, {0.0, 1e7, false, "seconds of stream time"});
+void checkSnapshot(YamlObject& item, OutputConfig& o) {
   if (!o.path.empty() && o.path.extension() != ".png") {
     item.error("path", fmt::format("expected a file ending in .png, got '{}'", o.path.string()));
   }
@@ -32,7 +30,13 @@ std::unique_ptr<render::FrameSink> openSnapshot(const OutputConfig& output,
 OutputType snapshotOutputType() {
   OutputType type;
   type.name = "snapshot";
-  type.readSettings = readSnapshot;
+  using Key = ConfigKey<OutputConfig>;
+  type.keys = {
+      Key::requiredPath("path", &OutputConfig::path, "the picture: .png"),
+      Key::number("at_s", &OutputConfig::atSeconds, {0.0, 1e7, false, "seconds of stream time"},
+                  "stream time of the snapshot"),
+  };
+  type.readSettings = checkSnapshot;
   type.pathUse = [](const OutputConfig&) { return OutputPathUse::kReplaced; };
   type.openPictureSink = openSnapshot;
   return type;

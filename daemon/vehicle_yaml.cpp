@@ -44,40 +44,66 @@ double VehicleConfig::reachM() const {
   return reach;
 }
 
-VehicleConfig readVehicle(YamlObject& v) {
-  VehicleConfig c;
-  const NumberRange size{0.05, 30.0, false, "metres"};
-  const NumberRange offset{-30.0, 30.0, false, "metres, vehicle frame"};
-  if (auto polygon = v.points("footprint", 3)) {
-    if (v.has("length_m") || v.has("width_m")) {
-      v.error("footprint", "give either length_m and width_m or footprint, not both");
-    }
-    c.footprint = *polygon;
-  } else {
-    c.lengthM = v.number("length_m", c.lengthM, size);
-    c.widthM = v.number("width_m", c.widthM, size);
+namespace {
+
+void readFootprint(YamlObject& v, VehicleConfig& c) {
+  if (auto polygon = v.points("footprint", 3)) c.footprint = *polygon;
+}
+
+// The box and the polygon are two ways to give one shape; the overhangs must leave a wheelbase.
+void checkShape(YamlObject& v, const VehicleConfig& c) {
+  if (!c.footprint.empty() && (v.has("length_m") || v.has("width_m"))) {
+    v.error("footprint", "give either length_m and width_m or footprint, not both");
   }
-  c.heightM = v.number("height_m", c.heightM, size);
-  c.groundClearanceM =
-      v.number("ground_clearance_m", c.groundClearanceM, {0.0, 5.0, false, "metres"});
   if (c.groundClearanceM >= c.heightM) {
     v.error("ground_clearance_m", fmt::format("expected less than height_m ({:g} m), got {:g}",
                                               c.heightM, c.groundClearanceM));
   }
-  c.frontOverhangM = v.number("front_overhang_m", c.frontOverhangM, {0.0, 10.0, false, "metres"});
-  c.rearOverhangM = v.number("rear_overhang_m", c.rearOverhangM, {0.0, 10.0, false, "metres"});
   if (c.footprint.empty() && c.frontOverhangM + c.rearOverhangM >= c.lengthM) {
     v.error("front_overhang_m",
             fmt::format("the overhangs ({:g} + {:g} m) leave no wheelbase in length_m {:g}",
                         c.frontOverhangM, c.rearOverhangM, c.lengthM));
   }
-  c.xM = v.number("x_m", c.xM, offset);
-  c.yM = v.number("y_m", c.yM, offset);
   if (!c.footprint.empty() && (v.has("x_m") || v.has("y_m"))) {
     v.error("footprint", "a footprint is already in the vehicle frame: x_m and y_m do not apply");
   }
-  c.marginM = v.number("margin_m", c.marginM, {0.0, 10.0, false, "metres"});
-  c.bodyMasks = v.boolean("body_masks", c.bodyMasks);
+}
+
+}  // namespace
+
+const ConfigKeys<VehicleConfig>& vehicleKeys() {
+  using Key = ConfigKey<VehicleConfig>;
+  const NumberRange size{0.05, 30.0, false, "metres"};
+  const NumberRange offset{-30.0, 30.0, false, "metres, vehicle frame"};
+  const NumberRange overhang{0.0, 10.0, false, "metres"};
+  static const ConfigKeys<VehicleConfig> kKeys{
+      Key::number("length_m", &VehicleConfig::lengthM, size, "bumper to bumper"),
+      Key::number("width_m", &VehicleConfig::widthM, size, "without mirrors"),
+      Key::custom(
+          "footprint", "a polygon instead of length_m and width_m", readFootprint,
+          [](const VehicleConfig& a, const VehicleConfig& b) { return a.footprint == b.footprint; },
+          {}, Shown::kExample),
+      Key::number("height_m", &VehicleConfig::heightM, size, "the roof above the ground"),
+      Key::number("ground_clearance_m", &VehicleConfig::groundClearanceM,
+                  {0.0, 5.0, false, "metres"}, "the underside above the ground"),
+      Key::number("front_overhang_m", &VehicleConfig::frontOverhangM, overhang,
+                  "front bumper to front axle"),
+      Key::number("rear_overhang_m", &VehicleConfig::rearOverhangM, overhang,
+                  "rear axle to rear bumper"),
+      Key::number("x_m", &VehicleConfig::xM, offset, "the body's centre, forward of the origin"),
+      Key::number("y_m", &VehicleConfig::yM, offset, "the body's centre, left of the origin"),
+      Key::number("margin_m", &VehicleConfig::marginM, overhang,
+                  "the dark ground patch drawn around the model reaches this far out"),
+      Key::flag("body_masks", &VehicleConfig::bodyMasks,
+                "mask the body out of the cameras that see it"),
+  };
+  return kKeys;
+}
+
+VehicleConfig readVehicle(YamlObject& v) {
+  VehicleConfig c;
+  vehicleKeys().read(v, c);
+  checkShape(v, c);
   v.finish();
   return c;
 }

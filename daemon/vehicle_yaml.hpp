@@ -1,19 +1,9 @@
 #pragma once
 // The ego vehicle in YAML: one `vehicle:` block (in the config, or in a rig file) that feeds the
-// car model of the render, the body masks of the stitcher and the default sizes of the views.
-//
-//   vehicle:
-//     length_m: 4.5            # bumper to bumper
-//     width_m: 1.85            # without mirrors
-//     height_m: 1.5            # roof above the ground
-//     ground_clearance_m: 0.15 # underside above the ground
-//     front_overhang_m: 0.9    # front bumper to front axle (the model's wheels)
-//     rear_overhang_m: 1.0     # rear axle to rear bumper
-//     x_m: 0.0                 # the body's centre in the vehicle frame (a rig whose origin is
-//     y_m: 0.0                 #   not under the body's centre)
-//     footprint: [[x, y], ...] # a polygon (vehicle frame, metres) instead of length and width
-//     margin_m: 0.3            # the dark ground patch drawn around the model
-//     body_masks: true         # mask the body out of each camera (false: the model only)
+// car model of the render, the body masks of the stitcher and the default sizes of the views. Its
+// keys (the box's length, width and height, ground clearance, overhangs, offset, or a footprint
+// polygon instead; the ground patch's margin; body_masks) are vehicleKeys()'s table, with their
+// ranges and docs; config/surroundd.reference.yaml shows them.
 //
 // Per camera, `body_mask:` adds to or replaces the computed mask: `{file: mask.png}` (white =
 // body, the lens's size) and/or `{polygon: [[u, v], ...]}` in pixels, `mode: add | replace`.
@@ -23,6 +13,7 @@
 #include <optional>
 #include <vector>
 
+#include "daemon/config_keys.hpp"
 #include "daemon/yaml_reader.hpp"
 #include "processing/vehicle_body.hpp"
 #include "render/car_model.hpp"
@@ -57,7 +48,9 @@ struct BodyMaskConfig {
   bool operator==(const BodyMaskConfig&) const = default;
 };
 
-// Reads and validates a `vehicle:` mapping; errors go to its Diagnostics.
+const ConfigKeys<VehicleConfig>& vehicleKeys();
+// Reads and validates a `vehicle:` mapping (its table, then the rules across keys); errors go to
+// its Diagnostics.
 VehicleConfig readVehicle(YamlObject& vehicle);
 // A camera's `body_mask:`; its picture must be of the lens's size.
 BodyMaskConfig readBodyMask(YamlObject& mask, cv::Size lensSize);

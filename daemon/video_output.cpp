@@ -6,7 +6,7 @@
 
 #include "daemon/built_in_outputs.hpp"
 #include "daemon/output_files.hpp"
-#include "render/video_sink.hpp"
+#include "render/outputs/video_sink.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -15,24 +15,26 @@ namespace {
 // view stays current.
 constexpr std::size_t kEncoderQueue = 3;
 
-// The encoder's keys, shared by both types.
-void readEncoding(YamlObject& item, OutputConfig& o) {
-  o.crf = item.integer("crf", o.crf, 0, 51);
-  o.preset = item.choice<std::string>("preset", o.preset,
-                                      {{"ultrafast", "ultrafast"},
-                                       {"superfast", "superfast"},
-                                       {"veryfast", "veryfast"},
-                                       {"faster", "faster"},
-                                       {"fast", "fast"},
-                                       {"medium", "medium"}});
-  o.pixelFormat = item.choice<std::string>("pixel_format", o.pixelFormat,
-                                           {{"yuv420p", "yuv420p"}, {"yuv444p", "yuv444p"}});
+using Key = ConfigKey<OutputConfig>;
+
+Key presetKey() {
+  return Key::choice("preset", &OutputConfig::preset,
+                     {{"ultrafast", "ultrafast"},
+                      {"superfast", "superfast"},
+                      {"veryfast", "veryfast"},
+                      {"faster", "faster"},
+                      {"fast", "fast"},
+                      {"medium", "medium"}},
+                     "x264 speed preset");
 }
 
-void readVideo(YamlObject& item, OutputConfig& o) {
-  o.path = item.outputPath("path").value_or("");
-  readEncoding(item, o);
-  o.segmentS = item.number("segment_s", o.segmentS, {0.0, 86400.0, false, "seconds"});
+Key pixelFormatKey() {
+  return Key::choice("pixel_format", &OutputConfig::pixelFormat,
+                     {{"yuv420p", "yuv420p"}, {"yuv444p", "yuv444p"}}, "the encoded pixel format");
+}
+
+// The container is chosen by the file's extension.
+void checkVideo(YamlObject& item, OutputConfig& o) {
   const auto extension = o.path.extension().string();
   if (extension != ".mp4" && extension != ".mkv") {
     item.error("path",
@@ -40,12 +42,10 @@ void readVideo(YamlObject& item, OutputConfig& o) {
   }
 }
 
-void readNetwork(YamlObject& item, OutputConfig& o) {
-  o.url = item.string("url", "");
+void checkNetwork(YamlObject& item, OutputConfig& o) {
   if (!o.url.starts_with("udp://") || o.url.size() <= 6) {
     item.error("url", fmt::format("expected udp://HOST:PORT, got '{}'", o.url));
   }
-  readEncoding(item, o);
 }
 
 std::unique_ptr<render::FrameSink> openVideo(const OutputConfig& output,
@@ -68,10 +68,22 @@ std::unique_ptr<render::FrameSink> openVideo(const OutputConfig& output,
 
 }  // namespace
 
+ConfigKey<OutputConfig> crfKey() {
+  return Key::integer("crf", &OutputConfig::crf, 0, 51, "x264 constant rate factor");
+}
+
 OutputType videoOutputType() {
   OutputType type;
   type.name = "video";
-  type.readSettings = readVideo;
+  type.keys = {
+      Key::requiredPath("path", &OutputConfig::path, "the file: .mp4 or .mkv (H.264)"),
+      crfKey(),
+      presetKey(),
+      pixelFormatKey(),
+      Key::number("segment_s", &OutputConfig::segmentS, {0.0, 86400.0, false, "seconds"},
+                  "a new file every this many seconds of stream time"),
+  };
+  type.readSettings = checkVideo;
   type.pathUse = [](const OutputConfig& o) {
     return o.segmentS > 0 ? OutputPathUse::kSegments : OutputPathUse::kKept;
   };
@@ -82,7 +94,14 @@ OutputType videoOutputType() {
 OutputType networkOutputType() {
   OutputType type;
   type.name = "network";
-  type.readSettings = readNetwork;
+  type.keys = {
+      Key::text("url", &OutputConfig::url, "where the stream goes, udp://HOST:PORT",
+                Shown::kExample),
+      crfKey(),
+      presetKey(),
+      pixelFormatKey(),
+  };
+  type.readSettings = checkNetwork;
   type.openPictureSink = openVideo;
   return type;
 }

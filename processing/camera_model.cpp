@@ -124,7 +124,10 @@ CameraModel::CameraModel(const Intrinsics& intrinsics) : intrinsics_(intrinsics)
 cv::Point2d CameraModel::sensorPoint(const cv::Point2d& pixel) const {
   const auto& in = intrinsics_;
   if (in.model != LensModel::kOcam) return {(pixel.x - in.cx) / in.fx, (pixel.y - in.cy) / in.fy};
-  // [u - xc; v - yc] = [c d; e 1] [x; y], inverted.
+  // [u - xc; v - yc] = [c d; e 1] [x; y], inverted. By hand: with Eigen's Matrix2d (inverse()
+  // here, the product in project()) sensorRadius() over a 1280x960 image took 23.2 ms against
+  // 18.5, project() of 1.2 million rays 93 against 88 ms (one core of the 2-core desk machine,
+  // medians of 5 alternating runs).
   const auto& a = in.ocam;
   const double det = a.c - a.d * a.e;
   const double du = pixel.x - in.cx;
@@ -206,7 +209,9 @@ std::optional<cv::Vec3d> CameraModel::unproject(const cv::Point2d& pixel) const 
     const double s = std::sin(theta) / thetaD;
     return cv::Vec3d(xd * s, yd * s, std::cos(theta));
   }
-  // Pinhole: Newton on the 2D distortion map, starting from the distorted point.
+  // Pinhole: Newton on the 2D distortion map, starting from the distorted point. The 2x2 step by
+  // Cramer's rule: with Eigen's Matrix2d and inverse() unprojecting every pixel of a 1280x720
+  // lens (a body mask's work) took 140 ms against 109 (medians of 5 alternating runs, one core).
   double x = xd;
   double y = yd;
   for (int i = 0; i < 50; ++i) {

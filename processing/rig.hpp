@@ -42,6 +42,8 @@ struct MountAngles {
 cv::Matx33d rotationFromMountAngles(const MountAngles& angles);
 // The inverse (pitch in [-90, 90]); rotationFromMountAngles() of the result gives `rotation` back.
 MountAngles mountAnglesFromRotation(const cv::Matx33d& rotation);
+// The rotation of a unit quaternion (w, x, y, z; Hamilton's convention, as ROS and Eigen write it).
+cv::Matx33d rotationFromQuaternion(const cv::Vec4d& wxyz);
 
 struct CameraCalibration {
   std::string name;

@@ -2,6 +2,7 @@
 # Installs the Debian 12 packages surroundd needs to build, test and run. Idempotent: installs only
 # what is missing and says what that is. Runs apt-get as root, or through sudo.
 # --fuzz: also clang and its sanitizer runtimes, for scripts/fuzz.sh (libFuzzer).
+# --soak: also gnuplot, for scripts/soak.sh's plot.
 # --cross-arm64: also the aarch64 cross compiler, qemu-user and mmdebstrap, for
 #   scripts/cross-arm64.sh.
 set -eu
@@ -10,18 +11,22 @@ PACKAGES="
   build-essential cmake pkg-config ccache
   libopencv-dev libyaml-cpp-dev libspdlog-dev libfmt-dev zlib1g-dev
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
-  libsuitesparse-dev
+  libsuitesparse-dev libeigen3-dev
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
   libx11-dev libxext-dev xvfb libdrm-dev libgbm-dev
   libturbojpeg0-dev libcamera-dev libsystemd-dev
-  libgtest-dev libgmock-dev opencv-doc help2man lintian
+  libgtest-dev libgmock-dev opencv-doc help2man lintian python3
   libmicrohttpd-dev chromium
 "
 
-case "${1:-}" in
-  --fuzz) PACKAGES="$PACKAGES clang libclang-rt-dev" ;;
-  --cross-arm64) PACKAGES="$PACKAGES crossbuild-essential-arm64 qemu-user-static mmdebstrap" ;;
-esac
+for argument in "$@"; do
+  case "$argument" in
+    --fuzz) PACKAGES="$PACKAGES clang libclang-rt-dev" ;;
+    --soak) PACKAGES="$PACKAGES gnuplot-nox" ;;
+    --cross-arm64) PACKAGES="$PACKAGES crossbuild-essential-arm64 qemu-user-static mmdebstrap" ;;
+    *) echo "usage: scripts/install-deps.sh [--fuzz] [--soak] [--cross-arm64]" >&2; exit 2 ;;
+  esac
+done
 
 # Node.js drives the browser test; Debian's is enough where none is installed.
 if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then

@@ -4,7 +4,9 @@
 # reloaded (SIGHUP) every SOAK_RELOAD_S seconds. Every SOAK_SAMPLE_S seconds its resident memory,
 # open files (/proc/PID/fd) and threads go into out/soak/samples.csv; at the end a summary
 # compares the memory after warm-up (the first sample after the first reload) with the end, per
-# reload. Exits 1 if surroundd died or a reload was not taken.
+# reload; with gnuplot (scripts/install-deps.sh --soak) it also draws them in out/soak/soak.png.
+# Exits 1 if surroundd died, a reload was not taken, or memory grows by more than
+# SOAK_MAX_MB_PER_RELOAD (1 MB) per reload after warm-up (judged from 10 reloads on).
 #
 #   scripts/soak.sh MINUTES
 #
@@ -125,7 +127,7 @@ while [ "$(date +%s)" -lt "$end" ]; do
     status=$(cat "/proc/$pid/status" 2>/dev/null) || { died=1; break; }
     rss=$(echo "$status" | awk '/^VmRSS:/ {print $2}')
     threads=$(echo "$status" | awk '/^Threads:/ {print $2}')
-    fds=$(ls "/proc/$pid/fd" 2>/dev/null | wc -l)
+    fds=$(find "/proc/$pid/fd" -mindepth 1 -maxdepth 1 2>/dev/null | wc -l)
     reloads=$(grep -c "reload: starting the pipeline for the new config" "$out/surroundd.log" || true)
     echo "$((now - start)),$reloads,$rss,$fds,$threads" >> "$out/samples.csv"
     next_sample=$((next_sample + sample_s))
@@ -139,7 +141,11 @@ trap - EXIT INT TERM
 # Memory is compared at the same point of each run: the last sample before the next reload (a
 # run's steady state; samples taken while a pipeline starts are lower). Warm-up: the first run
 # after the first reload.
-awk -F, -v sent="$sent" -v taken="$taken" -v died="$died" '
+# The verdict on memory: the least-squares slope of those steady values over the runs after warm-up
+# (endpoints alone swing by the ~10 MB a run's buffers vary), judged from 10 reloads on.
+max_growth=${SOAK_MAX_MB_PER_RELOAD:-1}
+memory=0
+awk -F, -v sent="$sent" -v taken="$taken" -v died="$died" -v max_growth="$max_growth" '
   NR == 1 { next }
   {
     n++; t[n] = $1; rss[n] = $3; fds[n] = $4; th[n] = $5
@@ -160,15 +166,53 @@ awk -F, -v sent="$sent" -v taken="$taken" -v died="$died" '
     line = "lowest RSS of each run (MB):"
     for (r = 0; r <= last; r++) if (r in low) line = line sprintf(" %.1f", low[r] / 1024)
     print line
+    grows = 0
     if (last >= 3) {
-      printf "after warm-up (run 1): %.1f MB; run %d: %.1f MB; %+.2f MB per reload\n",
-             steady[1] / 1024, last - 1, steady[last - 1] / 1024,
-             (steady[last - 1] - steady[1]) / 1024 / (last - 2)
+      for (r = 1; r < last; r++) if (r in steady) {
+        m++; x += r; y += steady[r] / 1024; xx += r * r; xy += r * steady[r] / 1024
+      }
+      slope = (m * xx - x * x) > 0 ? (m * xy - x * y) / (m * xx - x * x) : 0
+      printf "after warm-up (run 1): %.1f MB; run %d: %.1f MB; slope %+.2f MB per reload\n",
+             steady[1] / 1024, last - 1, steady[last - 1] / 1024, slope
+      if (last < 11) {
+        print "memory: too few reloads to judge growth (10 or more: run longer)"
+      } else if (slope > max_growth) {
+        printf "memory: GROWS %.2f MB per reload (more than %s)\n", slope, max_growth
+        grows = 1
+      } else {
+        printf "memory: flat (%+.2f MB per reload, limit %s)\n", slope, max_growth
+      }
     } else {
       print "growth per reload: too few reloads to compare (run longer)"
     }
     printf "open files: first %d, max %d, last %d; threads: first %d, max %d, last %d\n",
            fds[1], maxfd, fds[n], th[1], maxth, th[n]
-  }' "$out/samples.csv"
+    exit grows
+  }' "$out/samples.csv" || memory=1
+# The curves: memory on the left axis, open files and threads on the right, a mark at each reload.
+if command -v gnuplot >/dev/null 2>&1; then
+  gnuplot <<EOF
+set terminal pngcairo size 1200,600
+set output "$out/soak.png"
+set datafile separator ","
+set title "surroundd soak: ${minutes} min, a reload every ${reload_s} s"
+set xlabel "time (s)"
+set ylabel "resident memory (MB)"
+set y2label "open files, threads"
+set y2tics
+set ytics nomirror
+set yrange [0:*]
+set y2range [0:*]
+set key below horizontal
+prev = 0
+plot "$out/samples.csv" every ::1 using 1:(\$3/1024) with linespoints pt 7 ps 0.4 title "RSS (MB)", \
+     "" every ::1 using 1:4 axes x1y2 with steps title "open files", \
+     "" every ::1 using 1:5 axes x1y2 with steps title "threads", \
+     "" every ::1 using 1:(\$2 != prev ? (prev = \$2, 0) : 1/0) with points pt 9 lc "grey" title "reload"
+EOF
+  echo "plot: $out/soak.png"
+else
+  echo "soak: no plot (scripts/install-deps.sh --soak installs gnuplot)"
+fi
 echo "samples: $out/samples.csv; log: $out/surroundd.log"
-[ "$died" -eq 0 ] && [ "$taken" -ge $((sent - 1)) ]
+[ "$died" -eq 0 ] && [ "$taken" -ge $((sent - 1)) ] && [ "$memory" -eq 0 ]

@@ -12,6 +12,8 @@
 namespace surroundd {
 namespace {
 
+using ::testing::AllOf;
+using ::testing::ContainsRegex;
 using ::testing::HasSubstr;
 
 const std::string kRecording = std::string(SURROUNDD_FIXTURE_DIR) + "/synth_small";
@@ -66,6 +68,47 @@ TEST(BenchCli, PipelineReportsFrameRatesStagesAndTheBaselineAsJson) {
   EXPECT_LE(stages, 1000 / fps + 1e-6);
   EXPECT_GT(input["cpu_percent"].as<double>(), 0);
   EXPECT_GT(input["peak_mb"].as<double>(), 10);
+  // The figures held to limits: latency, and the start-up of the one run (its LUT built, so cold).
+  EXPECT_GT(input["latency_p50_ms"].as<double>(), 0);
+  EXPECT_GE(input["latency_p99_ms"].as<double>(), input["latency_p50_ms"].as<double>());
+  EXPECT_GT(input["startup_cold_s"].as<double>(), 0);
+  EXPECT_FALSE(input["startup_warm_s"]);
+}
+
+// --input raw: the recording is preloaded as a camera's frames, and the capture threads' work per
+// frame is the conversion to BGR; the report says so, and every set still comes out. The text
+// report gives the figures beside their limits.
+TEST(BenchCli, PipelineOnRawFramesSaysSoAndReportsTheConversion) {
+  const testing::TempDir dir;
+  testing::ChildProcess bench(
+      {SURROUND_BENCH, "pipeline", "--json", "--repeats", "1", "--size", "320x240", "--view", "top",
+       "--input", "raw", "--raw-format", "nv12", kRecording},
+      dir / "log.txt", {}, dir / "out.json");
+  ASSERT_EQ(bench.wait(), 0) << bench.output();
+  const YAML::Node report = YAML::Load(bench.standardOutput())["pipeline"];
+  EXPECT_EQ(report["input"].as<std::string>(), "raw-nv12");
+  const YAML::Node input = report["inputs"][0];
+  EXPECT_EQ(input["frame_sets"].as<int>(), 30);
+  EXPECT_GT(input["ms"]["convert"].as<double>(), 0);
+  EXPECT_FALSE(input["ms"]["decode"]);
+  EXPECT_NEAR(input["ratio"].as<double>(),
+              input["fps"].as<double>() / input["baseline_fps"].as<double>(), 1e-3);
+
+  // Two runs: the second reads the LUT the first cached, so the text gives a warm start-up too, and
+  // each figure is printed beside its limit.
+  testing::ChildProcess text({SURROUND_BENCH, "pipeline", "--repeats", "2", "--size", "320x240",
+                              "--view", "top", "--input", "raw", kRecording},
+                             dir / "text.txt");
+  ASSERT_EQ(text.wait(), 0) << text.output();
+  EXPECT_THAT(text.output(), AllOf(HasSubstr("input: raw-yuyv"), HasSubstr("convert+sync")));
+  EXPECT_THAT(text.output(),
+              AllOf(ContainsRegex("synth_small frame rate [0-9.]+ fps \\(ISO 16505 / IEC "
+                                  "63033-3: >= 30 fps, (not )?met\\)"),
+                    ContainsRegex("synth_small latency capture to output p50 [0-9.]+ ms  p99 "
+                                  "[0-9.]+ ms \\(ISO 16505 / IEC 63033-3: p99 < 200 ms, "),
+                    ContainsRegex("synth_small first picture [0-9.]+ s after the pipeline started "
+                                  "\\(FMVSS 111: <= 2\\.0 s, (not )?met; target <= 1\\.0 s, "
+                                  "(not )?met\\); cold LUT cache [0-9.]+ s")));
 }
 
 TEST(BenchCli, BadCommandLinesAreUsageErrors) {
@@ -78,6 +121,13 @@ TEST(BenchCli, BadCommandLinesAreUsageErrors) {
                   "--view needs top, 360, orbit or split"},
         std::pair{std::vector<std::string>{"pipeline", "--size", "641x480", kRecording},
                   "--size needs an even WIDTHxHEIGHT"},
+        std::pair{std::vector<std::string>{"pipeline", "--input", "h264", kRecording},
+                  "--input needs decode or raw"},
+        std::pair{std::vector<std::string>{"pipeline", "--input", "raw", "--raw-format", "uyvy",
+                                           kRecording},
+                  "--raw-format needs yuyv or nv12"},
+        std::pair{std::vector<std::string>{"pipeline", "--raw-format", "nv12", kRecording},
+                  "--raw-format goes with --input raw"},
         std::pair{std::vector<std::string>{"stitch", "--threads", "0", kRecording},
                   "--threads needs a number from 1 to 256"},
         std::pair{std::vector<std::string>{"stitch", "--fast", kRecording},

@@ -9,14 +9,7 @@ calibrate=$2
 source_dir=$3
 here=$(cd "$(dirname "$0")" && pwd)
 
-if [ ! -d "$here/node_modules/playwright-core" ]; then
-  echo "calibration_guide_test: run 'npm ci --prefix tests/browser' first (scripts/test.sh does)" >&2
-  exit 1
-fi
-
-work=$(mktemp -d)
-pid=""
-trap '[ -n "$pid" ] && { kill $pid 2>/dev/null || true; wait $pid 2>/dev/null || true; }; rm -rf "$work"' EXIT
+. "$here/test_setup.sh"
 "$synth" --rig "$source_dir/config/rigs/fisheye.yaml" --calibration-session front --size 640x360 \
   --seconds 15 --fps 4 --out "$work/session" > "$work/synth.txt"
 "$calibrate" guide --file "$work/session/frame_%04d.png" --fps 4 --board 9x6 --model fisheye \

@@ -1,5 +1,5 @@
 #!/usr/bin/env node
-// Headless-Chromium check of surroundd's live page (render/http_page.cpp) against a running HTTP
+// Headless-Chromium check of surroundd's live page (render/outputs/http_page.cpp) against a running HTTP
 // stream output. See README.md here for how to set it up and run it.
 //
 //   node tests/browser/live_page.test.mjs URL [--view NAME] [--min-view-change LEVELS]

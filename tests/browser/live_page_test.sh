@@ -7,13 +7,7 @@ surroundd=$1
 recording=$2/synth_small
 here=$(cd "$(dirname "$0")" && pwd)
 
-if [ ! -d "$here/node_modules/playwright-core" ]; then
-  echo "live_page_test: run 'npm ci --prefix tests/browser' first (scripts/test.sh does)" >&2
-  exit 1
-fi
-
-work=$(mktemp -d)
-trap 'kill $pid 2>/dev/null || true; wait $pid 2>/dev/null || true; rm -rf "$work"' EXIT
+. "$here/test_setup.sh"
 # The recording's rig with every source looping, so the page has pictures for as long as it needs.
 sed 's/source: {file: \(.*\)}/source: {file: '"$(printf '%s' "$recording" | sed 's/[\/&]/\\&/g')"'\/\1, loop: true}/' \
   "$recording/rig.yaml" > "$work/rig.yaml"

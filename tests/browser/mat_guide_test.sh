@@ -13,14 +13,7 @@ calibrate=$2
 source_dir=$3
 here=$(cd "$(dirname "$0")" && pwd)
 
-if [ ! -d "$here/node_modules/playwright-core" ]; then
-  echo "mat_guide_test: run 'npm ci --prefix tests/browser' first (scripts/test.sh does)" >&2
-  exit 1
-fi
-
-work=$(mktemp -d)
-pid=""
-trap '[ -n "$pid" ] && { kill $pid 2>/dev/null || true; wait $pid 2>/dev/null || true; }; rm -rf "$work"' EXIT
+. "$here/test_setup.sh"
 "$synth" --rig "$source_dir/config/rigs/fisheye.yaml" --calibration-mat 7x6@0.2 --size 960x540 \
   --out "$work/mat" > "$work/synth.txt"
 sed 's/square_m: 0.2$/square_m: 0.25/' "$work/mat/mat.yaml" > "$work/wrong-mat.yaml"

@@ -7,9 +7,9 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "processing/calibration_coverage.hpp"
-#include "processing/calibration_verdict.hpp"
-#include "processing/view_acceptance.hpp"
+#include "processing/calibration/calibration_coverage.hpp"
+#include "processing/calibration/calibration_verdict.hpp"
+#include "processing/calibration/view_acceptance.hpp"
 #include "tests/calibration/board_views_support.hpp"
 
 namespace surroundd::calibration::testing {

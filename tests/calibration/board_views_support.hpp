@@ -6,7 +6,7 @@
 #include <opencv2/aruco.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "processing/calibration_board.hpp"
+#include "processing/calibration/calibration_board.hpp"
 #include "tests/calibration/calibration_test_support.hpp"
 
 namespace surroundd::calibration::testing {

@@ -24,6 +24,7 @@ namespace {
 
 using surroundd::testing::TempDir;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 const processing::Checkerboard kBoard{{9, 6}, 0.05};
 
@@ -250,20 +251,12 @@ TEST(CalibrateCli, IntrinsicsWithAnUnreadableOrOddSizedImage) {
                     "from one camera at one resolution");
 }
 
-TEST(CalibrateCli, UsageErrorsNameTheOption) {
+// The guide's camera: an unreachable device, a recording that is not there (needs the guide's
+// page: a build without HTTP refuses the guide before it opens a camera).
+TEST(CalibrateCli, GuideCamerasThatCannotBeOpenedAreNamed) {
   const TempDir dir;
-  expectFailure(calibrate(dir, {}), 2,
-                "surround-calibrate: missing the subcommand: intrinsics, guide, extrinsics, import "
-                "or mask (see --help)");
-  expectFailure(calibrate(dir, {"calibrate"}), 2,
-                "unknown subcommand 'calibrate': expected intrinsics, guide, extrinsics, import or "
-                "mask");
-  // The guide: no camera, an unreachable device, a recording that is not there.
   const std::vector<std::string> guide{
       "guide", "--board", "9x6", "--model", "fisheye", "--out", (dir / "lens.yaml").string()};
-  expectFailure(calibrate(dir, guide), 2,
-                "surround-calibrate guide: --device or --file: give one camera (a V4L2 device, or "
-                "a recording)");
   auto onDevice = guide;
   onDevice.insert(onDevice.end(), {"--device", (dir / "video9").string()});
   expectFailure(calibrate(dir, onDevice), 2,
@@ -272,6 +265,38 @@ TEST(CalibrateCli, UsageErrorsNameTheOption) {
   auto onFile = guide;
   onFile.insert(onFile.end(), {"--file", (dir / "missing_%04d.png").string()});
   expectFailure(calibrate(dir, onFile), 2, "surround-calibrate guide: --file: ");
+  EXPECT_FALSE(std::filesystem::exists(dir / "lens.yaml"));
+}
+
+// A build without HTTP has no guide page: asking for it is refused before any camera is opened,
+// with how to build it in.
+TEST(CalibrateCli, GuideInABuildWithoutItsPageSaysHowToBuildIt) {
+  if (SURROUNDD_GUIDE_BUILT) GTEST_SKIP() << "this build has the guide (SURROUNDD_WITH_HTTP on)";
+  const TempDir dir;
+  const CalibrateRun run =
+      calibrate(dir, {"guide", "--board", "9x6", "--model", "fisheye", "--device",
+                      (dir / "video9").string(), "--out", (dir / "lens.yaml").string()});
+  expectFailure(run, 2,
+                "surround-calibrate guide: this build has no HTTP server for its page (configure "
+                "with -DSURROUNDD_WITH_HTTP=ON");
+  EXPECT_THAT(run.output, Not(HasSubstr("cannot open")));
+  EXPECT_THAT(run.output, Not(HasSubstr("failed")));
+}
+
+TEST(CalibrateCli, UsageErrorsNameTheOption) {
+  const TempDir dir;
+  expectFailure(calibrate(dir, {}), 2,
+                "surround-calibrate: missing the subcommand: intrinsics, guide, extrinsics, import "
+                "or mask (see --help)");
+  expectFailure(calibrate(dir, {"calibrate"}), 2,
+                "unknown subcommand 'calibrate': expected intrinsics, guide, extrinsics, import or "
+                "mask");
+  // The guide without a camera (its other inputs: GuideCamerasThatCannotBeOpenedAreNamed).
+  const std::vector<std::string> guide{
+      "guide", "--board", "9x6", "--model", "fisheye", "--out", (dir / "lens.yaml").string()};
+  expectFailure(calibrate(dir, guide), 2,
+                "surround-calibrate guide: --device or --file: give one camera (a V4L2 device, or "
+                "a recording)");
   EXPECT_FALSE(std::filesystem::exists(dir / "lens.yaml"));
   expectFailure(calibrate(dir, {"import", "--pjlab", dir.path().string(), "--axes",
                                 "right,forward,down", "--out", "rig.yaml"}),

@@ -12,8 +12,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "daemon/rig_yaml.hpp"
-#include "processing/calibration_error.hpp"
-#include "processing/calibration_targets.hpp"
+#include "processing/calibration/calibration_error.hpp"
+#include "processing/calibration/calibration_targets.hpp"
 #include "processing/rig.hpp"
 #include "tools/synth/calibration_mat.hpp"
 #include "tools/synth/calibration_scenes.hpp"

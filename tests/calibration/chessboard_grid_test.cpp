@@ -1,9 +1,10 @@
-// The label check on chessboard grids grown from part of a board (processing/chessboard_grid):
-// on a rendered 9x6 board, a correct grid and any part of it pass whole; a grid grown a row past
-// the board onto its outline is cut back to the board; grids that skip corners (every other
-// column, or columns 8, 3, 1, 0 as OpenCV grew one on an opencv-doc photograph) are refused.
+// The label check on chessboard grids grown from part of a board
+// (processing/calibration/chessboard_grid): on a rendered 9x6 board, a correct grid and any part of
+// it pass whole; a grid grown a row past the board onto its outline is cut back to the board; grids
+// that skip corners (every other column, or columns 8, 3, 1, 0 as OpenCV grew one on an opencv-doc
+// photograph) are refused.
 
-#include "processing/chessboard_grid.hpp"
+#include "processing/calibration/chessboard_grid.hpp"
 
 #include <numeric>
 

@@ -8,8 +8,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "processing/extrinsic_calibration.hpp"
-#include "processing/ground_marker_detection.hpp"
+#include "processing/calibration/extrinsic_calibration.hpp"
+#include "processing/calibration/ground_marker_detection.hpp"
 #include "tests/calibration/calibration_test_support.hpp"
 #include "tools/synth/hash.hpp"
 

@@ -415,6 +415,37 @@ TEST(Import, PjlabYamlOfTheFisheyeSampleWithTheOriginAtTheCamerasCentre) {
   }
 }
 
+// Found by the ASan run of the suite: a 3x3 matrix written as one flat list of 9 numbers was read
+// as one row, and its second and third rows from past its end.
+TEST(Import, MatricesWrittenAsFlatListsOfNineNumbersAreReadAsThreeRows) {
+  const TempDir dir;
+  const auto truth = preset("paper.yaml");
+  std::vector<std::string> arguments{"--out", (dir / "rig.yaml").string()};
+  for (const auto& camera : truth) {
+    const auto file = dir / (camera.name + ".yml");
+    const auto flat = [](const auto& matrix) {
+      return std::vector<double>(matrix.val, matrix.val + 9);
+    };
+    cv::FileStorage storage(file.string(), cv::FileStorage::WRITE);
+    const auto& lens = camera.intrinsics;
+    storage << "image_width" << lens.imageSize.width << "image_height" << lens.imageSize.height;
+    storage << "K" << flat(cv::Matx33d(cameraMatrix(lens)));
+    storage << "D" << std::vector<double>(lens.distortion.begin(), lens.distortion.end());
+    const auto [rotation, translation] = kTopDown.cameraFromSource(camera.pose);
+    storage << "R" << flat(rotation) << "t"
+            << std::vector<double>{translation.val, translation.val + 3};
+    storage.release();
+    arguments.push_back("--camera");
+    arguments.push_back(camera.name + "=" + file.string());
+  }
+  for (const auto& option : kTopDown.options()) arguments.push_back(option);
+  const auto imported = runImport(arguments);
+  expectPoses(imported, truth, "flat lists");
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    expectSameLens(imported[i].calibration.intrinsics, truth[i].intrinsics, truth[i].name);
+  }
+}
+
 std::string importError(const std::vector<std::string>& arguments) {
   try {
     runImport(arguments);

@@ -7,9 +7,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "processing/calibration_coverage.hpp"
-#include "processing/intrinsic_calibration.hpp"
-#include "processing/target_detection.hpp"
+#include "processing/calibration/calibration_coverage.hpp"
+#include "processing/calibration/intrinsic_calibration.hpp"
+#include "processing/calibration/target_detection.hpp"
 #include "tests/calibration/calibration_test_support.hpp"
 
 namespace surroundd::calibration::testing {

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "processing/mat_calibration.hpp"
+#include "processing/calibration/mat_calibration.hpp"
 #include "tests/calibration/calibration_test_support.hpp"
 #include "tools/synth/calibration_mat.hpp"
 

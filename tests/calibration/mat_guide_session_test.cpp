@@ -18,7 +18,7 @@
 #include <gtest/gtest.h>
 
 #include "daemon/rig_yaml.hpp"
-#include "processing/calibration_error.hpp"
+#include "processing/calibration/calibration_error.hpp"
 #include "tests/calibration/mat_calibration_support.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tools/calibrate/mat_guide_state_json.hpp"

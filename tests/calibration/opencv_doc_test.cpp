@@ -14,7 +14,7 @@
 #include <opencv2/imgproc.hpp>
 #include <yaml-cpp/yaml.h>
 
-#include "processing/calibration_board.hpp"
+#include "processing/calibration/calibration_board.hpp"
 #include "tests/calibration/calibrate_run.hpp"
 #include "tests/support/temp_dir.hpp"
 

@@ -2,7 +2,7 @@
 // board's own order however it is turned, several boards of one pattern are all found, and an
 // ArUco marker gives its id and its corners clockwise from its top left.
 
-#include "processing/target_detection.hpp"
+#include "processing/calibration/target_detection.hpp"
 
 #include <numbers>
 

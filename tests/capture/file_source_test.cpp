@@ -13,7 +13,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "capture/sequence_pattern.hpp"
-#include "render/video_encoder.hpp"
+#include "render/outputs/video_encoder.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/support/test_support.hpp"
 

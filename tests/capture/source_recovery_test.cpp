@@ -15,7 +15,7 @@
 #include "capture/camera_stream.hpp"
 #include "capture/file_source.hpp"
 #include "capture/v4l2_source.hpp"
-#include "render/video_encoder.hpp"
+#include "render/outputs/video_encoder.hpp"
 #include "tests/capture/fake_v4l2_device.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/support/test_support.hpp"

@@ -9,7 +9,7 @@
 #include "daemon/panorama_setup.hpp"
 #include "daemon/pipeline.hpp"
 #include "daemon/rig_yaml.hpp"
-#include "processing/panorama_ownership.hpp"
+#include "processing/stitch/panorama_ownership.hpp"
 #include "tests/support/temp_dir.hpp"
 
 namespace surroundd::daemon {

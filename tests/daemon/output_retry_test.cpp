@@ -71,8 +71,8 @@ TEST(OutputRetry, AFailedOutputIsOpenedAgainAndNothingItWroteIsLost) {
     EXPECT_EQ(part.last, capture::ReadStatus::kEndOfStream) << segment;
     after += part.images.size();
   }
-  // Every frame set since the output came back.
-  EXPECT_EQ(after, summary.frameSets - *watch.back);
+  // Every frame set made once it was back is in them.
+  EXPECT_GE(after, summary.frameSets - *watch.back);
   EXPECT_GE(after, OutputWatch::kSetsAfterReturn);
 }
 

@@ -1,5 +1,6 @@
-// The pipeline's figures: quantiles from the duration histogram, and the Prometheus text they are
-// published in (checked line by line against the exposition format's grammar).
+// The pipeline's figures: quantiles from the duration histogram, the limits printed beside them,
+// the process's start they count from, and the Prometheus text they are published in (checked
+// line by line against the exposition format's grammar).
 
 #include "daemon/pipeline_report.hpp"
 
@@ -11,6 +12,8 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+#include "daemon/process_start.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -70,6 +73,8 @@ PipelineReport sampleReport() {
   }
   report.outputs = 2;
   report.outputDropped = 3;
+  report.startup = milliseconds(620);
+  report.startupFrom = StartupFrom::kProcess;
   return report;
 }
 
@@ -82,9 +87,51 @@ TEST(PipelineReport, StatusNamesEveryCameraStageAndLatency) {
   EXPECT_THAT(text, ::testing::ContainsRegex(
                         "stage stitch +p50 +5\\.01 ms +p99 +10\\.00 ms +\\(100 sets, 10\\.0/s\\)"));
   EXPECT_THAT(text, ::testing::HasSubstr("latency capture to output: p50 33.5 ms"));
+  EXPECT_THAT(text, ::testing::HasSubstr(
+                        "frame rate: 30.0 fps (ISO 16505 / IEC 63033-3: >= 30 fps, met)\n"));
+  EXPECT_THAT(text, ::testing::ContainsRegex(
+                        "p99 3[0-9]\\.[0-9] ms \\(ISO 16505 / IEC 63033-3: p99 < 200 ms, met\\)"));
+  EXPECT_THAT(text, ::testing::HasSubstr("first picture: 0.62 s after the process started "
+                                         "(FMVSS 111: <= 2.0 s, met; target <= 1.0 s, met)\n"));
   EXPECT_THAT(text,
               ::testing::HasSubstr("camera back: out of sync, 295 frames, 0 faults, 2 queued"));
   EXPECT_THAT(text, ::testing::Not(::testing::HasSubstr("stage render")));  // nothing recorded
+}
+
+// Each limit is judged as its standard words it: at least 30 fps, latency below 200 ms (at the
+// p99), the first picture within 2.0 s (and surroundd's 1 s target).
+TEST(PipelineReport, FiguresAreJudgedAgainstTheirLimitsAtTheEdges) {
+  EXPECT_THAT(frameRateWithLimit(30.0), ::testing::EndsWith(", met)"));
+  EXPECT_THAT(frameRateWithLimit(29.96), ::testing::HasSubstr("30.0 fps (ISO 16505 / IEC 63033-3: "
+                                                              ">= 30 fps, not met)"));
+  const auto latencyOf = [](milliseconds duration) {
+    DurationHistogram histogram;
+    histogram.record(duration);
+    return latencyWithLimit(histogram);
+  };
+  EXPECT_THAT(latencyOf(milliseconds(199)), ::testing::EndsWith("p99 < 200 ms, met)"));
+  EXPECT_THAT(latencyOf(milliseconds(200)), ::testing::EndsWith("p99 < 200 ms, not met)"));
+  EXPECT_EQ(startupWithLimits(milliseconds(1500), StartupFrom::kReload),
+            "1.50 s after the reload started (FMVSS 111: <= 2.0 s, met; target <= 1.0 s, not met)");
+  EXPECT_THAT(startupWithLimits(milliseconds(2000), StartupFrom::kPipeline),
+              ::testing::HasSubstr("<= 2.0 s, met;"));
+  EXPECT_THAT(startupWithLimits(milliseconds(2010), StartupFrom::kPipeline),
+              ::testing::HasSubstr("<= 2.0 s, not met;"));
+
+  PipelineReport starting = sampleReport();
+  starting.startup.reset();
+  EXPECT_THAT(statusText(starting), ::testing::HasSubstr("first picture: none yet\n"));
+  EXPECT_THAT(prometheusText(starting), ::testing::Not(::testing::HasSubstr("startup_seconds{")));
+}
+
+// The kernel's start time, not main's: it lies before this program's static initializers ran, and
+// not long before (the loader maps the libraries in well under a minute).
+const auto kStaticInitialization = std::chrono::steady_clock::now();
+
+TEST(ProcessStartTime, LiesJustBeforeTheProgramsStaticInitialization) {
+  const auto started = processStartTime();
+  EXPECT_LE(started, kStaticInitialization);
+  EXPECT_LT(kStaticInitialization - started, std::chrono::minutes(1));
 }
 
 TEST(PipelineReport, PrometheusTextFollowsTheExpositionFormat) {
@@ -127,6 +174,9 @@ TEST(PipelineReport, PrometheusTextFollowsTheExpositionFormat) {
   EXPECT_EQ(values["surroundd_camera_sync_dropped_total{camera=\"right\"}"], 2);
   EXPECT_EQ(values["surroundd_camera_sets_without_total{camera=\"back\"}"], 5);
   EXPECT_EQ(values["surroundd_camera_queue_depth{camera=\"back\"}"], 2);
+  EXPECT_NEAR(values["surroundd_startup_seconds{since=\"process\"}"], 0.62, 1e-9);
+  EXPECT_THAT(text, ::testing::HasSubstr("(FMVSS 111: at most 2; target 1)"));
+  EXPECT_THAT(text, ::testing::HasSubstr("(ISO 16505 / IEC 63033-3: at least 30)"));
 }
 
 }  // namespace

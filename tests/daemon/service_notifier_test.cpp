@@ -4,6 +4,8 @@
 
 #include "daemon/service_notifier.hpp"
 
+#include <chrono>
+#include <csignal>
 #include <regex>
 
 #include <fmt/format.h>
@@ -67,20 +69,28 @@ TEST_F(ServiceNotifierTest, PingsTheWatchdogOnlyWhileFrameSetsKeepComing) {
   EXPECT_EQ(pingsIn(9000, 10000, true), 2);
 }
 
-// Every message until STOPPING=1, or until nothing comes for 2.5 s; the first (READY=1, once the
-// first frame set is through) may take up to 60 s, as under an emulator (scripts/cross-arm64.sh).
-// A reader that gave up early would leave surroundd blocked on a full socket.
-std::vector<std::string> messagesUntilStopping(testing::NotifySocket& socket) {
+// Every message until STOPPING=1 (the last one) while surroundd runs, however slowly it starts:
+// under a sanitizer on a loaded machine READY=1 came after more than 2.5 s, the test stopped
+// reading, and surroundd then blocked for good on the full socket. At most 2 minutes; a surroundd
+// still running then is killed, so that the test fails instead of hanging.
+std::vector<std::string> messagesUntilStopping(testing::NotifySocket& socket,
+                                               testing::ChildProcess& surroundd) {
   std::vector<std::string> all;
-  for (int idle = 0; idle < (all.empty() ? 1200 : 50);) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(2);
+  bool exited = false;
+  while (std::chrono::steady_clock::now() < deadline) {
     const auto message = socket.receive();
     if (!message) {
-      ++idle;
+      if (exited) break;  // and nothing more came after its exit
+      exited = !surroundd.running();
       continue;
     }
-    idle = 0;
     all.push_back(message->text);
-    if (all.back().find("STOPPING=1") != std::string::npos) break;  // the last one
+    if (all.back().find("STOPPING=1") != std::string::npos) break;
+  }
+  if (surroundd.running() && std::chrono::steady_clock::now() >= deadline) {
+    ADD_FAILURE() << "surroundd did not stop within 2 minutes";
+    surroundd.signal(SIGKILL);
   }
   return all;
 }
@@ -98,7 +108,7 @@ outputs:
   testing::ChildProcess surroundd(
       {SURROUNDD_EXECUTABLE, "--config", config.string()}, dir / "log.txt",
       {"NOTIFY_SOCKET=" + socket.path().string(), "WATCHDOG_USEC=200000"});
-  const auto messages = messagesUntilStopping(socket);
+  const auto messages = messagesUntilStopping(socket, surroundd);
   EXPECT_EQ(surroundd.wait(), 0) << surroundd.output();
   ASSERT_FALSE(messages.empty()) << surroundd.output();
   EXPECT_EQ(messages.front(), "READY=1");

@@ -2,6 +2,8 @@
 // good config (SIGHUP and `reload`), SIGTERM leaving playable files, and the watchdog going quiet
 // when a stage stalls. The rig replays the small synthetic recording in a loop, in real time.
 
+#include <algorithm>
+#include <functional>
 #include <regex>
 #include <thread>
 
@@ -88,6 +90,23 @@ outputs:
       }
     }
   }
+  // The start-up time in `status`, checked to lie between 0 and the time since `since` (when the
+  // test started what it counts from) and to have its limits beside it.
+  void expectFirstPictureWithin(std::string_view from,
+                                std::chrono::steady_clock::time_point since) const {
+    const auto status = request("status");
+    const double upTo =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+    std::smatch match;
+    ASSERT_TRUE(std::regex_search(
+        status.body, match,
+        std::regex(fmt::format(R"(first picture: ([0-9.]+) s after the {} started \(FMVSS 111: <= )"
+                               R"(2\.0 s, (not )?met; target <= 1\.0 s, (not )?met\))",
+                               from))))
+        << status.body;
+    EXPECT_GT(std::stod(match[1]), 0);
+    EXPECT_LT(std::stod(match[1]), upTo);
+  }
   // Waits until the pipeline has gone through at least `sets` frame sets.
   void waitForSets(testing::ChildProcess& surroundd, std::uint64_t sets) const {
     const auto deadline = std::chrono::steady_clock::now() + 30s;
@@ -103,6 +122,7 @@ outputs:
 };
 
 TEST_F(ServiceTest, ControlRequestsRoundTripAndSigtermLeavesPlayableFiles) {
+  const auto launched = std::chrono::steady_clock::now();
   auto surroundd = start(writeConfig(R"(  - {type: video, stream: surround, path: out/orbit.mp4}
   - {type: video, stream: mosaic, path: out/mosaic.mkv}
   - {type: http, stream: surround, listen: "127.0.0.1:0"})"));
@@ -115,6 +135,12 @@ TEST_F(ServiceTest, ControlRequestsRoundTripAndSigtermLeavesPlayableFiles) {
     EXPECT_THAT(status.body, ::testing::ContainsRegex(fmt::format("stage {} +p50", stage)));
   }
   EXPECT_THAT(status.body, HasSubstr("latency capture to output: p50"));
+  // The figures beside their limits; the start-up counts from the process's start.
+  EXPECT_THAT(status.body,
+              ::testing::ContainsRegex(
+                  R"(frame rate: [0-9.]+ fps \(ISO 16505 / IEC 63033-3: >= 30 fps, )"));
+  EXPECT_THAT(status.body, HasSubstr("ms (ISO 16505 / IEC 63033-3: p99 < 200 ms, "));
+  expectFirstPictureWithin("process", launched);
 
   const auto metrics = request("metrics");
   ASSERT_TRUE(metrics.ok);
@@ -124,6 +150,14 @@ TEST_F(ServiceTest, ControlRequestsRoundTripAndSigtermLeavesPlayableFiles) {
   EXPECT_GE(std::stoi(match[1]), 10);
   EXPECT_THAT(metrics.body, HasSubstr("surroundd_latency_seconds{quantile=\"0.99\"}"));
   EXPECT_THAT(metrics.body, HasSubstr("surroundd_camera_healthy{camera=\"left\"} 1"));
+  ASSERT_TRUE(std::regex_search(metrics.body, match,
+                                std::regex("\nsurroundd_startup_seconds\\{since=\"process\"\\} "
+                                           "([0-9.]+)\n")))
+      << metrics.body;
+  EXPECT_GT(std::stod(match[1]), 0);
+  EXPECT_LT(std::stod(match[1]),
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - launched).count());
+  EXPECT_THAT(surroundd->output(), HasSubstr("first picture out "));
 
   // The view switches: the next snapshot is a top view, unlike the orbit before it.
   const auto before = request("snapshot");
@@ -191,11 +225,14 @@ TEST_F(ServiceTest, AReloadWithABadConfigIsRejectedAndAGoodOneRestartsTheOutputs
   // A good one: the first file is finalized, the new outputs start under new names.
   writeConfig(R"(  - {type: video, stream: mosaic, path: out/first.mp4}
   - {type: snapshot, stream: mosaic, path: out/still.png, at_s: 0.1})");
+  const auto reloaded = std::chrono::steady_clock::now();
   const auto accepted = request("reload");
   EXPECT_TRUE(accepted.ok) << accepted.body;
   // The reply comes before the old pipeline ends; every status after this line is the new one's.
   waitForLog(*surroundd, "reload: starting the pipeline for the new config");
   waitForSets(*surroundd, 5);
+  // The new run's start-up: the gap the reload left in the pictures.
+  expectFirstPictureWithin("reload", reloaded);
   surroundd->signal(SIGTERM);
   EXPECT_EQ(surroundd->wait(), 0) << surroundd->output();
   const auto first = testing::decodeAll(dir_ / "out/first.mp4");
@@ -237,6 +274,59 @@ TEST_F(ServiceTest, AStalledOutputStageStopsTheWatchdogPings) {
   EXPECT_EQ(messages.front().text, "READY=1");
   EXPECT_GE(std::ranges::count_if(messages, isPing), 1);
   EXPECT_TRUE(stopped) << "the watchdog pings went on while the output stage was stalled";
+}
+
+// (A short name: the notify socket's path, in a folder named after the test, must fit in 108
+// bytes.)
+TEST_F(ServiceTest, DegradedWhileNoOutputWorks) {
+  // Issue 18.3: a recorder whose only output had failed kept feeding the watchdog. Its folder is
+  // taken away (a file stands in its place, so every new segment fails to open, as on a full
+  // disk), then given back.
+  testing::NotifySocket notify(dir_ / "notify");
+  auto surroundd = start(
+      writeConfig(R"(  - {type: video, stream: mosaic, path: out/drive.mkv, segment_s: 0.5})"),
+      {"NOTIFY_SOCKET=" + (dir_ / "notify").string(), "WATCHDOG_USEC=200000"});
+  std::vector<testing::NotifySocket::Message> messages;
+  const auto isPing = [](const auto& m) { return m.text == "WATCHDOG=1"; };
+  const auto isDegraded = [](const auto& m) {
+    return m.text.starts_with("STATUS=degraded: every output has failed");
+  };
+  // Reads until `done` holds, at most 60 s (however slowly it runs: CI load, sanitizers).
+  const auto readUntil = [&](const std::function<bool()>& done) {
+    for (const auto deadline = std::chrono::steady_clock::now() + 60s;
+         !done() && std::chrono::steady_clock::now() < deadline && surroundd->running();) {
+      if (auto message = notify.receive()) messages.push_back(std::move(*message));
+    }
+    return done();
+  };
+  ASSERT_TRUE(readUntil([&] { return std::ranges::any_of(messages, isPing); }))
+      << surroundd->output();
+
+  std::filesystem::rename(dir_ / "out", dir_ / "out-taken");
+  dir_.write("out", "not a folder");
+  const auto taken = messages.size();
+  const auto since = [&](std::size_t from, const auto& what) {
+    return std::ranges::any_of(messages.begin() + static_cast<std::ptrdiff_t>(from), messages.end(),
+                               what);
+  };
+  // Degraded, and then no ping for 3 s (fifteen 200 ms watchdog periods).
+  const bool quiet = readUntil([&] {
+    if (!since(taken, isDegraded)) return false;
+    const auto lastPing = std::ranges::find_if(messages.rbegin(), messages.rend(), isPing);
+    return std::chrono::steady_clock::now() - lastPing->at > 3s;
+  });
+  ASSERT_TRUE(surroundd->running()) << surroundd->output();
+  EXPECT_TRUE(quiet) << "no degraded status, or the pings went on: " << surroundd->output();
+  EXPECT_THAT(surroundd->output(), HasSubstr("output still failing"));
+
+  // The folder is back: the next retry opens the output again and the pings resume.
+  std::filesystem::remove(dir_ / "out");
+  const auto back = messages.size();
+  EXPECT_TRUE(readUntil([&] { return since(back, isPing); })) << surroundd->output();
+  EXPECT_THAT(surroundd->output(), HasSubstr("works again"));
+  surroundd->signal(SIGTERM);
+  EXPECT_EQ(surroundd->wait(), 1) << "an output failed in this run: " << surroundd->output();
+  EXPECT_FALSE(std::filesystem::is_empty(dir_ / "out"));
 }
 
 }  // namespace

@@ -11,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-#include "render/http_server.hpp"
+#include "render/outputs/http_server.hpp"
 #include "tests/fuzz/fuzz_support.hpp"
 
 namespace {

@@ -13,7 +13,7 @@
 
 #include <zlib.h>
 
-#include "processing/panorama_lut_cache.hpp"
+#include "processing/stitch/panorama_lut_cache.hpp"
 #include "tests/fuzz/fuzz_support.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

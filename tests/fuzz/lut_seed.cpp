@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "processing/panorama_lut_cache.hpp"
+#include "processing/stitch/panorama_lut_cache.hpp"
 
 using surroundd::processing::BlendTap;
 using surroundd::processing::LutTap;

@@ -399,5 +399,23 @@ TEST(Rig, MountAnglesRoundTrip) {
   EXPECT_NEAR(axis[2], -0.5, 1e-12);
 }
 
+// A quaternion turns as the mount angles do: yaw about +z, pitch about -y, roll about +x.
+TEST(Rig, QuaternionTurnsAsTheMountAnglesDo) {
+  const cv::Matx33d level = rotationFromMountAngles({});
+  const auto about = [](double deg, const cv::Vec3d& axis) {
+    const double half = deg * kDegToRad / 2;
+    return cv::Vec4d(std::cos(half), std::sin(half) * axis[0], std::sin(half) * axis[1],
+                     std::sin(half) * axis[2]);
+  };
+  for (const auto& [angles, quaternion] :
+       {std::pair{MountAngles{90, 0, 0}, about(90, {0, 0, 1})},
+        std::pair{MountAngles{0, -30, 0}, about(30, {0, 1, 0})},
+        std::pair{MountAngles{0, 0, 12}, about(12, {1, 0, 0})}}) {
+    EXPECT_LT(cv::norm(rotationFromQuaternion(quaternion) * level - rotationFromMountAngles(angles),
+                       cv::NORM_INF),
+              1e-12);
+  }
+}
+
 }  // namespace
 }  // namespace surroundd::processing

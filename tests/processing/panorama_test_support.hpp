@@ -7,7 +7,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "processing/panorama_lut.hpp"
+#include "processing/stitch/panorama_lut.hpp"
 #include "tools/bench/recording_truth.hpp"
 
 namespace surroundd::processing::testing {

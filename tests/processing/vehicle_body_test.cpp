@@ -10,7 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "common/work_pool.hpp"
-#include "processing/panorama_lut.hpp"
+#include "processing/stitch/panorama_lut.hpp"
 #include "tests/processing/panorama_test_support.hpp"
 
 namespace surroundd::processing {

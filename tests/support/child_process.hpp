@@ -62,18 +62,16 @@ class ChildProcess {
   // Whether it has not exited yet (if it has, its status is collected and wait() is not needed).
   bool running() {
     if (exited_) return false;
-    int status = 0;
-    if (::waitpid(pid_, &status, WNOHANG) == 0) return true;
+    if (::waitpid(pid_, &status_, WNOHANG) == 0) return true;
     exited_ = true;
     return false;
   }
 
   // Exit status, or 128 + signal number when it was killed.
   int wait() {
-    int status = 0;
-    ::waitpid(pid_, &status, 0);
+    if (!exited_) ::waitpid(pid_, &status_, 0);
     exited_ = true;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    return WIFEXITED(status_) ? WEXITSTATUS(status_) : 128 + WTERMSIG(status_);
   }
 
   // What it wrote to stderr (and stdout, unless that has its own file).
@@ -104,6 +102,7 @@ class ChildProcess {
   std::filesystem::path stdoutFile_;
   pid_t pid_ = -1;
   bool exited_ = false;
+  int status_ = 0;  // waitpid's, once it has exited
 };
 
 }  // namespace surroundd::testing

@@ -14,8 +14,8 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include "render/outputs/xlib_display.hpp"  // after every other header: Xlib's macros
 #include "render/render_error.hpp"
-#include "render/xlib_display.hpp"  // after every other header: Xlib's macros
 
 namespace surroundd::testing {
 namespace {

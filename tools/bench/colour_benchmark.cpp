@@ -7,9 +7,9 @@
 
 #include "capture/file_source.hpp"
 #include "common/work_pool.hpp"
-#include "processing/gain_compensation.hpp"
-#include "processing/poisson_correction.hpp"
-#include "processing/stitcher.hpp"
+#include "processing/colour/gain_compensation.hpp"
+#include "processing/colour/poisson_correction.hpp"
+#include "processing/stitch/stitcher.hpp"
 #include "tools/bench/panorama_accuracy.hpp"
 #include "tools/bench/poisson_benchmark.hpp"
 #include "tools/bench/recording_truth.hpp"

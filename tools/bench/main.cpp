@@ -4,7 +4,8 @@
 //   surround-bench stitch [--threads N] [--repeats N] [--json] RECORDING...
 //   surround-bench colour [--threads N] [--repeats N] [--pictures DIR] RECORDING|CONFIG...
 //   surround-bench pipeline [--threads N] [--repeats N] [--json] [--solver S] [--projection P]
-//                           [--view V] [--size WxH] RECORDING...
+//                           [--view V] [--size WxH] [--input decode|raw] [--raw-format F]
+//                           RECORDING...
 //
 // Exit codes: 0 done, 1 failed while measuring, 2 bad command line.
 
@@ -29,7 +30,8 @@ constexpr std::string_view kUsage =
     R"(usage: surround-bench stitch [--threads N] [--repeats N] [--json] RECORDING...
        surround-bench colour [--threads N] [--repeats N] [--pictures DIR] RECORDING|CONFIG...
        surround-bench pipeline [--threads N] [--repeats N] [--json] [--solver S]
-                               [--projection P] [--view V] [--size WxH] RECORDING...
+                               [--projection P] [--view V] [--size WxH] [--input I]
+                               [--raw-format F] RECORDING...
   stitch        LUT build, stitch against cv::remap, accuracy against the ground truth
   colour        Poisson colour correction: solvers, per-frame cost, seam colour error; for a
                 CONFIG (a surroundd .yaml: any rig, the shared real ones, your own car): per
@@ -37,6 +39,8 @@ constexpr std::string_view kUsage =
                 no correction, gains and Poisson, and the mean level
   pipeline      the whole daemon pipeline (the paper's tables 1 and 2): frames per second,
                 milliseconds per stage, CPU and peak memory, against a decode-only replay
+                (--input raw: convert-only); frame rate, latency and time to the first picture
+                (cold and warm LUT cache) beside their limits
   RECORDING     a surround-synth recording folder (with ground truth); scripts/bench.sh makes
                 4x480p, 720p and 1080p ones
   --threads N   worker threads (default 2); stitch measures 1 thread too
@@ -46,6 +50,10 @@ constexpr std::string_view kUsage =
   --projection P  pipeline: bowl | sphere (default bowl)
   --view V      pipeline: top | 360 | orbit | split (default orbit)
   --size WxH    pipeline: output size (default 1280x720)
+  --input I     pipeline: decode (each video decoded as it plays: replay figures; the default) |
+                raw (decoded once at start into memory as a camera's frames, converted to BGR per
+                frame as a V4L2 camera's are: live-rig figures)
+  --raw-format F  pipeline, --input raw: yuyv | nv12 (default yuyv)
   --pictures DIR  colour, CONFIG: also write the panoramas (none, gain, Poisson) and body masks
 )";
 
@@ -79,6 +87,7 @@ std::optional<E> parseWord(std::string_view text,
 
 int main(int argc, char** argv) {
   namespace bench = surroundd::bench;
+  using surroundd::capture::PixelLayout;
   using surroundd::processing::PanoramaProjection;
   using surroundd::processing::PoissonSolverKind;
   using surroundd::render::ViewKind;
@@ -94,6 +103,7 @@ int main(int argc, char** argv) {
   bench::PipelineBenchmarkOptions pipeline;
   std::optional<int> repeats;
   std::filesystem::path pictures;
+  bool rawFormat = false;  // --raw-format given
   for (int i = 2; i < argc; ++i) {
     const std::string_view arg = argv[i];
     const bool hasValue = i + 1 < argc;
@@ -129,6 +139,19 @@ int main(int argc, char** argv) {
       if (!view) return usageError("--view needs top, 360, orbit or split");
       pipeline.view = *view;
       ++i;
+    } else if (command == "pipeline" && arg == "--input") {
+      const auto input = parseWord<bench::BenchInput>(
+          value, {{"decode", bench::BenchInput::kDecode}, {"raw", bench::BenchInput::kRaw}});
+      if (!input) return usageError("--input needs decode or raw");
+      pipeline.input = *input;
+      ++i;
+    } else if (command == "pipeline" && arg == "--raw-format") {
+      const auto format = parseWord<PixelLayout>(
+          value, {{"yuyv", PixelLayout::kYuyv}, {"nv12", PixelLayout::kNv12}});
+      if (!format) return usageError("--raw-format needs yuyv or nv12");
+      pipeline.rawFormat = *format;
+      rawFormat = true;
+      ++i;
     } else if (command == "colour" && arg == "--pictures") {
       if (!hasValue) return usageError("--pictures needs a folder");
       pictures = value;
@@ -145,6 +168,9 @@ int main(int argc, char** argv) {
     }
   }
   if (options.recordings.empty()) return usageError("no recording given");
+  if (rawFormat && pipeline.input != bench::BenchInput::kRaw) {
+    return usageError("--raw-format goes with --input raw");
+  }
   if (repeats) options.repeats = *repeats;
   try {
     if (command == "colour") {

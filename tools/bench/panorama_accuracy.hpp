@@ -10,7 +10,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "processing/panorama_lut.hpp"
+#include "processing/stitch/panorama_lut.hpp"
 #include "tools/bench/recording_truth.hpp"
 #include "tools/synth/scene.hpp"
 

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -33,14 +35,22 @@ struct RunFigures {
   double fps() const { return summary.framesPerSecond(); }
 };
 
+// From the pipeline's construction (cameras and outputs opened, the LUT built or read from the
+// cache; with raw input, the recording preloaded) to its first picture handed to the video output.
+using Startup = std::chrono::duration<double>;
+
 struct RecordingFigures {
   std::string name;
   cv::Size camera;
   cv::Size panorama;
   RunFigures full;         // the run of median frame rate
   double baselineFps = 0;  // median
-  double decodeMs = 0;     // per camera frame, in the capture threads
+  double decodeMs = 0;     // per camera frame, in the capture threads: decode or raw conversion
+  Startup coldStartup{0};  // the first full run's: the LUT is built and cached
+  std::optional<Startup> warmStartup;  // the median of the later runs': read from the cache
 };
+
+Startup startupOf(const RunFigures& run) { return run.summary.report.startup.value_or(Startup{}); }
 
 double cpuSecondsSoFar() {
   rusage usage{};
@@ -88,6 +98,9 @@ daemon::Config configFor(const std::filesystem::path& folder, const RecordingTru
   config.panorama.projection = options.projection;
   config.panorama.cacheDir = scratch / "lut-cache";
   config.colour.poisson.solver = options.solver;
+  if (options.input == BenchInput::kRaw) {
+    for (auto& camera : config.cameras) camera.preload = options.rawFormat;
+  }
   config.render.view = options.view;
   config.render.widthPx = options.outputSize.width;
   config.render.heightPx = options.outputSize.height;
@@ -113,10 +126,19 @@ RecordingFigures measure(const std::filesystem::path& folder,
     baselineFps.push_back(runOnce(baseline).fps());
     fullRuns.push_back(runOnce(full));
   }
+  RecordingFigures figures;
+  figures.coldStartup = startupOf(fullRuns.front());
+  if (fullRuns.size() > 1) {
+    std::vector<Startup> warm;
+    for (auto run = fullRuns.begin() + 1; run != fullRuns.end(); ++run) {
+      warm.push_back(startupOf(*run));
+    }
+    std::ranges::sort(warm);
+    figures.warmStartup = warm[warm.size() / 2];
+  }
   std::ranges::sort(fullRuns, {}, &RunFigures::fps);
   std::ranges::sort(baselineFps);
 
-  RecordingFigures figures;
   figures.name = folder.filename().string();
   figures.camera = truth.rig.cameras.front().intrinsics.imageSize;
   figures.panorama = truth.panorama.size;
@@ -150,6 +172,41 @@ constexpr std::array kStages{daemon::Stage::kSync,     daemon::Stage::kStitch,
                              daemon::Stage::kCorrect,  daemon::Stage::kRender,
                              daemon::Stage::kReadBack, daemon::Stage::kOutput};
 
+// The input's name in the report ("decode", "raw-yuyv", "raw-nv12") and what the capture threads
+// do per camera frame.
+std::string inputName(const PipelineBenchmarkOptions& options) {
+  if (options.input == BenchInput::kDecode) return "decode";
+  return options.rawFormat == capture::PixelLayout::kNv12 ? "raw-nv12" : "raw-yuyv";
+}
+const char* captureWork(const PipelineBenchmarkOptions& options) {
+  return options.input == BenchInput::kDecode ? "decode" : "convert";
+}
+
+// The figures the standards hold a surround view to, beside their limits. The replay runs as fast
+// as it can and waits for its slowest output, so its latency includes the wait in full queues: an
+// upper bound of a live rig's, where the newest set wins.
+void printAgainstLimits(const std::vector<RecordingFigures>& all,
+                        const PipelineBenchmarkOptions& options) {
+  fmt::print(
+      "\nagainst the limits (the run of median frame rate; the first picture from the pipeline's "
+      "start with a warm LUT cache, the first run's cold one beside it{})\n",
+      options.input == BenchInput::kRaw ? "; the recordings' preload into memory counts in it"
+                                        : "");
+  for (const auto& r : all) {
+    fmt::print("{:<8} frame rate {}\n", r.name, daemon::frameRateWithLimit(r.full.fps()));
+    fmt::print("{:<8} latency capture to output {}\n", r.name,
+               daemon::latencyWithLimit(r.full.summary.report.latency));
+    const auto from = daemon::StartupFrom::kPipeline;
+    if (r.warmStartup) {
+      fmt::print("{:<8} first picture {}; cold LUT cache {:.2f} s\n", r.name,
+                 daemon::startupWithLimits(*r.warmStartup, from), r.coldStartup.count());
+    } else {
+      fmt::print("{:<8} first picture (cold LUT cache; warm with --repeats 2 or more) {}\n", r.name,
+                 daemon::startupWithLimits(r.coldStartup, from));
+    }
+  }
+}
+
 void printText(const std::vector<RecordingFigures>& all, const PipelineBenchmarkOptions& options,
                int cores) {
   const auto& first = all.front().full.summary;
@@ -161,8 +218,16 @@ void printText(const std::vector<RecordingFigures>& all, const PipelineBenchmark
       processing::poissonSolverName(options.solver), render::toString(options.view),
       options.outputSize.width, options.outputSize.height, options.threads, cores, first.renderer,
       options.repeats);
-  fmt::print("{:<26} {:>7} {:>13} {:>7} {:>6} {:>8}\n", "input -> panorama", "FPS", "decode+sync",
-             "ratio", "CPU %", "peak MB");
+  if (options.input == BenchInput::kDecode) {
+    fmt::print("input: decode (each camera's H.264 video decoded as it plays)\n");
+  } else {
+    fmt::print(
+        "input: {} (each recording decoded once at start into memory as {} frames, converted to "
+        "BGR per frame as a V4L2 camera's are; peak MB includes them)\n",
+        inputName(options), capture::toString(options.rawFormat));
+  }
+  fmt::print("{:<26} {:>7} {:>13} {:>7} {:>6} {:>8}\n", "input -> panorama", "FPS",
+             fmt::format("{}+sync", captureWork(options)), "ratio", "CPU %", "peak MB");
   for (const auto& r : all) {
     fmt::print("{:<26} {:>7.1f} {:>9.1f} FPS {:>6.2f}x {:>6.0f} {:>8.0f}\n",
                fmt::format("4x{}x{} -> {}x{}", r.camera.width, r.camera.height, r.panorama.width,
@@ -171,9 +236,9 @@ void printText(const std::vector<RecordingFigures>& all, const PipelineBenchmark
                r.full.peakMegabytes);
   }
   fmt::print(
-      "\nmilliseconds per frame set (pipeline thread; decode runs in parallel, one thread "
-      "per camera, and is per camera frame)\n{:<8} {:>7}",
-      "input", "decode");
+      "\nmilliseconds per frame set (pipeline thread; {0} runs in parallel, one thread "
+      "per camera, and is per camera frame)\n{1:<8} {0:>7}",
+      captureWork(options), "input");
   for (const auto stage : kStages) fmt::print(" {:>9}", daemon::toString(stage));
   fmt::print("\n");
   for (const auto& r : all) {
@@ -181,28 +246,38 @@ void printText(const std::vector<RecordingFigures>& all, const PipelineBenchmark
     for (const auto stage : kStages) fmt::print(" {:>9.2f}", stageMs(r.full, stage));
     fmt::print("\n");
   }
+  printAgainstLimits(all, options);
   fmt::print(
-      "\n'ratio' is the full pipeline's frame rate over the decode+sync-only replay of the "
+      "\n'ratio' is the full pipeline's frame rate over the {}+sync-only replay of the "
       "same recording, run in turns with it.\n{}\n",
-      kPaperFigures);
+      captureWork(options), kPaperFigures);
+}
+
+double latencyMs(const RecordingFigures& r, double quantile) {
+  return std::chrono::duration<double, std::milli>(r.full.summary.report.latency.quantile(quantile))
+      .count();
 }
 
 void printJson(const std::vector<RecordingFigures>& all, const PipelineBenchmarkOptions& options,
                int cores) {
   fmt::print(
       "{{\"pipeline\": {{\"threads\": {}, \"cores\": {}, \"repeats\": {}, \"view\": \"{}\", "
-      "\"renderer\": \"{}\", \"inputs\": [",
-      options.threads, cores, options.repeats, render::toString(options.view),
+      "\"input\": \"{}\", \"renderer\": \"{}\", \"inputs\": [",
+      options.threads, cores, options.repeats, render::toString(options.view), inputName(options),
       all.front().full.summary.renderer);
   for (std::size_t i = 0; i < all.size(); ++i) {
     const auto& r = all[i];
     fmt::print(
         "{}\n  {{\"name\": \"{}\", \"camera\": [{}, {}], \"panorama\": [{}, {}], "
         "\"fps\": {:.3f}, \"baseline_fps\": {:.3f}, \"ratio\": {:.4f}, \"cpu_percent\": "
-        "{:.1f}, \"peak_mb\": {:.1f}, \"frame_sets\": {}, \"ms\": {{\"decode\": {:.3f}",
+        "{:.1f}, \"peak_mb\": {:.1f}, \"frame_sets\": {}, \"latency_p50_ms\": {:.3f}, "
+        "\"latency_p99_ms\": {:.3f}, \"startup_cold_s\": {:.4f}, {}\"ms\": {{\"{}\": {:.3f}",
         i == 0 ? "" : ",", r.name, r.camera.width, r.camera.height, r.panorama.width,
         r.panorama.height, r.full.fps(), r.baselineFps, r.full.fps() / r.baselineFps,
-        cpuPercent(r.full, cores), r.full.peakMegabytes, r.full.summary.frameSets, r.decodeMs);
+        cpuPercent(r.full, cores), r.full.peakMegabytes, r.full.summary.frameSets,
+        latencyMs(r, 0.5), latencyMs(r, 0.99), r.coldStartup.count(),
+        r.warmStartup ? fmt::format("\"startup_warm_s\": {:.4f}, ", r.warmStartup->count()) : "",
+        captureWork(options), r.decodeMs);
     for (const auto stage : kStages) {
       fmt::print(", \"{}\": {:.3f}", daemon::toString(stage), stageMs(r.full, stage));
     }

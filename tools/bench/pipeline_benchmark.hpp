@@ -3,7 +3,14 @@
 // daemon pipeline (decode, sync, stitch, colour correction, surround render, read-back, H.264
 // encode) replays each recording as fast as possible; reported are frames per second,
 // milliseconds per stage, CPU utilization and peak memory, with the ratio against a baseline run
-// in turns with it: the same replay doing only decode and sync (the most any pipeline could do).
+// in turns with it: the same replay doing only decode and sync (the most any pipeline could do);
+// and the frame rate, capture-to-output latency and time to the first picture (cold and warm LUT
+// cache) beside the limits of ISO 16505 / IEC 63033-3 and FMVSS 111 (daemon/compliance_limits.hpp).
+//
+// Input: each camera's video decoded as it plays (kDecode, replay figures), or decoded once at
+// start into memory as YUYV or NV12 frames and converted to BGR per frame as a V4L2 camera's frames
+// are (kRaw: what a live rig costs, without four H.264 decodes on the same cores). Raw frames are
+// held in memory: peak memory then includes them.
 
 #include <filesystem>
 #include <optional>
@@ -11,14 +18,19 @@
 
 #include <opencv2/core.hpp>
 
-#include "processing/panorama_lut.hpp"
-#include "processing/poisson_solver.hpp"
+#include "capture/pixel_conversion.hpp"
+#include "processing/colour/poisson_solver.hpp"
+#include "processing/stitch/panorama_lut.hpp"
 #include "render/view_camera.hpp"
 
 namespace surroundd::bench {
 
+enum class BenchInput { kDecode, kRaw };
+
 struct PipelineBenchmarkOptions {
   std::vector<std::filesystem::path> recordings;
+  BenchInput input = BenchInput::kDecode;
+  capture::PixelLayout rawFormat = capture::PixelLayout::kYuyv;  // kRaw: kYuyv or kNv12
   int threads = 2;
   int repeats = 3;
   bool json = false;

@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "processing/poisson_matrix.hpp"
+#include "processing/colour/poisson_matrix.hpp"
 #include "tools/bench/timing.hpp"
 
 namespace surroundd::bench {

@@ -10,8 +10,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "processing/poisson_correction.hpp"
-#include "processing/poisson_solver.hpp"
+#include "processing/colour/poisson_correction.hpp"
+#include "processing/colour/poisson_solver.hpp"
 
 namespace surroundd::bench {
 

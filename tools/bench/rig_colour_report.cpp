@@ -7,9 +7,9 @@
 #include "common/work_pool.hpp"
 #include "daemon/config.hpp"
 #include "daemon/panorama_setup.hpp"
-#include "processing/gain_compensation.hpp"
-#include "processing/poisson_correction.hpp"
-#include "processing/stitcher.hpp"
+#include "processing/colour/gain_compensation.hpp"
+#include "processing/colour/poisson_correction.hpp"
+#include "processing/stitch/stitcher.hpp"
 #include "tools/bench/seam_measures.hpp"
 #include "tools/bench/timing.hpp"
 

@@ -11,7 +11,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "processing/poisson_correction.hpp"
+#include "processing/colour/poisson_correction.hpp"
 
 namespace surroundd {
 class WorkPool;

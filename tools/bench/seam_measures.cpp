@@ -8,7 +8,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "processing/ground_top_view.hpp"
+#include "processing/calibration/ground_top_view.hpp"
 
 namespace surroundd::bench {
 namespace {

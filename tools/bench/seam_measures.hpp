@@ -23,7 +23,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "processing/panorama_lut.hpp"
+#include "processing/stitch/panorama_lut.hpp"
 
 namespace surroundd::bench {
 

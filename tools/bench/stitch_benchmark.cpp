@@ -12,8 +12,8 @@
 #include <unistd.h>
 
 #include "common/work_pool.hpp"
-#include "processing/panorama_lut_cache.hpp"
-#include "processing/stitcher.hpp"
+#include "processing/stitch/panorama_lut_cache.hpp"
+#include "processing/stitch/stitcher.hpp"
 #include "tools/bench/panorama_accuracy.hpp"
 #include "tools/bench/recording_truth.hpp"
 #include "tools/bench/remap_baseline.hpp"

@@ -16,8 +16,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "processing/calibration/mat_calibration.hpp"
 #include "processing/camera_model.hpp"
-#include "processing/mat_calibration.hpp"
 #include "tools/calibrate/guide_options.hpp"
 #include "tools/calibrate/import_options.hpp"
 #include "tools/calibrate/intrinsics_options.hpp"

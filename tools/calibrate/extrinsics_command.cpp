@@ -8,8 +8,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "processing/extrinsic_calibration.hpp"
-#include "processing/ground_marker_detection.hpp"
+#include "processing/calibration/extrinsic_calibration.hpp"
+#include "processing/calibration/ground_marker_detection.hpp"
 #include "tools/calibrate/calibration_output.hpp"
 #include "tools/calibrate/marker_file.hpp"
 #include "tools/calibrate/mat_command.hpp"

@@ -80,7 +80,9 @@ Found<cv::Mat> requireMatrix(const std::filesystem::path& file,
                                  matrix ? fmt::format("{} numbers", matrix->total())
                                         : std::string("something that is not a matrix")));
   }
-  return {*matrix, origin};
+  // Every key of 9 numbers is a 3x3 matrix (camera, rotation, homography), however the file wrote
+  // it: as 3 rows or as one flat list (read as one row, whose (1, 1) lay past its end).
+  return {matrix->total() == 9 ? matrix->reshape(1, 3) : *matrix, origin};
 }
 
 cv::Matx33d rotationOf(const cv::Mat& matrix, const std::string& origin) {

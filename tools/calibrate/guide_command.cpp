@@ -4,8 +4,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "capture/source_recovery.hpp"
-#include "processing/calibration_error.hpp"
-#include "render/http_stream_sink.hpp"
+#include "processing/calibration/calibration_error.hpp"
+#include "render/outputs/http_stream_sink.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 #include "tools/calibrate/calibration_output.hpp"
 #include "tools/calibrate/guide_io.hpp"

@@ -13,7 +13,7 @@
 #include <opencv2/core.hpp>
 
 #include "capture/frame_source.hpp"
-#include "render/http_stream_sink.hpp"
+#include "render/outputs/http_stream_sink.hpp"
 
 namespace surroundd::calibrate {
 

@@ -6,8 +6,8 @@
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
 
-#include "processing/calibration_error.hpp"
-#include "processing/view_acceptance.hpp"
+#include "processing/calibration/calibration_error.hpp"
+#include "processing/calibration/view_acceptance.hpp"
 #include "tools/calibrate/lens_field.hpp"
 
 namespace surroundd::calibrate {

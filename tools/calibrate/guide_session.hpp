@@ -17,10 +17,10 @@
 
 #include <opencv2/core.hpp>
 
-#include "processing/calibration_board.hpp"
-#include "processing/calibration_coverage.hpp"
-#include "processing/calibration_verdict.hpp"
-#include "processing/intrinsic_calibration.hpp"
+#include "processing/calibration/calibration_board.hpp"
+#include "processing/calibration/calibration_coverage.hpp"
+#include "processing/calibration/calibration_verdict.hpp"
+#include "processing/calibration/intrinsic_calibration.hpp"
 
 namespace surroundd::calibrate {
 

@@ -1,7 +1,7 @@
-// Built instead of guide_command.cpp and mat_guide_command.cpp where SURROUNDD_WITH_HTTP is off: the guide's page needs the
-// HTTP server.
-#include <stdexcept>
-
+// Built instead of guide_command.cpp and mat_guide_command.cpp where SURROUNDD_WITH_HTTP is off:
+// the guide's page needs the HTTP server. Asking this build for it is a usage error (status 2),
+// refused before any camera is opened, with how to build it in.
+#include "tools/calibrate/calibrate_options.hpp"
 #include "tools/calibrate/guide_command.hpp"
 #include "tools/calibrate/mat_guide_command.hpp"
 
@@ -9,8 +9,8 @@ namespace surroundd::calibrate {
 namespace {
 
 [[noreturn]] void refuse() {
-  throw std::runtime_error(
-      "surround-calibrate guide: this build has no HTTP server for its page (configure with "
+  throw UsageError(
+      "this build has no HTTP server for its page (configure with "
       "-DSURROUNDD_WITH_HTTP=ON; needs libmicrohttpd-dev and libturbojpeg0-dev)");
 }
 

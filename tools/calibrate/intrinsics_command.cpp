@@ -8,9 +8,9 @@
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "processing/calibration_coverage.hpp"
-#include "processing/picture_search.hpp"
-#include "processing/view_acceptance.hpp"
+#include "processing/calibration/calibration_coverage.hpp"
+#include "processing/calibration/picture_search.hpp"
+#include "processing/calibration/view_acceptance.hpp"
 #include "tools/calibrate/calibration_output.hpp"
 #include "tools/calibrate/intrinsics_report.hpp"
 #include "tools/calibrate/lens_field.hpp"

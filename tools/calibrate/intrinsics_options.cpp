@@ -4,7 +4,7 @@
 
 #include <fmt/format.h>
 
-#include "processing/calibration_targets.hpp"
+#include "processing/calibration/calibration_targets.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 
 namespace surroundd::calibrate {

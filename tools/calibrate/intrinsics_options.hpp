@@ -9,8 +9,8 @@
 #include <string_view>
 #include <vector>
 
-#include "processing/calibration_board.hpp"
-#include "processing/calibration_verdict.hpp"
+#include "processing/calibration/calibration_board.hpp"
+#include "processing/calibration/calibration_verdict.hpp"
 #include "processing/camera_model.hpp"
 
 namespace surroundd::calibrate {

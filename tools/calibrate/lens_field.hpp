@@ -6,7 +6,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "processing/calibration_coverage.hpp"
+#include "processing/calibration/calibration_coverage.hpp"
 #include "processing/rig.hpp"
 
 namespace surroundd::calibrate {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "daemon/yaml_reader.hpp"
-#include "processing/calibration_error.hpp"
+#include "processing/calibration/calibration_error.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 #include "tools/calibrate/extrinsics_command.hpp"
 #include "tools/calibrate/guide_command.hpp"
@@ -66,9 +66,9 @@ int run(const std::vector<std::string_view>& arguments) {
 int main(int argc, char** argv) {
   const int status = run({argv + 1, argv + argc});
   // The intrinsics' board search may have left a detection thread running past its time bound
-  // (processing/picture_search.hpp): static destructors must not run under it, so the process
-  // ends here, with its output flushed, without them. Every file was written whole before this
-  // (calibration_output.cpp writes a .part and renames it), so none is left half-written.
+  // (processing/calibration/picture_search.hpp): static destructors must not run under it, so the
+  // process ends here, with its output flushed, without them. Every file was written whole before
+  // this (calibration_output.cpp writes a .part and renames it), so none is left half-written.
   std::cout.flush();
   std::cerr.flush();
   std::fflush(nullptr);  // whatever a library wrote through C's stdio

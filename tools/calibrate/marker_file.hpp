@@ -15,11 +15,11 @@
 //       yaw_deg: 90                  # direction of the print's first row (u axis); default 0
 //     - {name: tag7, type: aruco, id: 7, side_m: 0.3, x_m: 2.5, y_m: -1.0, yaw_deg: 0}
 //
-// The print lies face up; its geometry is processing/calibration_targets.hpp's.
+// The print lies face up; its geometry is processing/calibration/calibration_targets.hpp's.
 //
 // A calibration mat (--mat): checkerboards on the ground, each seen whole by the cameras named
 // (one, or two neighbours for the seam between them); the board's two ends may look alike (see
-// processing/ground_mat.hpp). Same frame and placement keys as the markers:
+// processing/calibration/ground_mat.hpp). Same frame and placement keys as the markers:
 //
 //   boards:
 //     - name: front_left             # required, unique
@@ -38,9 +38,9 @@
 #include <filesystem>
 #include <vector>
 
-#include "processing/calibration_targets.hpp"
-#include "processing/extrinsic_calibration.hpp"
-#include "processing/ground_mat.hpp"
+#include "processing/calibration/calibration_targets.hpp"
+#include "processing/calibration/extrinsic_calibration.hpp"
+#include "processing/calibration/ground_mat.hpp"
 
 namespace surroundd::calibrate {
 

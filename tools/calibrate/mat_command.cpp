@@ -7,7 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "daemon/rig_yaml.hpp"
-#include "processing/calibration_error.hpp"
+#include "processing/calibration/calibration_error.hpp"
 #include "tools/calibrate/calibration_output.hpp"
 #include "tools/calibrate/camera_pictures.hpp"
 #include "tools/calibrate/marker_file.hpp"

@@ -6,7 +6,7 @@
 #include <ostream>
 #include <vector>
 
-#include "processing/ground_mat.hpp"
+#include "processing/calibration/ground_mat.hpp"
 #include "processing/rig.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 

@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "capture/source_recovery.hpp"
-#include "processing/calibration_error.hpp"
+#include "processing/calibration/calibration_error.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 #include "tools/calibrate/camera_pictures.hpp"
 #include "tools/calibrate/guide_io.hpp"

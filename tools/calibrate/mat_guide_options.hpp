@@ -13,7 +13,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "processing/mat_calibration.hpp"
+#include "processing/calibration/mat_calibration.hpp"
 
 namespace surroundd::calibrate {
 

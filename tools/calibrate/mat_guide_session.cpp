@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
-#include "processing/calibration_error.hpp"
+#include "processing/calibration/calibration_error.hpp"
 
 namespace surroundd::calibrate {
 namespace {

@@ -15,8 +15,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "processing/ground_top_view.hpp"
-#include "processing/mat_calibration.hpp"
+#include "processing/calibration/ground_top_view.hpp"
+#include "processing/calibration/mat_calibration.hpp"
 
 namespace surroundd::calibrate {
 

@@ -2,7 +2,7 @@
 
 #include <fmt/format.h>
 
-#include "processing/calibration_error.hpp"
+#include "processing/calibration/calibration_error.hpp"
 #include "tools/calibrate/calibration_output.hpp"
 
 namespace surroundd::calibrate {

@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "processing/mat_calibration.hpp"
+#include "processing/calibration/mat_calibration.hpp"
 
 namespace surroundd::calibrate {
 

@@ -5,7 +5,7 @@
 
 #include <ostream>
 
-#include "processing/mat_calibration.hpp"
+#include "processing/calibration/mat_calibration.hpp"
 
 namespace surroundd::calibrate {
 

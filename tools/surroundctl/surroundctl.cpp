@@ -19,7 +19,8 @@ using namespace surroundd;
 constexpr std::string_view kUsage = R"(usage: surroundctl [--socket PATH] COMMAND
 
 commands:
-  status            frame rate, per-stage p50/p99 milliseconds, latency, each camera's health
+  status            frame rate, per-stage p50/p99 milliseconds, latency, time to the first
+                    picture (each beside its limit), each camera's health
   metrics           the same and more in Prometheus text format
   view NAME         switch the surround outputs to top, 360, orbit or split
   snapshot FILE     save the newest output picture as a PNG

@@ -16,9 +16,9 @@ namespace surroundd::synth {
 namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180;
-// Mat boards are found in a top view of the ground (processing/mat_board_detection.hpp), which
-// undoes the shear of a slanted view; the squares must still be large enough in the picture for
-// cornerSubPix there.
+// Mat boards are found in a top view of the ground
+// (processing/calibration/mat_board_detection.hpp), which undoes the shear of a slanted view; the
+// squares must still be large enough in the picture for cornerSubPix there.
 constexpr ViewFit kMatFit{6, 4, false};
 
 // The optical axis's heading on the ground, radians from +x towards +y.

@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "processing/ground_mat.hpp"
+#include "processing/calibration/ground_mat.hpp"
 #include "processing/rig.hpp"
 
 namespace surroundd::synth {

@@ -11,8 +11,8 @@
 #include <opencv2/aruco/dictionary.hpp>
 #include <opencv2/calib3d.hpp>
 
+#include "processing/calibration/target_detection.hpp"
 #include "processing/camera_model.hpp"
-#include "processing/target_detection.hpp"
 #include "tools/synth/hash.hpp"
 
 namespace surroundd::synth {

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "processing/calibration_targets.hpp"
+#include "processing/calibration/calibration_targets.hpp"
 #include "processing/rig.hpp"
 
 namespace surroundd::synth {

@@ -11,7 +11,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "processing/calibration_targets.hpp"
+#include "processing/calibration/calibration_targets.hpp"
 #include "processing/rig.hpp"
 #include "tools/synth/synth_options.hpp"
 

@@ -17,7 +17,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "render/video_encoder.hpp"
+#include "render/outputs/video_encoder.hpp"
 
 namespace surroundd::synth {
 

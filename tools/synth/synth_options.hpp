@@ -14,7 +14,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "processing/calibration_targets.hpp"
+#include "processing/calibration/calibration_targets.hpp"
 #include "tools/synth/scene.hpp"
 
 namespace surroundd::synth {

@@ -15,15 +15,15 @@
 
 #include <opencv2/core.hpp>
 
-#include "processing/calibration_targets.hpp"
+#include "processing/calibration/calibration_targets.hpp"
 #include "processing/camera_model.hpp"
 #include "processing/rig.hpp"
 #include "tools/synth/photometrics.hpp"
 
 namespace surroundd::synth {
 
-// The print of one target: reflectance in its pattern frame (processing/calibration_targets.hpp),
-// a white margin around it included.
+// The print of one target: reflectance in its pattern frame
+// (processing/calibration/calibration_targets.hpp), a white margin around it included.
 class TargetPattern {
  public:
   static TargetPattern checkerboard(const processing::Checkerboard& board);

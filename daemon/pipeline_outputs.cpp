@@ -1,0 +1,172 @@
+#include "daemon/pipeline_outputs.hpp"
+
+#include <algorithm>
+
+#include <spdlog/spdlog.h>
+
+#include "daemon/output_files.hpp"
+#include "daemon/output_type.hpp"
+
+namespace surroundd::daemon {
+namespace {
+
+// The config's output, writing where no earlier run's data is lost.
+OutputConfig withUnusedPath(OutputConfig output) {
+  if (auto path = unusedOutputPath(output); path != output.path) {
+    spdlog::info("{} holds what an earlier run wrote: this run writes {}", output.path.string(),
+                 path.string());
+    output.path = std::move(path);
+  }
+  return output;
+}
+
+}  // namespace
+
+PipelineOutputs::PipelineOutputs(double nominalFps, bool latestWins)
+    : nominalFps_(nominalFps), latestWins_(latestWins) {}
+
+void PipelineOutputs::addPicture(const OutputConfig& config, cv::Size size, const cv::Mat* picture,
+                                 std::unique_ptr<render::SurroundView> view) {
+  PictureOutput output;
+  output.config = withUnusedPath(config);
+  output.size = size;
+  output.picture = picture;
+  open(output);
+  output.view = std::move(view);
+  pictures_.push_back(std::move(output));
+}
+
+void PipelineOutputs::addRecording(const OutputConfig& config,
+                                   const std::vector<RigCamera>& cameras) {
+  const OutputConfig output = withUnusedPath(config);
+  recordings_.push_back(
+      outputTypeOf(output).openCameraFramesSink(output, {{}, nominalFps_, latestWins_, &cameras}));
+}
+
+bool PipelineOutputs::shows(OutputStream stream) const {
+  return std::ranges::any_of(
+      pictures_, [&](const PictureOutput& o) { return o.config.stream == stream && o.sink; });
+}
+
+void PipelineOutputs::drop(PictureOutput& output, const std::exception& error) {
+  output.sink.reset();
+  output.retryDelay = kFirstOutputRetry;
+  output.nextRetry = Clock::now() + output.retryDelay;
+  spdlog::error("output failed, dropping it: {}; trying it again in {} s", error.what(),
+                output.retryDelay.count());
+  ++failures_;
+}
+
+void PipelineOutputs::handOver(PictureOutput& output, const cv::Mat& picture,
+                               std::chrono::nanoseconds streamTime, Clock::time_point origin) {
+  guarded(output, [&] {
+    output.sink->consume(picture, streamTime);
+    output.latest = picture;
+    const auto now = Clock::now();
+    latency_.record(now - origin);
+    if (!firstPictureAt_) firstPictureAt_ = now;
+  });
+}
+
+void PipelineOutputs::record(const capture::FrameSet& set) {
+  for (auto& recording : recordings_) {
+    if (!recording) continue;
+    try {
+      recording->record(set);
+    } catch (const std::exception& e) {
+      spdlog::error("recording failed, dropping it: {}", e.what());
+      ++failures_;
+      recording.reset();
+    }
+  }
+}
+
+void PipelineOutputs::open(PictureOutput& output) {
+  // Where the failed try left data, this one writes the next name.
+  output.config.path = unusedOutputPath(output.config);
+  output.sink = outputTypeOf(output.config)
+                    .openPictureSink(output.config, {output.size, nominalFps_, latestWins_});
+}
+
+void PipelineOutputs::retry(Clock::time_point now) {
+  for (auto& output : pictures_) {
+    if (output.sink || now < output.nextRetry) continue;
+    try {
+      open(output);
+      spdlog::info("output {} works again", output.sink->describe());
+    } catch (const std::exception& e) {
+      output.retryDelay = std::min(2 * output.retryDelay, kLastOutputRetry);
+      output.nextRetry = now + output.retryDelay;
+      spdlog::error("output still failing: {}; trying it again in {} s", e.what(),
+                    output.retryDelay.count());
+    }
+  }
+}
+
+void PipelineOutputs::followPages(bool statusDue, const std::function<std::string()>& status) {
+  std::string text;
+  for (auto& output : pictures_) {
+    render::ViewPage* page = output.sink ? output.sink->page() : nullptr;
+    if (page == nullptr) continue;
+    if (const auto name = page->takeViewRequest(); name && output.view) {
+      if (const auto view = render::parseViewKind(*name)) output.view->setView(*view);
+    }
+    if (statusDue) {
+      if (text.empty()) text = status();
+      page->setStatus(text);
+    }
+  }
+}
+
+void PipelineOutputs::setView(ViewKind view) {
+  for (auto& output : pictures_) {
+    if (!output.view) continue;
+    output.view->setView(view);
+    if (render::ViewPage* page = output.sink ? output.sink->page() : nullptr) {
+      page->setActiveView(toString(view));
+    }
+  }
+}
+
+void PipelineOutputs::finish(std::chrono::nanoseconds lastTime,
+                             const std::function<cv::Mat(PictureOutput&)>& lastPicture,
+                             std::vector<std::string>& written) {
+  for (auto& output : pictures_) {
+    guarded(output, [&] {
+      output.sink->finish(lastPicture(output), lastTime);
+      written.push_back(output.sink->describe());
+    });
+  }
+  for (auto& recording : recordings_) {
+    if (!recording) continue;
+    try {
+      recording->finish();
+      written.push_back(recording->describe());
+    } catch (const std::exception& e) {
+      spdlog::error("recording failed to finish: {}", e.what());
+      ++failures_;
+    }
+  }
+}
+
+bool PipelineOutputs::anyWorks() const {
+  return std::ranges::any_of(pictures_, [](const PictureOutput& o) { return o.sink != nullptr; }) ||
+         std::ranges::any_of(recordings_, [](const auto& r) { return r != nullptr; });
+}
+
+cv::Mat PipelineOutputs::latestPicture() const {
+  const auto shown = [](const PictureOutput& o) { return !o.latest.empty(); };
+  const auto surround =
+      std::ranges::find_if(pictures_, [&](const PictureOutput& o) { return o.view && shown(o); });
+  if (surround != pictures_.end()) return surround->latest;
+  const auto any = std::ranges::find_if(pictures_, shown);
+  return any != pictures_.end() ? any->latest : cv::Mat();
+}
+
+std::uint64_t PipelineOutputs::dropped() const {
+  std::uint64_t dropped = 0;
+  for (const auto& output : pictures_) dropped += output.sink ? output.sink->dropped() : 0;
+  return dropped;
+}
+
+}  // namespace surroundd::daemon

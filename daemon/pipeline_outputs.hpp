@@ -1,0 +1,118 @@
+#pragma once
+// The pipeline's outputs, opened through their types' factories (output_type.hpp): those that
+// take a picture per frame set (a stream's picture, or a surround view rendered for the output)
+// and those that record the camera frames. One output's failure never stops the others: it is
+// logged and the output dropped, then opened again after kFirstOutputRetry, then after twice as
+// long each time, up to kLastOutputRetry (a disk with room again, a display plugged back in).
+//
+// Error policy: adding an output throws what its factory throws (at start-up, naming the output);
+// after that nothing here throws. Pipeline thread only.
+
+#include <chrono>
+#include <cstdint>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "capture/frame_set.hpp"
+#include "daemon/camera_frames_sink.hpp"
+#include "daemon/config.hpp"
+#include "daemon/duration_histogram.hpp"
+#include "render/outputs/frame_sink.hpp"
+#include "render/surround_view.hpp"
+
+namespace surroundd::daemon {
+
+class PipelineOutputs {
+ public:
+  using Clock = std::chrono::steady_clock;
+  static constexpr std::chrono::seconds kFirstOutputRetry{1};
+  static constexpr std::chrono::seconds kLastOutputRetry{60};
+
+  // An output of pictures: a stream's picture, made by a stage, or a surround view of its own.
+  struct PictureOutput {
+    OutputConfig config;  // to open it again after a failure (its path: the one it writes now)
+    cv::Size size;
+    const cv::Mat* picture = nullptr;            // the stream's picture; null for a surround view
+    std::unique_ptr<render::SurroundView> view;  // surround outputs
+    std::unique_ptr<render::FrameSink> sink;     // null while it has failed
+    Clock::time_point nextRetry{};               // when failed: when it is opened again
+    std::chrono::seconds retryDelay{0};
+    std::chrono::nanoseconds pendingTime{0};  // stream time of the view's pending picture
+    Clock::time_point pendingOrigin{};        // capture time of the pending picture's set
+    cv::Mat latest;                           // header over the picture last handed over
+  };
+
+  // `nominalFps`: the cameras' frame rate; `latestWins`: live, queues drop their oldest picture.
+  PipelineOutputs(double nominalFps, bool latestWins);
+
+  // Opens an output of `picture`'s stream (its size), or of `view` (picture null).
+  void addPicture(const OutputConfig& config, cv::Size size, const cv::Mat* picture,
+                  std::unique_ptr<render::SurroundView> view);
+  // Opens a recording of `cameras`' frames.
+  void addRecording(const OutputConfig& config, const std::vector<RigCamera>& cameras);
+
+  std::vector<PictureOutput>& pictures() { return pictures_; }
+  const std::vector<PictureOutput>& pictures() const { return pictures_; }
+  // Whether a working output shows `stream`.
+  bool shows(OutputStream stream) const;
+
+  // Runs `step` on the output (if it works); an exception drops the output with a logged error.
+  template <typename Step>
+  void guarded(PictureOutput& output, Step&& step) {
+    if (!output.sink) return;
+    try {
+      step();
+    } catch (const std::exception& e) {
+      drop(output, e);
+    }
+  }
+  // Hands `picture` of the set captured at `origin` to the output (guarded), timing the latency.
+  void handOver(PictureOutput& output, const cv::Mat& picture, std::chrono::nanoseconds streamTime,
+                Clock::time_point origin);
+  // Each recording's copy of the set.
+  void record(const capture::FrameSet& set);
+  // Opens again the failed outputs whose retry is due.
+  void retry(Clock::time_point now);
+  // Outputs with a page (FrameSink::page()): switches the views they ask for; gives them
+  // `status()` when `statusDue`.
+  void followPages(bool statusDue, const std::function<std::string()>& status);
+  // Every surround output shows `view` from the next frame set on.
+  void setView(ViewKind view);
+  // Finalizes every output; each picture output is given `lastPicture(output)`. Adds what each
+  // wrote to `written`.
+  void finish(std::chrono::nanoseconds lastTime,
+              const std::function<cv::Mat(PictureOutput&)>& lastPicture,
+              std::vector<std::string>& written);
+
+  // Whether any output works: with none, the run records nothing (a full disk).
+  bool anyWorks() const;
+  // The newest picture handed to the first output that shows one (a surround view if any); a
+  // header over the pipeline's buffer, valid until the next frame set. Empty before.
+  cv::Mat latestPicture() const;
+  std::size_t count() const { return pictures_.size() + recordings_.size(); }
+  std::uint64_t failures() const { return failures_; }
+  std::uint64_t dropped() const;  // pictures outputs dropped because they fell behind
+  const DurationHistogram& latency() const { return latency_; }
+  // When the first picture was handed to an output; empty before.
+  std::optional<Clock::time_point> firstPictureAt() const { return firstPictureAt_; }
+
+ private:
+  void open(PictureOutput& output);
+  void drop(PictureOutput& output, const std::exception& error);
+
+  double nominalFps_;
+  bool latestWins_;
+  std::vector<PictureOutput> pictures_;
+  std::vector<std::unique_ptr<CameraFramesSink>> recordings_;  // null once failed
+  std::uint64_t failures_ = 0;
+  DurationHistogram latency_;  // a set's capture to its picture handed to an output
+  std::optional<Clock::time_point> firstPictureAt_;
+};
+
+}  // namespace surroundd::daemon

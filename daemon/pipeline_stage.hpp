@@ -1,0 +1,49 @@
+#pragma once
+// One step of the pipeline thread's work on each frame set. The pipeline is a short list of
+// stages (Pipeline's constructor lists them, in order): each is set up once from the config — all
+// that is heavy happens then — and is then given every frame set in turn. A stage owns its state
+// and says where its time goes (StageTimes); what it makes for later stages it hands them at
+// set-up (a picture they read) or in the set's FrameWork.
+//
+// Error policy: set-up throws, naming what could not be set up. An exception from process() drops
+// the set (Pipeline counts it, and rebuilds after Pipeline::kRebuildAfterFailures in a row).
+// Threads: the pipeline thread only.
+
+#include <array>
+#include <chrono>
+
+#include <opencv2/core.hpp>
+
+#include "capture/frame_set.hpp"
+#include "common/camera_limit.hpp"
+#include "daemon/pipeline_outputs.hpp"
+#include "daemon/stage_times.hpp"
+
+namespace surroundd::daemon {
+
+// One frame set on its way through the stages.
+struct FrameWork {
+  const capture::FrameSet& set;
+  std::array<const cv::Mat*, kMaxCameras> images{};  // per camera; null where the set has none
+  std::chrono::nanoseconds streamTime{0};            // since the run's first set
+  std::chrono::steady_clock::time_point origin{};    // the capture time of its oldest frame
+  // Per camera: what is wrong with it (its health), or null; a faulty camera's picture is marked
+  // and left out of colour correction.
+  std::array<const char*, kMaxCameras> faults{};
+  PipelineOutputs& outputs;
+};
+
+class PipelineStage {
+ public:
+  virtual ~PipelineStage() = default;
+  PipelineStage() = default;
+  PipelineStage(const PipelineStage&) = delete;
+  PipelineStage& operator=(const PipelineStage&) = delete;
+
+  virtual void process(FrameWork& work, StageTimes& times) = 0;
+  // The cameras have stopped and the outputs are about to be finalized: hand over what is still
+  // in flight.
+  virtual void finish(PipelineOutputs& /*outputs*/) {}
+};
+
+}  // namespace surroundd::daemon

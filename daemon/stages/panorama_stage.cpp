@@ -1,0 +1,70 @@
+#include "daemon/stages/panorama_stage.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "daemon/panorama_setup.hpp"
+#include "daemon/pipeline_ends.hpp"
+
+namespace surroundd::daemon {
+
+PanoramaStage::PanoramaStage(const Config& config, WorkPool& pool)
+    : PanoramaStage(config, pool, rigOf(config, pool)) {}
+
+PanoramaStage::PanoramaStage(const Config& config, WorkPool& pool, const processing::Rig& rig)
+    : lut_(obtainPanoramaLut(config, rig, pool)),
+      stitcher_(lut_, pool),
+      ownership_(lut_),
+      corrected_(config.cameras.size()),
+      stitched_(config.cameras.size()),
+      panorama_(lut_.size, CV_8UC3) {
+  for (const auto& size : lut_.cameraSizes) {
+    blackFrames_.emplace_back(size, CV_8UC3, cv::Scalar::all(0));
+  }
+  setUpColourCorrection(config, rig, pool);
+}
+
+void PanoramaStage::setUpColourCorrection(const Config& config, const processing::Rig& rig,
+                                          WorkPool& pool) {
+  const processing::ColourCorrectionSettings& settings = config.colour.poisson;
+  if (config.colour.method == ColourMethod::kGain) {
+    gains_ = std::make_unique<processing::GainCompensation>(lut_, pool, settings.minGain,
+                                                            settings.maxGain, cameraNames(config));
+    spdlog::info("colour correction: global gain compensation");
+  } else if (config.colour.method == ColourMethod::kPoisson) {
+    poisson_ = std::make_unique<processing::PoissonColourCorrection>(rig, panoramaSettings(config),
+                                                                     lut_, settings, pool);
+    for (const auto& note : poisson_->notes()) spdlog::warn("colour correction: {}", note);
+    spdlog::info("colour correction: Poisson, {} region(s) at scale {:g}, solver {}",
+                 poisson_->domain().regions.size(), settings.scale, poisson_->solverNames());
+  }
+}
+
+void PanoramaStage::process(FrameWork& work, StageTimes& times) {
+  for (std::size_t c = 0; c < work.set.cameraCount; ++c) {
+    const cv::Mat* image = work.images[c];
+    // A faulty camera's picture would pull its neighbours' colours: correction goes without it.
+    corrected_[c] = image != nullptr && work.faults[c] == nullptr ? *image : cv::Mat();
+    stitched_[c] = image != nullptr ? *image : blackFrames_[c];
+  }
+  stitcher_.stitch(stitched_, panorama_);
+  times.lap(Stage::kStitch);
+  if (poisson_) {
+    poisson_->update(corrected_);
+    for (const auto& note : poisson_->notesOfLastUpdate()) {
+      spdlog::warn("colour correction: {}", note);
+    }
+    poisson_->apply(panorama_);
+  } else if (gains_) {
+    gains_->update(corrected_);
+    for (const auto& note : gains_->notesOfLastUpdate()) {
+      spdlog::warn("colour correction: {}", note);
+    }
+    gains_->apply(panorama_);
+  }
+  for (std::size_t c = 0; c < work.set.cameraCount; ++c) {
+    if (work.faults[c] != nullptr) ownership_.markFaulty(panorama_, c);
+  }
+  times.lap(Stage::kCorrect);
+}
+
+}  // namespace surroundd::daemon

@@ -1,0 +1,51 @@
+#pragma once
+// Whether a lens solve can be trusted, against limits a user can set, and the solve that leaves
+// out views whose error is too large by itself (an absolute limit: when every view is bad, every
+// view is named, which a comparison with the median never does).
+
+#include <span>
+#include <string>
+#include <vector>
+
+#include "processing/calibration/calibration_board.hpp"
+#include "processing/calibration/intrinsic_calibration.hpp"
+
+namespace surroundd::processing {
+
+struct CalibrationLimits {
+  double maxRmsPx = 1.0;        // over every corner of every view used
+  double maxViewRmsPx = 2.0;    // a view above it is left out of the solve (and named)
+  double maxEdgeWidthPx = 4.0;  // a picture whose edges are wider is too blurred to use
+  double minCoverage = 0.35;    // share of the lens's image cells with corners (CoverageMap)
+  int minViews = kMinimumBoardViews;
+  // The focal length against the image width (a 2-degree telephoto to a 240-degree fisheye) and
+  // against the solver's starting guess: a solve that never left its guess, or ran far from it,
+  // did not converge to a lens.
+  double minFocalPerWidth = 0.08;
+  double maxFocalPerWidth = 30;
+  double maxFocalFromGuess = 4;  // factor either way
+  double maxAspect = 1.25;       // fx / fy, either way
+};
+
+struct Verdict {
+  bool passed = true;
+  std::vector<std::string> failures;     // one sentence each
+  std::vector<std::string> viewsToDrop;  // names, worst first
+};
+
+// Judges a solve. `coverage`: CoverageMap::coveredShare of the views used.
+Verdict judgeCalibration(const IntrinsicCalibration& result, double coverage,
+                         const CalibrationLimits& limits);
+
+struct RobustCalibration {
+  IntrinsicCalibration result;
+  std::vector<std::string> leftOut;  // "name: RMS 3.41 px" for each view the solve dropped
+};
+
+// Solves, then while the worst view's RMS is above limits.maxViewRmsPx and more than
+// limits.minViews views remain, leaves that view out and solves again.
+RobustCalibration calibrateLeavingOutBadViews(LensModel model, cv::Size imageSize,
+                                              std::vector<BoardView> views,
+                                              const CalibrationLimits& limits);
+
+}  // namespace surroundd::processing

@@ -1,0 +1,159 @@
+#pragma once
+// Poisson local colour correction (DESIGN.md §2.3, the paper's §2.3): per frame, each source
+// camera's region of the panorama gets a smooth correction field that takes its colours to the
+// target cameras' across every seam, solved at a reduced scale and applied to the stitched
+// panorama after bicubic upsampling. Target cameras are left as they are.
+//
+// The field is multiplicative by default: it is solved for log(target / source), so the source
+// keeps its own contrast and each pixel is scaled. Cameras differ by gain, white balance and
+// vignetting, all of them factors, so an additive field (the paper's, `kAdditive`) matches the
+// seam's mean but leaves bright and dark pixels next to it off by the gain difference times their
+// distance from that mean.
+//
+// On real rigs the seam data is made robust (seam_statistics.hpp: trimmed means of usable samples,
+// filtered along each seam, from the ground and never from the vehicle's body; the far ground,
+// past the bowl's floor, as one band with its own median: correction_domain.hpp), the field is
+// bounded to gains in [minGain, maxGain], and one rule stands above the rest: correction never
+// makes a seam worse than none. After each solve, every seam's step (its typical block's: the
+// target's levels against the source's as the field next to the seam leaves them) is compared
+// with its step uncorrected, and so is each stretch of 16 blocks along it (near and far ground
+// differ); a seam or stretch that got worse (by more than noise: 5 % and half a level) has its
+// data dropped (gain 1 there) and its region is solved again. Clamps, seams with too little
+// usable data and dropped seams are said once each in notesOfLastUpdate().
+//
+// Set up once (domain, systems, solver factorizations, buffers); update() and apply() are the
+// per-frame calls and allocate nothing. A camera missing from a frame set leaves the seams it
+// shares at their last values; missing for kLostAfterSets sets in a row it counts as lost and the
+// domain changes: a lost source's region is left uncorrected, a lost target's seams become free
+// (Neumann) borders. The domain and solvers for each set of cameras are built the first time it
+// occurs (a one-off cost, said in notesOfLastUpdate()) and kept for when it occurs again.
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "processing/colour/correction_domain.hpp"
+#include "processing/colour/poisson_solver.hpp"
+#include "processing/colour/seam_statistics.hpp"
+
+namespace surroundd {
+class WorkPool;
+}
+
+namespace surroundd::processing {
+
+enum class CorrectionField { kMultiplicative, kAdditive };
+
+// "multiplicative", "additive": the config's words.
+std::string_view correctionFieldName(CorrectionField field);
+
+struct ColourCorrectionSettings {
+  double scale = 0.25;  // the field's resolution against the panorama's (1 / block size)
+  CorrectionField field = CorrectionField::kMultiplicative;
+  PoissonSolverKind solver = PoissonSolverKind::kAuto;
+  double tolerance = 5e-5;         // iterative solver: relative residual
+  double temporalSmoothing = 0.0;  // weight of the previous frame's seam data, 0..0.99
+  double minGain = 0.5;            // the field's bounds, as gains (additive: the levels these
+  double maxGain = 2.0;            //   gains would add to the seam's source level)
+  bool groundSeams = true;         // seam data from the bowl's floor only
+
+  bool operator==(const ColourCorrectionSettings&) const = default;
+};
+
+class PoissonColourCorrection {
+ public:
+  // Borrows the LUT and the pool; both must outlive this object. Throws std::invalid_argument for
+  // a scale that does not fit the panorama.
+  PoissonColourCorrection(const Rig& rig, const PanoramaSettings& panorama, const PanoramaLut& lut,
+                          const ColourCorrectionSettings& settings, WorkPool& pool);
+  ~PoissonColourCorrection();
+  PoissonColourCorrection(const PoissonColourCorrection&) = delete;
+  PoissonColourCorrection& operator=(const PoissonColourCorrection&) = delete;
+
+  static constexpr int kLostAfterSets = 5;
+
+  // How each seam of the last update() fared.
+  struct SeamReport {
+    std::uint8_t source = 0, target = 0;
+    int blocks = 0, validBlocks = 0, clampedBlocks = 0;
+    int droppedBlocks = 0;  // in stretches the correction would have made worse: gain 1 there
+    bool dropped = false;   // the whole seam would have got worse: gain 1 all along it
+    // Median over measured blocks of the mean over channels of |target - source| in levels:
+    // without correction, and with the field as it leaves the source next to the seam.
+    double stepUncorrected = 0, stepCorrected = 0;
+  };
+
+  // Things left out at set-up (regions without a seam to a target), to be logged once.
+  const std::vector<std::string>& notes() const;
+  // What the last update() changed in the domain, the first time cameras were lost or came back
+  // in this combination (empty otherwise), to be logged.
+  const std::vector<std::string>& notesOfLastUpdate() const { return changes_; }
+  // The domain in use: the full rig's, or the one without the cameras lost now.
+  const CorrectionDomain& domain() const;
+  std::string solverNames() const;
+
+  // Solves this frame's fields from the camera images (an empty Mat: that camera is missing).
+  // Returns the solvers' iterations, summed over regions (0 for direct solvers).
+  int update(std::span<const cv::Mat> frames);
+
+  // Adds the fields to a panorama stitched from the same frames (8-bit BGR of the LUT's size).
+  void apply(cv::Mat& panorama);
+
+  const std::vector<SeamReport>& seams() const { return seamReports_; }
+
+  // The field at block resolution, CV_32FC3: the levels it adds to a pixel at 255, the most it
+  // changes any pixel (0 outside the regions' reach). Additive: simply the levels it adds.
+  const cv::Mat& field() const { return field_; }
+
+ private:
+  struct RegionState;
+  struct Configuration;
+  Configuration& configurationFor(std::uint32_t presentCameras);
+  void followLostCameras(std::span<const cv::Mat> frames);
+  void gatherSeams(std::span<const cv::Mat> frames);
+  // Gives the seam's blocks past the bowl's floor one value, their median (of each channel).
+  void farGroundAsOneBand(const CorrectionRegion& region, const CorrectionSeam& seam,
+                          RegionState& state);
+  void solveRegions(std::span<const std::uint8_t> which);
+  // Drops the data of seams the solved field makes worse; true when any was dropped.
+  bool dropWorseningSeams();
+  void noteOnce(std::vector<std::uint8_t>& said, std::size_t seam, std::string note);
+  template <CorrectionField kField>
+  void applyRows(int first, int last, cv::Mat& panorama, std::vector<float>& columnBuffer) const;
+
+  const PanoramaLut& lut_;
+  WorkPool& pool_;
+  ColourCorrectionSettings settings_;
+  Rig rig_;
+  PanoramaSettings panorama_;
+  // Per set of cameras not lost (bit c: camera c), its domain and solvers' state.
+  std::map<std::uint32_t, std::unique_ptr<Configuration>> configurations_;
+  Configuration* full_ = nullptr;    // every camera
+  Configuration* active_ = nullptr;  // the cameras not lost now
+  std::uint32_t activeCameras_ = 0;
+  std::vector<int> missingSets_;  // per camera: frame sets in a row without it
+  std::vector<std::string> changes_;
+  std::vector<SeamReport> seamReports_;
+  SeamBlockMeter meter_;
+  std::vector<float> window_;          // running median along a seam
+  std::vector<std::uint8_t> resolve_;  // per region
+  std::vector<float> stepScratch_;     // per block of a seam: its step without and with the field
+  cv::Mat field_;
+  // Upsampling: bicubic weights for each sub-block phase (Catmull-Rom), each pixel column's first
+  // tap (in blocks, -2..width), the rows that have anything to correct, and one row buffer per
+  // work chunk.
+  static constexpr int kPad = 3;
+  std::vector<std::array<float, 4>> phaseWeights_;
+  std::vector<int> columnTap_;
+  std::vector<bool> rowHasShare_;
+  std::vector<std::vector<float>> rowBuffers_;
+};
+
+}  // namespace surroundd::processing

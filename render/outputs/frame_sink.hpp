@@ -1,0 +1,47 @@
+#pragma once
+// Where rendered frames go. Each picture output in the config is one FrameSink; the pipeline hands
+// every sink each frame it wants, in stream order, then finish() once. The sinks are one header
+// each beside this one (video_sink.hpp, snapshot_sink.hpp, http_stream_sink.hpp, ...).
+//
+// Threads: a sink that may block (an encoder, a display's vblank, JPEG encoding, a network write)
+// runs behind a QueuedSink: its consume() runs on the queue's thread while the pipeline thread may
+// ask its wantsFrame() and page(), so a sink keeps those two safe for that.
+//
+// Error policy: consume() and finish() throw (EncoderError, std::runtime_error) naming the file;
+// the pipeline logs the failure and drops that sink, the others go on.
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "render/outputs/view_page.hpp"
+
+namespace surroundd::render {
+
+class FrameSink {
+ public:
+  virtual ~FrameSink() = default;
+  FrameSink() = default;
+  FrameSink(const FrameSink&) = delete;
+  FrameSink& operator=(const FrameSink&) = delete;
+
+  // `bgr` is 8-bit BGR; `streamTime` counts from the first frame of the run.
+  virtual void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) = 0;
+  // Whether the frame at `streamTime` is needed: the pipeline skips making pictures (renders) that
+  // no sink wants.
+  virtual bool wantsFrame(std::chrono::nanoseconds /*streamTime*/) const { return true; }
+  // The run is over; `lastFrame` is the picture of the run's last frame, at `lastTime` (empty if
+  // there was none).
+  virtual void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) = 0;
+  // What was written, for the log ("video /out/demo/mosaic.mp4 (300 frames)").
+  virtual std::string describe() const = 0;
+  // Pictures it was given but dropped because it fell behind (see QueuedSink).
+  virtual std::uint64_t dropped() const { return 0; }
+  // A page a viewer acts on (views asked for, status shown), or null: the pipeline asks every
+  // output for one instead of knowing which kind has one. Borrowed; lives as long as the sink.
+  virtual ViewPage* page() { return nullptr; }
+};
+
+}  // namespace surroundd::render

@@ -1,0 +1,289 @@
+#include "render/outputs/video_encoder.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "common/ffmpeg_util.hpp"
+
+extern "C" {
+#include <libavutil/opt.h>
+#include <libavutil/pixdesc.h>
+}
+
+namespace surroundd::render {
+namespace {
+
+// Encoder time base: microseconds, so that timestamps keep their precision in MP4. Matroska stores
+// milliseconds whatever is asked (its muxer forces 1/1000 on the stream); packets are rescaled.
+constexpr AVRational kMicroseconds{1, 1'000'000};
+// MP4 writes a first timestamp other than zero as an edit list in the movie timescale, which
+// defaults to milliseconds: the whole file would then be shifted by up to 1 ms.
+constexpr const char* kMp4MovieTimescale = "1000000";
+
+}  // namespace
+
+struct VideoEncoder::Impl {
+  VideoEncoderSettings settings;
+  std::filesystem::path partPath;
+  ffmpeg::OutputFormatPtr format;
+  ffmpeg::CodecContextPtr codec;
+  ffmpeg::FramePtr frame;
+  ffmpeg::PacketPtr packet;
+  ffmpeg::SwsContextPtr sws;
+  AVStream* stream = nullptr;  // owned by `format`
+  std::uint64_t framesWritten = 0;
+  std::optional<std::int64_t> lastPts;
+  bool closed = false;
+
+  bool network() const { return !settings.url.empty(); }
+  std::string target() const { return network() ? settings.url : settings.path.string(); }
+
+  [[noreturn]] void fail(std::string_view what, int error = 0) const {
+    const char* kind = network() ? "stream" : "video";
+    throw EncoderError(error == 0 ? fmt::format("{} '{}': {}", kind, target(), what)
+                                  : fmt::format("{} '{}': {}: {}", kind, target(), what,
+                                                ffmpeg::errorText(error)));
+  }
+
+  void open();
+  void drain(bool flushing);
+};
+
+void VideoEncoder::Impl::open() {
+  const auto extension = settings.path.extension().string();
+  const char* muxer = network()             ? "mpegts"
+                      : extension == ".mp4" ? "mp4"
+                      : extension == ".mkv" ? "matroska"
+                                            : nullptr;
+  if (muxer == nullptr)
+    fail(fmt::format("expected a file ending in .mp4 or .mkv, got '{}'", extension));
+  if (network() && !settings.url.starts_with("udp://")) {
+    fail("expected a udp://HOST:PORT address");
+  }
+  if (settings.size.width <= 0 || settings.size.height <= 0 || settings.size.width % 2 != 0 ||
+      settings.size.height % 2 != 0) {
+    fail(fmt::format("frame size must be even and positive, got {}x{}", settings.size.width,
+                     settings.size.height));
+  }
+  const AVPixelFormat pixelFormat = av_get_pix_fmt(settings.pixelFormat.c_str());
+  if (pixelFormat != AV_PIX_FMT_YUV420P && pixelFormat != AV_PIX_FMT_YUV444P &&
+      pixelFormat != AV_PIX_FMT_BGR24) {
+    fail(fmt::format("pixel format must be yuv420p, yuv444p or bgr24, got '{}'",
+                     settings.pixelFormat));
+  }
+  // bgr24 is H.264 on the pictures' own channels (libx264rgb): with crf 0 the frames come back
+  // bit for bit.
+  const bool rgb = pixelFormat == AV_PIX_FMT_BGR24;
+  if (!(settings.nominalFps > 0 && settings.nominalFps <= 1000)) {
+    fail(fmt::format("nominal frame rate must be in (0, 1000], got {}", settings.nominalFps));
+  }
+  if (settings.crf < 0 || settings.crf > 51) {
+    fail(fmt::format("crf must be in 0..51 (0 = lossless), got {}", settings.crf));
+  }
+  const char* encoderName = rgb ? "libx264rgb" : "libx264";
+  const AVCodec* encoder = avcodec_find_encoder_by_name(encoderName);
+  if (encoder == nullptr) fail(fmt::format("this FFmpeg has no {} encoder", encoderName));
+
+  // A file is written under a temporary name until it is finalized; a stream has no name to keep.
+  std::string destination = settings.url;
+  if (!network()) {
+    partPath = settings.path;
+    partPath += ".part";
+    destination = partPath.string();
+  } else if (destination.find("pkt_size=") == std::string::npos) {
+    // Seven 188-byte TS packets per datagram: below every Ethernet MTU, so nothing is fragmented.
+    destination += destination.find('?') == std::string::npos ? "?pkt_size=1316" : "&pkt_size=1316";
+  }
+  AVFormatContext* rawFormat = nullptr;
+  if (const int error =
+          avformat_alloc_output_context2(&rawFormat, nullptr, muxer, destination.c_str());
+      error < 0) {
+    fail("cannot set up the container", error);
+  }
+  format.reset(rawFormat);
+
+  codec.reset(avcodec_alloc_context3(encoder));
+  if (!codec) fail("out of memory");
+  codec->width = settings.size.width;
+  codec->height = settings.size.height;
+  codec->pix_fmt = pixelFormat;
+  codec->time_base = kMicroseconds;
+  // A large bound keeps NTSC rates exact (29.97 -> 30000/1001).
+  codec->framerate = av_d2q(settings.nominalFps, 1 << 16);
+  codec->thread_count = settings.threads;
+  // BT.601 limited range, tagged, so that every decoder converts back the way sws converted here.
+  codec->colorspace = rgb ? AVCOL_SPC_RGB : AVCOL_SPC_SMPTE170M;
+  codec->color_primaries = AVCOL_PRI_SMPTE170M;
+  codec->color_trc = AVCOL_TRC_SMPTE170M;
+  codec->color_range = rgb ? AVCOL_RANGE_JPEG : AVCOL_RANGE_MPEG;
+  if (settings.bitExact) codec->flags |= AV_CODEC_FLAG_BITEXACT;
+  if ((format->oformat->flags & AVFMT_GLOBALHEADER) != 0)
+    codec->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
+  av_opt_set(codec->priv_data, "preset", settings.preset.c_str(), 0);
+  av_opt_set(codec->priv_data, "crf", std::to_string(settings.crf).c_str(), 0);
+  // x264's AVX-512 macroblock-tree kernel makes the output depend on leftover heap contents (seen
+  // with x264 164 r3095); without mbtree the same input gives the same bytes on every CPU.
+  if (settings.bitExact) av_opt_set(codec->priv_data, "x264-params", "mbtree=0", 0);
+  if (pixelFormat == AV_PIX_FMT_YUV444P) av_opt_set(codec->priv_data, "profile", "high444", 0);
+  if (network()) {
+    // A viewer sees each picture as soon as it is encoded (no look-ahead, no B-frames), and one
+    // that joins late waits at most a second for a keyframe.
+    av_opt_set(codec->priv_data, "tune", "zerolatency", 0);
+    codec->gop_size = std::max(1, static_cast<int>(std::lround(settings.nominalFps)));
+  }
+  // x264 checks the preset only here.
+  if (const int error = avcodec_open2(codec.get(), encoder, nullptr); error < 0) {
+    fail(fmt::format("cannot open the H.264 encoder (preset '{}', crf {}, {})", settings.preset,
+                     settings.crf, settings.pixelFormat),
+         error);
+  }
+
+  stream = avformat_new_stream(format.get(), nullptr);
+  if (stream == nullptr) fail("cannot add a video stream");
+  stream->time_base = kMicroseconds;
+  stream->avg_frame_rate = codec->framerate;
+  stream->r_frame_rate = codec->framerate;
+  if (const int error = avcodec_parameters_from_context(stream->codecpar, codec.get()); error < 0) {
+    fail("cannot describe the video stream", error);
+  }
+  if (settings.bitExact) format->flags |= AVFMT_FLAG_BITEXACT;
+  if (const int error = avio_open(&format->pb, destination.c_str(), AVIO_FLAG_WRITE); error < 0) {
+    fail(network() ? std::string("cannot open") : fmt::format("cannot create '{}'", destination),
+         error);
+  }
+  AVDictionary* muxerOptions = nullptr;
+  if (extension == ".mp4") av_dict_set(&muxerOptions, "movie_timescale", kMp4MovieTimescale, 0);
+  const int headerError = avformat_write_header(format.get(), &muxerOptions);
+  av_dict_free(&muxerOptions);
+  if (headerError < 0) fail("cannot write the container header", headerError);
+
+  frame.reset(av_frame_alloc());
+  packet.reset(av_packet_alloc());
+  if (!frame || !packet) fail("out of memory");
+  frame->format = pixelFormat;
+  frame->width = settings.size.width;
+  frame->height = settings.size.height;
+  if (const int error = av_frame_get_buffer(frame.get(), 0); error < 0)
+    fail("out of memory", error);
+  sws.reset(sws_getContext(settings.size.width, settings.size.height, AV_PIX_FMT_BGR24,
+                           settings.size.width, settings.size.height, pixelFormat,
+                           SWS_BICUBIC | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT | SWS_BITEXACT,
+                           nullptr, nullptr, nullptr));
+  if (!sws) fail("cannot set up the colour conversion");
+  if (!rgb) {
+    const int* bt601 = sws_getCoefficients(SWS_CS_ITU601);
+    sws_setColorspaceDetails(sws.get(), bt601, 1, bt601, 0, 0, 1 << 16, 1 << 16);
+  }
+}
+
+void VideoEncoder::Impl::drain(bool flushing) {
+  while (true) {
+    const int status = avcodec_receive_packet(codec.get(), packet.get());
+    if (status == AVERROR(EAGAIN) || (flushing && status == AVERROR_EOF)) return;
+    if (status < 0) fail("encoding failed", status);
+    av_packet_rescale_ts(packet.get(), codec->time_base, stream->time_base);
+    packet->stream_index = stream->index;
+    if (const int error = av_interleaved_write_frame(format.get(), packet.get()); error < 0) {
+      fail(network() ? "cannot send" : "cannot write to the file", error);
+    }
+  }
+}
+
+VideoEncoder::VideoEncoder(VideoEncoderSettings settings) : impl_(std::make_unique<Impl>()) {
+  impl_->settings = std::move(settings);
+  try {
+    impl_->open();
+  } catch (...) {
+    // Nothing half-made stays behind.
+    impl_->format.reset();
+    if (!impl_->partPath.empty()) {
+      std::error_code ignored;
+      std::filesystem::remove(impl_->partPath, ignored);
+    }
+    throw;
+  }
+}
+
+VideoEncoder::~VideoEncoder() {
+  try {
+    close();
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+  }
+}
+
+void VideoEncoder::write(const cv::Mat& bgr, std::chrono::nanoseconds timestamp) {
+  auto& s = *impl_;
+  if (s.closed) s.fail("write after close");
+  if (bgr.type() != CV_8UC3 || bgr.size() != s.settings.size) {
+    s.fail(fmt::format("expected an 8-bit BGR image of {}x{}, got {}x{} of type {}",
+                       s.settings.size.width, s.settings.size.height, bgr.cols, bgr.rows,
+                       bgr.type()));
+  }
+  const std::int64_t pts = std::chrono::duration_cast<std::chrono::microseconds>(timestamp).count();
+  // The container keeps its own precision (ms in MKV): two frames must not fall on one tick there.
+  const std::int64_t containerPts = av_rescale_q(pts, kMicroseconds, s.stream->time_base);
+  if (s.lastPts && containerPts <= av_rescale_q(*s.lastPts, kMicroseconds, s.stream->time_base)) {
+    s.fail(fmt::format("timestamps must increase (at the file's precision): {} us after {} us", pts,
+                       *s.lastPts));
+  }
+  if (const int error = av_frame_make_writable(s.frame.get()); error < 0)
+    s.fail("out of memory", error);
+  const std::uint8_t* source[] = {bgr.data};
+  const int sourceStride[] = {static_cast<int>(bgr.step[0])};
+  sws_scale(s.sws.get(), source, sourceStride, 0, bgr.rows, s.frame->data, s.frame->linesize);
+  s.frame->pts = pts;
+  if (const int error = avcodec_send_frame(s.codec.get(), s.frame.get()); error < 0) {
+    s.fail("encoding failed", error);
+  }
+  s.drain(false);
+  s.lastPts = pts;
+  ++s.framesWritten;
+}
+
+void VideoEncoder::close() {
+  auto& s = *impl_;
+  if (s.closed || !s.format) return;
+  s.closed = true;
+  const auto discard = [&s] {
+    s.format.reset();
+    std::error_code ignored;
+    std::filesystem::remove(s.partPath, ignored);
+  };
+  if (s.framesWritten == 0) {
+    discard();
+    if (s.network()) return;  // nothing was sent; nothing is lost
+    s.fail("no frames written; no file made");
+  }
+  try {
+    if (const int error = avcodec_send_frame(s.codec.get(), nullptr); error < 0)
+      s.fail("flushing failed", error);
+    s.drain(true);
+    if (const int error = av_write_trailer(s.format.get()); error < 0)
+      s.fail("cannot finalize the file", error);
+    s.format.reset();  // closes the file
+  } catch (...) {
+    discard();
+    throw;
+  }
+  if (s.network()) return;
+  std::error_code renamed;
+  std::filesystem::rename(s.partPath, s.settings.path, renamed);
+  // The finished file is kept under its .part name rather than lost.
+  if (renamed) {
+    s.fail(fmt::format("finished, but cannot rename '{}' to the final name: {}",
+                       s.partPath.string(), renamed.message()));
+  }
+}
+
+const std::filesystem::path& VideoEncoder::path() const { return impl_->settings.path; }
+
+std::string VideoEncoder::target() const { return impl_->target(); }
+
+std::uint64_t VideoEncoder::framesWritten() const { return impl_->framesWritten; }
+
+}  // namespace surroundd::render

@@ -1,0 +1,117 @@
+// The encoder queue: every picture in order when it waits, the newest winning when it drops, and a
+// failure of the output reaching the pipeline thread.
+
+#include "render/outputs/queued_sink.hpp"
+
+#include <chrono>
+#include <future>
+#include <latch>
+#include <mutex>
+#include <stdexcept>
+#include <utility>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "tests/support/test_support.hpp"
+
+namespace surroundd::render {
+namespace {
+
+using std::chrono::milliseconds;
+using WhenFull = QueuedSink::WhenFull;
+
+const cv::Size kSize(64, 48);
+
+cv::Mat picture(int index) { return testing::syntheticPicture(kSize, index); }
+
+// An output that keeps what it is given, and can be held (like an encoder stuck on a slow disk)
+// or made to fail.
+class KeepingSink final : public FrameSink {
+ public:
+  struct Shared {
+    std::mutex mutex;
+    std::vector<std::pair<cv::Mat, std::chrono::nanoseconds>> consumed;
+    std::latch release{1};
+    bool hold = false;
+    std::promise<void> holding;  // set when the first held picture is taken
+    bool holdingSet = false;     // only the worker thread touches it
+    int failAt = -1;
+    bool finished = false;
+  };
+  explicit KeepingSink(Shared& shared) : shared_(shared) {}
+  void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) override {
+    if (shared_.hold) {
+      if (!std::exchange(shared_.holdingSet, true)) shared_.holding.set_value();
+      shared_.release.wait();
+    }
+    const std::lock_guard lock(shared_.mutex);
+    if (static_cast<int>(shared_.consumed.size()) == shared_.failAt) {
+      throw std::runtime_error("disk full");
+    }
+    shared_.consumed.emplace_back(bgr.clone(), streamTime);
+  }
+  void finish(const cv::Mat& /*lastFrame*/, std::chrono::nanoseconds /*lastTime*/) override {
+    shared_.finished = true;
+  }
+  std::string describe() const override { return "kept"; }
+
+ private:
+  Shared& shared_;
+};
+
+TEST(QueuedSink, WhenItWaitsEveryPictureArrivesInOrder) {
+  KeepingSink::Shared shared;
+  QueuedSink sink(std::make_unique<KeepingSink>(shared), kSize, 2, WhenFull::kWait);
+  for (int i = 0; i < 20; ++i) sink.consume(picture(i), milliseconds(i));
+  sink.finish({}, {});
+  EXPECT_TRUE(shared.finished);
+  ASSERT_EQ(shared.consumed.size(), 20u);
+  for (int i = 0; i < 20; ++i) {
+    EXPECT_EQ(shared.consumed[i].second, milliseconds(i));
+    EXPECT_EQ(cv::norm(shared.consumed[i].first, picture(i), cv::NORM_INF), 0.0) << i;
+  }
+  EXPECT_EQ(sink.dropped(), 0u);
+  EXPECT_EQ(sink.describe(), "kept");
+}
+
+TEST(QueuedSink, WhenItDropsTheNewestPicturesWinAndDropsAreCounted) {
+  KeepingSink::Shared shared;
+  shared.hold = true;
+  QueuedSink sink(std::make_unique<KeepingSink>(shared), kSize, 3, WhenFull::kDropOldest);
+  sink.consume(picture(0), milliseconds(0));
+  // The worker has taken the first picture and is stuck on it (bounded: a worker that never takes
+  // it fails the test instead of hanging it).
+  const bool taken =
+      shared.holding.get_future().wait_for(std::chrono::seconds(30)) == std::future_status::ready;
+  if (!taken) shared.release.count_down();
+  ASSERT_TRUE(taken);
+  for (int i = 1; i < 10; ++i) sink.consume(picture(i), milliseconds(i));  // never blocks
+  shared.release.count_down();
+  sink.finish({}, {});
+  ASSERT_EQ(shared.consumed.size(), 4u);
+  EXPECT_EQ(shared.consumed[0].second, milliseconds(0));
+  for (int k = 1; k < 4; ++k) {
+    EXPECT_EQ(shared.consumed[k].second, milliseconds(6 + k));
+    EXPECT_EQ(cv::norm(shared.consumed[k].first, picture(6 + k), cv::NORM_INF), 0.0);
+  }
+  EXPECT_EQ(sink.dropped(), 6u);
+  EXPECT_EQ(sink.describe(), "kept; 6 pictures dropped (output too slow)");
+}
+
+TEST(QueuedSink, AFailureOfTheOutputIsRethrownOnThePipelineThread) {
+  KeepingSink::Shared shared;
+  shared.failAt = 2;
+  QueuedSink sink(std::make_unique<KeepingSink>(shared), kSize, 1, WhenFull::kWait);
+  EXPECT_THROW(
+      {
+        for (int i = 0; i < 10; ++i) sink.consume(picture(i), milliseconds(i));
+        sink.finish({}, {});
+      },
+      std::runtime_error);
+  EXPECT_FALSE(shared.finished);
+  EXPECT_EQ(shared.consumed.size(), 2u);
+}
+
+}  // namespace
+}  // namespace surroundd::render
