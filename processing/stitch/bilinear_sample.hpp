@@ -7,6 +7,8 @@
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#elif defined(__ARM_NEON)
+#include <arm_neon.h>
 #endif
 
 #include "processing/stitch/kernel_path.hpp"
@@ -47,6 +49,26 @@ inline std::uint32_t bilinear(const std::uint8_t* source, std::size_t rowBytes, 
     sum = _mm_srli_epi32(_mm_add_epi32(sum, _mm_set1_epi32(1 << 13)), 14);
     sum = _mm_packs_epi32(sum, sum);
     return static_cast<std::uint32_t>(_mm_cvtsi128_si32(_mm_packus_epi16(sum, sum))) & 0xffffffU;
+  }
+#elif defined(__ARM_NEON)
+  if constexpr (kPath == KernelPath::kNeon) {
+    // c0 c1 c2 (and one more byte) of the left and the right pixel of a row, in 16-bit lanes.
+    const auto horizontal = [&](const std::uint8_t* p) {
+      std::uint32_t left = 0;
+      std::uint32_t right = 0;
+      std::memcpy(&left, p, 4);
+      std::memcpy(&right, p + 2, 4);
+      right >>= 8;
+      const uint16x4_t l = vget_low_u16(vmovl_u8(vcreate_u8(left)));
+      const uint16x4_t r = vget_low_u16(vmovl_u8(vcreate_u8(right)));
+      return vmla_n_u16(vmul_n_u16(l, static_cast<std::uint16_t>(wx0)), r,
+                        static_cast<std::uint16_t>(wx1));
+    };
+    uint32x4_t sum = vmull_n_u16(horizontal(top), static_cast<std::uint16_t>(wy0));
+    sum = vmlal_n_u16(sum, horizontal(bottom), static_cast<std::uint16_t>(wy1));
+    // Rounded: (sum + 2^13) >> 14, at most 255, so the narrowing moves lose nothing.
+    const uint8x8_t bytes = vmovn_u16(vcombine_u16(vrshrn_n_u32(sum, 14), vdup_n_u16(0)));
+    return vget_lane_u32(vreinterpret_u32_u8(bytes), 0) & 0xffffffU;
   }
 #endif
   std::uint32_t packed = 0;

@@ -1,7 +1,8 @@
-// Every kernel path a build has (processing/stitch/kernel_path.hpp: SSE2 on x86) gives exactly the bytes
-// of the portable one (issue 19.4), on the synth_small recording's first frame set through its own
-// panorama LUT: every tap of the LUT and of its seam blends sampled alone, the whole stitch, and
-// every pair of weights on pictures of random and extreme bytes.
+// Every kernel path a build has (processing/stitch/kernel_path.hpp: SSE2 on x86-64, NEON on
+// arm64) gives exactly the bytes of the portable one (issue 19.4), on the synth_small recording's
+// first frame set through its own panorama LUT: every tap of the LUT and of its seam blends sampled
+// alone, the whole stitch, the colour correction's fields applied to it, and every pair of weights
+// on pictures of random and extreme bytes.
 
 #include <array>
 #include <cstdint>
@@ -13,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "common/work_pool.hpp"
+#include "processing/colour/poisson_correction.hpp"
 #include "processing/stitch/bilinear_sample.hpp"
 #include "processing/stitch/kernel_path.hpp"
 #include "processing/stitch/stitcher.hpp"
@@ -25,6 +27,8 @@ namespace {
 #if defined(__x86_64__)
 // Or the comparisons below would compare the portable path with itself.
 static_assert(kernelPathBuilt(KernelPath::kSse2));
+#elif defined(__aarch64__)
+static_assert(kernelPathBuilt(KernelPath::kNeon));
 #endif
 
 class KernelPathsTest : public ::testing::Test {
@@ -95,6 +99,32 @@ TEST_F(KernelPathsTest, EveryPathStitchesTheSameBytes) {
   cv::Mat native;
   stitcher.stitch(frames_, native);
   EXPECT_EQ(cv::norm(native, portable, cv::NORM_INF), 0.0);
+}
+
+// The colour correction's field applied by each path, both fields, over the whole stitched
+// panorama: the blend bands' pixels (a share of the source camera) and the rest.
+TEST_F(KernelPathsTest, EveryPathAppliesTheSameCorrection) {
+  Stitcher stitcher(lut_, pool_);
+  cv::Mat raw;
+  stitcher.stitch(frames_, raw);
+  for (const CorrectionField field :
+       {CorrectionField::kMultiplicative, CorrectionField::kAdditive}) {
+    SCOPED_TRACE(correctionFieldName(field));
+    ColourCorrectionSettings correction;
+    correction.field = field;
+    PoissonColourCorrection poisson(truth_.rig, testing::settingsFor(truth_), lut_, correction,
+                                    pool_);
+    poisson.update(frames_);
+    cv::Mat portable = raw.clone();
+    poisson.apply(portable, KernelPath::kPortable);
+    ASSERT_GT(cv::norm(portable, raw, cv::NORM_L1), 1000.0);  // a field that changes the picture
+    for (const KernelPath path : kKernelPaths) {
+      SCOPED_TRACE(kernelPathName(path));
+      cv::Mat panorama = raw.clone();
+      poisson.apply(panorama, path);
+      EXPECT_EQ(cv::norm(panorama, portable, cv::NORM_INF), 0.0);
+    }
+  }
 }
 
 // Every weight pair (0..128 each) on 2x2 pictures of random bytes, of all 0 and of all 255 (the
