@@ -16,6 +16,15 @@
 
 namespace surroundd::processing {
 
+// The bytes of pixel `column` (0 or 1) of the two at p, as c0 | c1 << 8 | c2 << 16, plus the next
+// pixel's c0 << 24 for column 0: four bytes read from inside the two pixels' six, so that the
+// last pixel of an image is safe to read.
+inline std::uint32_t pixelBytes(const std::uint8_t* p, int column) {
+  std::uint32_t bytes = 0;
+  std::memcpy(&bytes, p + 2 * column, 4);
+  return column == 0 ? bytes : bytes >> 8;
+}
+
 // Bilinear sample of one 3-byte pixel in fixed point (weights in 1/128, result rounded), as the
 // bytes c0 | c1 << 8 | c2 << 16. Horizontal first in 16 bits (at most 255 * 128), then vertical in
 // 32; every path computes exactly what the portable one does (kernel_path.hpp). Reads stay inside
@@ -35,13 +44,8 @@ inline std::uint32_t bilinear(const std::uint8_t* source, std::size_t rowBytes, 
     const __m128i weightLeft = _mm_set1_epi16(static_cast<short>(wx0));
     const __m128i weightRight = _mm_set1_epi16(static_cast<short>(wx1));
     const auto horizontal = [&](const std::uint8_t* p) {
-      std::uint32_t left = 0;  // c0 c1 c2 of the left pixel, then one byte of the right one
-      std::uint32_t right = 0;
-      std::memcpy(&left, p, 4);
-      std::memcpy(&right, p + 2, 4);
-      right >>= 8;  // c0 c1 c2 of the right pixel
-      const __m128i l = _mm_unpacklo_epi8(_mm_cvtsi32_si128(static_cast<int>(left)), zero);
-      const __m128i r = _mm_unpacklo_epi8(_mm_cvtsi32_si128(static_cast<int>(right)), zero);
+      const auto l = _mm_unpacklo_epi8(_mm_cvtsi32_si128(static_cast<int>(pixelBytes(p, 0))), zero);
+      const auto r = _mm_unpacklo_epi8(_mm_cvtsi32_si128(static_cast<int>(pixelBytes(p, 1))), zero);
       return _mm_add_epi16(_mm_mullo_epi16(l, weightLeft), _mm_mullo_epi16(r, weightRight));
     };
     const __m128i pairs = _mm_unpacklo_epi16(horizontal(top), horizontal(bottom));
@@ -54,13 +58,8 @@ inline std::uint32_t bilinear(const std::uint8_t* source, std::size_t rowBytes, 
   if constexpr (kPath == KernelPath::kNeon) {
     // c0 c1 c2 (and one more byte) of the left and the right pixel of a row, in 16-bit lanes.
     const auto horizontal = [&](const std::uint8_t* p) {
-      std::uint32_t left = 0;
-      std::uint32_t right = 0;
-      std::memcpy(&left, p, 4);
-      std::memcpy(&right, p + 2, 4);
-      right >>= 8;
-      const uint16x4_t l = vget_low_u16(vmovl_u8(vcreate_u8(left)));
-      const uint16x4_t r = vget_low_u16(vmovl_u8(vcreate_u8(right)));
+      const uint16x4_t l = vget_low_u16(vmovl_u8(vcreate_u8(pixelBytes(p, 0))));
+      const uint16x4_t r = vget_low_u16(vmovl_u8(vcreate_u8(pixelBytes(p, 1))));
       return vmla_n_u16(vmul_n_u16(l, static_cast<std::uint16_t>(wx0)), r,
                         static_cast<std::uint16_t>(wx1));
     };

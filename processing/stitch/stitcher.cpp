@@ -28,21 +28,19 @@ inline std::uint64_t bilinearPair(const std::uint8_t* sourceA, std::size_t rowBy
   const std::uint8_t* topA = sourceA + static_cast<std::size_t>(a.offset) * 3;
   const std::uint8_t* topB = sourceB + static_cast<std::size_t>(b.offset) * 3;
   const __m128i zero = _mm_setzero_si128();
-  const auto load = [](const std::uint8_t* p, int skip) {
-    std::uint32_t bytes = 0;
-    std::memcpy(&bytes, p + skip, 4);
-    return _mm_cvtsi32_si128(static_cast<int>(skip == 0 ? bytes : bytes >> 8));
+  const auto load = [](const std::uint8_t* p, int column) {
+    return _mm_cvtsi32_si128(static_cast<int>(pixelBytes(p, column)));
   };
-  // Left and right neighbours of both pixels in one row, 16-bit lanes: a in 0-3, b in 4-7.
-  const auto lanes = [&](const std::uint8_t* pa, const std::uint8_t* pb, int skip) {
-    return _mm_unpacklo_epi8(_mm_unpacklo_epi32(load(pa, skip), load(pb, skip)), zero);
+  // Left or right neighbours of both pixels in one row, 16-bit lanes: a in 0-3, b in 4-7.
+  const auto lanes = [&](const std::uint8_t* pa, const std::uint8_t* pb, int column) {
+    return _mm_unpacklo_epi8(_mm_unpacklo_epi32(load(pa, column), load(pb, column)), zero);
   };
   const __m128i wx1 = _mm_unpacklo_epi64(_mm_set1_epi16(static_cast<short>(a.fx)),
                                          _mm_set1_epi16(static_cast<short>(b.fx)));
   const __m128i wx0 = _mm_sub_epi16(_mm_set1_epi16(LutTap::kFractionOne), wx1);
   const auto horizontal = [&](const std::uint8_t* pa, const std::uint8_t* pb) {
     return _mm_add_epi16(_mm_mullo_epi16(lanes(pa, pb, 0), wx0),
-                         _mm_mullo_epi16(lanes(pa, pb, 2), wx1));
+                         _mm_mullo_epi16(lanes(pa, pb, 1), wx1));
   };
   const __m128i upper = horizontal(topA, topB);
   const __m128i lower = horizontal(topA + rowBytesA, topB + rowBytesB);
@@ -66,19 +64,15 @@ inline std::uint64_t bilinearPair(const std::uint8_t* sourceA, std::size_t rowBy
                                   std::size_t rowBytesB, const LutTap& b) {
   const std::uint8_t* topA = sourceA + static_cast<std::size_t>(a.offset) * 3;
   const std::uint8_t* topB = sourceB + static_cast<std::size_t>(b.offset) * 3;
-  const auto load = [](const std::uint8_t* p, int skip) {
-    std::uint32_t bytes = 0;
-    std::memcpy(&bytes, p + skip, 4);
-    return static_cast<std::uint64_t>(skip == 0 ? bytes : bytes >> 8);
-  };
-  const auto lanes = [&](const std::uint8_t* pa, const std::uint8_t* pb, int skip) {
-    return vmovl_u8(vcreate_u8(load(pa, skip) | load(pb, skip) << 32));
+  const auto lanes = [](const std::uint8_t* pa, const std::uint8_t* pb, int column) {
+    const std::uint64_t both = pixelBytes(pa, column) | std::uint64_t{pixelBytes(pb, column)} << 32;
+    return vmovl_u8(vcreate_u8(both));
   };
   const uint16x8_t wx1 = vcombine_u16(vdup_n_u16(static_cast<std::uint16_t>(a.fx)),
                                       vdup_n_u16(static_cast<std::uint16_t>(b.fx)));
   const uint16x8_t wx0 = vsubq_u16(vdupq_n_u16(LutTap::kFractionOne), wx1);
   const auto horizontal = [&](const std::uint8_t* pa, const std::uint8_t* pb) {
-    return vmlaq_u16(vmulq_u16(lanes(pa, pb, 0), wx0), lanes(pa, pb, 2), wx1);
+    return vmlaq_u16(vmulq_u16(lanes(pa, pb, 0), wx0), lanes(pa, pb, 1), wx1);
   };
   const uint16x8_t upper = horizontal(topA, topB);
   const uint16x8_t lower = horizontal(topA + rowBytesA, topB + rowBytesB);
