@@ -1,8 +1,9 @@
 // Issue 18: an output that failed was dropped for good, and a recorder with every output failed
 // looked healthy. Now a failed output is opened again after a pause (doubling up to a minute) under
-// a name that keeps what it wrote, and the pipeline says when no output works. The failure here
-// is real: while the first segment is written, a folder takes the second segment's file name, so
-// that segment cannot be opened.
+// a name that keeps what it wrote, and the pipeline says when no output works. The failure in the
+// pipeline's test is real: while the first segment is written, a folder takes the second segment's
+// file name, so that segment cannot be opened. The pauses are tested on the outputs alone, with
+// an output type of this test's own that fails when told to.
 
 #include <atomic>
 #include <optional>
@@ -11,13 +12,96 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "daemon/output_type.hpp"
 #include "daemon/pipeline.hpp"
+#include "daemon/pipeline_outputs.hpp"
 #include "tests/daemon/replay_config.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace surroundd::daemon {
 namespace {
+
+// An output that fails when told to: its pictures while `consumeFails`, its opening while
+// `openFails`; `opens` counts the tries to open it.
+struct FlakyState {
+  bool consumeFails = false;
+  bool openFails = false;
+  int opens = 0;
+};
+FlakyState& flaky() {
+  static FlakyState state;
+  return state;
+}
+
+class FlakySink final : public render::FrameSink {
+ public:
+  void consume(const cv::Mat& /*bgr*/, std::chrono::nanoseconds /*streamTime*/) override {
+    if (flaky().consumeFails) throw std::runtime_error("flaky: the picture was refused");
+  }
+  void finish(const cv::Mat& /*lastFrame*/, std::chrono::nanoseconds /*lastTime*/) override {}
+  std::string describe() const override { return "flaky"; }
+};
+
+bool flakyRegistered() {
+  static const bool kDone = [] {
+    OutputType type;
+    type.name = "flaky";
+    type.readSettings = [](YamlObject&, OutputConfig&) {};
+    type.openPictureSink = [](const OutputConfig&, const OutputContext&) {
+      ++flaky().opens;
+      if (flaky().openFails) throw std::runtime_error("flaky: cannot open");
+      return std::unique_ptr<render::FrameSink>(std::make_unique<FlakySink>());
+    };
+    registerOutputType(std::move(type));
+    return true;
+  }();
+  return kDone;
+}
+
+TEST(OutputRetry, AnOutputStillFailingIsTriedAfterTwiceThePauseEachTimeUpToAMinute) {
+  ASSERT_TRUE(flakyRegistered());
+  using Clock = PipelineOutputs::Clock;
+  OutputConfig config;
+  config.kind = OutputKind{"flaky"};
+  PipelineOutputs outputs(30, false);
+  outputs.addPicture(config, cv::Size(64, 48), nullptr, nullptr);
+  auto& output = outputs.pictures().at(0);
+  const cv::Mat picture(48, 64, CV_8UC3, cv::Scalar::all(90));
+
+  flaky() = {true, true, 0};
+  const auto failedAt = Clock::now();
+  outputs.handOver(output, picture, {}, failedAt);
+  ASSERT_FALSE(output.sink);
+  EXPECT_FALSE(outputs.anyWorks());
+  EXPECT_EQ(outputs.failures(), 1u);
+
+  // Each pause from a failed try to the next: 1 s after the failure, then 2, 4, ... up to 60 s.
+  auto now = output.nextRetry;
+  EXPECT_GE(now - failedAt, std::chrono::seconds(1));
+  for (const int pause : {2, 4, 8, 16, 32, 60, 60}) {
+    SCOPED_TRACE(pause);
+    outputs.retry(now - std::chrono::milliseconds(1));  // not yet
+    EXPECT_EQ(flaky().opens, 0);
+    outputs.retry(now);
+    EXPECT_EQ(flaky().opens, 1);
+    EXPECT_EQ(output.nextRetry - now, std::chrono::seconds(pause));
+    flaky().opens = 0;
+    now = output.nextRetry;
+  }
+
+  // Once it opens, it works, and a later failure starts again from 1 s.
+  flaky() = {false, false, 0};
+  outputs.retry(now);
+  ASSERT_TRUE(output.sink);
+  EXPECT_TRUE(outputs.anyWorks());
+  outputs.handOver(output, picture, {}, Clock::now());
+  flaky().consumeFails = true;
+  outputs.handOver(output, picture, {}, Clock::now());
+  ASSERT_FALSE(output.sink);
+  EXPECT_EQ(output.retryDelay, PipelineOutputs::kFirstOutputRetry);
+  EXPECT_EQ(outputs.failures(), 2u);
+}
 
 // Takes the second segment's name once the first is being written, watches whether some output
 // works, loop by loop, and stops the run once kSetsAfterReturn frame sets went through after the
