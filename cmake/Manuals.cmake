@@ -1,6 +1,10 @@
 # Manual pages, made from each program's --help by help2man (Debian's help2man package) with the
 # name, description and cross references of docs/man/<program>.h2m, so that they never drift
 # from what the programs say. Without help2man they are left out, and configure says so.
+if(CMAKE_CROSSCOMPILING)
+  message(STATUS "Cross build: the manual pages are left out (help2man runs the programs)")
+  return()
+endif()
 find_program(HELP2MAN_EXECUTABLE help2man)
 if(NOT HELP2MAN_EXECUTABLE)
   message(STATUS "help2man not found (Debian: help2man): the manual pages are left out")

@@ -3,6 +3,8 @@
 # what is missing and says what that is. Runs apt-get as root, or through sudo.
 # --fuzz: also clang and its sanitizer runtimes, for scripts/fuzz.sh (libFuzzer).
 # --soak: also gnuplot, for scripts/soak.sh's plot.
+# --cross-arm64: also the aarch64 cross compiler, qemu-user and mmdebstrap, for
+#   scripts/cross-arm64.sh.
 set -eu
 
 PACKAGES="
@@ -21,7 +23,8 @@ for argument in "$@"; do
   case "$argument" in
     --fuzz) PACKAGES="$PACKAGES clang libclang-rt-dev" ;;
     --soak) PACKAGES="$PACKAGES gnuplot-nox" ;;
-    *) echo "usage: scripts/install-deps.sh [--fuzz] [--soak]" >&2; exit 2 ;;
+    --cross-arm64) PACKAGES="$PACKAGES crossbuild-essential-arm64 qemu-user-static mmdebstrap" ;;
+    *) echo "usage: scripts/install-deps.sh [--fuzz] [--soak] [--cross-arm64]" >&2; exit 2 ;;
   esac
 done
 

@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 #include <utility>
 
 #include <fmt/format.h>
 
 #include "common/camera_limit.hpp"
 #include "common/work_pool.hpp"
+#include "processing/colour/float_lanes.hpp"
 #include "processing/colour/poisson_correction_state.hpp"
 
 namespace surroundd::processing {
@@ -28,6 +30,32 @@ std::array<float, 4> catmullRom(double t) {
 int firstTapOffset(int r, int block) {
   return static_cast<int>(std::floor((r + 0.5) / block - 0.5)) - 1;
 }
+
+// A pixel's level (a float or a vector of channels) corrected by the field's value there, clamped
+// to 0..255. `weight` is the source camera's share of the pixel (`whole`: all of it).
+template <CorrectionField kField, typename Level>
+Level correctedLevel(Level pixel, Level value, float weight, bool whole) {
+  Level corrected;
+  if constexpr (kField == CorrectionField::kAdditive) {
+    corrected = pixel + weight * value;
+  } else {
+    const Level gain = 1 + value * (1.0f / 255);
+    if (whole) {
+      corrected = pixel * gain;
+    } else {
+      // In the seam band the pixel is w * source + (1 - w) * target, with target = gain * source
+      // where the field is right, so the source's part is pixel / (w + (1 - w) gain).
+      corrected = pixel * gain / (weight + (1 - weight) * gain);
+    }
+  }
+  return clampLanes(corrected, 0.0f, 255.0f);
+}
+
+// Non-negative, so adding a half and truncating rounds (lround is a libm call per value).
+inline std::uint8_t roundedLevel(float level) {
+  return static_cast<std::uint8_t>(level + 0.5f);  // NOLINT(bugprone-incorrect-roundings)
+}
+inline IntLanes roundedLevel(FloatLanes level) { return truncatedLanes(level + 0.5f); }
 
 }  // namespace
 
@@ -59,7 +87,7 @@ PoissonColourCorrection::PoissonColourCorrection(const Rig& rig, const PanoramaS
   }
   rowBuffers_.assign(
       static_cast<std::size_t>(pool.threads()) * 4,
-      std::vector<float>(static_cast<std::size_t>(domain.grid.width + 2 * kPad) * 3));
+      std::vector<float>(static_cast<std::size_t>(domain.grid.width + 2 * kPad) * 3 + 1));
   for (int u = 0; u < lut.size.width; ++u) {
     columnTap_.push_back(u / domain.block + firstTapOffset(u % domain.block, domain.block));
   }
@@ -230,7 +258,22 @@ int PoissonColourCorrection::update(std::span<const cv::Mat> frames) {
   return iterations;
 }
 
-void PoissonColourCorrection::apply(cv::Mat& panorama) {
+void PoissonColourCorrection::apply(cv::Mat& panorama, KernelPath path) {
+  if (!kernelPathBuilt(path)) {
+    throw std::invalid_argument(
+        fmt::format("colour correction: this build has no {} kernels", kernelPathName(path)));
+  }
+  const bool multiplicative = settings_.field == CorrectionField::kMultiplicative;
+  auto rows =
+      multiplicative
+          ? &PoissonColourCorrection::applyRows<CorrectionField::kMultiplicative, kNativeKernels>
+          : &PoissonColourCorrection::applyRows<CorrectionField::kAdditive, kNativeKernels>;
+  if (path == KernelPath::kPortable) {
+    rows = multiplicative ? &PoissonColourCorrection::applyRows<CorrectionField::kMultiplicative,
+                                                                KernelPath::kPortable>
+                          : &PoissonColourCorrection::applyRows<CorrectionField::kAdditive,
+                                                                KernelPath::kPortable>;
+  }
   const int chunks = static_cast<int>(rowBuffers_.size());
   pool_.parallelFor(
       chunks,
@@ -240,17 +283,13 @@ void PoissonColourCorrection::apply(cv::Mat& panorama) {
           const int first = height * chunk / chunks;
           const int last = height * (chunk + 1) / chunks;
           auto& buffer = rowBuffers_[static_cast<std::size_t>(chunk)];
-          if (settings_.field == CorrectionField::kMultiplicative) {
-            applyRows<CorrectionField::kMultiplicative>(first, last, panorama, buffer);
-          } else {
-            applyRows<CorrectionField::kAdditive>(first, last, panorama, buffer);
-          }
+          (this->*rows)(first, last, panorama, buffer);
         }
       },
       chunks);
 }
 
-template <CorrectionField kField>
+template <CorrectionField kField, KernelPath kPath>
 void PoissonColourCorrection::applyRows(int first, int last, cv::Mat& panorama,
                                         std::vector<float>& columnBuffer) const {
   const CorrectionDomain& domain = full_->domain;  // its grid and shares are every domain's
@@ -278,7 +317,8 @@ void PoissonColourCorrection::applyRows(int first, int last, cv::Mat& panorama,
       column[-kPad * 3 + x] = column[(gridWidth - kPad) * 3 + x];
       column[gridWidth * 3 + x] = column[x];
     }
-    // Horizontal pass where a source camera contributes.
+    // Horizontal pass where a source camera contributes: the three channels one at a time, or as
+    // three lanes of one vector operation (SSE2, NEON: float_lanes.hpp), with the same roundings.
     auto* out = panorama.ptr<std::uint8_t>(v);
     for (int u = 0; u < width; ++u) {
       if (share[u] == 0) continue;
@@ -286,27 +326,24 @@ void PoissonColourCorrection::applyRows(int first, int last, cv::Mat& panorama,
       const float* tap =
           column + static_cast<std::ptrdiff_t>(columnTap_[static_cast<std::size_t>(u)]) * 3;
       const float weight = share[u] * (1.0f / 256);
+      const bool whole = share[u] == 256;
       std::uint8_t* pixel = out + static_cast<std::size_t>(u) * 3;
-      for (int c = 0; c < 3; ++c) {
-        const float value =
-            wx[0] * tap[c] + wx[1] * tap[3 + c] + wx[2] * tap[6 + c] + wx[3] * tap[9 + c];
-        float corrected = 0;
-        if constexpr (kField == CorrectionField::kAdditive) {
-          corrected = pixel[c] + weight * value;
-        } else {
-          const float gain = 1 + value * (1.0f / 255);
-          if (share[u] == 256) {
-            corrected = pixel[c] * gain;
-          } else {
-            // In the seam band the pixel is w * source + (1 - w) * target, with target = gain *
-            // source where the field is right, so the source's part is pixel / (w + (1 - w) gain).
-            corrected = pixel[c] * gain / (weight + (1 - weight) * gain);
-          }
+      if constexpr (kPath == KernelPath::kPortable) {
+        for (int c = 0; c < 3; ++c) {
+          const float value =
+              wx[0] * tap[c] + wx[1] * tap[3 + c] + wx[2] * tap[6 + c] + wx[3] * tap[9 + c];
+          pixel[c] = roundedLevel(
+              correctedLevel<kField>(static_cast<float>(pixel[c]), value, weight, whole));
         }
-        corrected = std::clamp(corrected, 0.0f, 255.0f);
-        // Non-negative, so adding a half and truncating rounds (lround is a libm call per value).
-        pixel[c] =
-            static_cast<std::uint8_t>(corrected + 0.5f);  // NOLINT(bugprone-incorrect-roundings)
+      } else {
+        // Lane 3 reads the next block's first channel (the buffer has a float to spare at its
+        // end) and is dropped.
+        const FloatLanes value = wx[0] * loadLanes(tap) + wx[1] * loadLanes(tap + 3) +
+                                 wx[2] * loadLanes(tap + 6) + wx[3] * loadLanes(tap + 9);
+        const FloatLanes level = {static_cast<float>(pixel[0]), static_cast<float>(pixel[1]),
+                                  static_cast<float>(pixel[2]), 0};
+        const IntLanes rounded = roundedLevel(correctedLevel<kField>(level, value, weight, whole));
+        for (int c = 0; c < 3; ++c) pixel[c] = static_cast<std::uint8_t>(rounded[c]);
       }
     }
   }

@@ -42,6 +42,7 @@
 #include "processing/colour/correction_domain.hpp"
 #include "processing/colour/poisson_solver.hpp"
 #include "processing/colour/seam_statistics.hpp"
+#include "processing/stitch/kernel_path.hpp"
 
 namespace surroundd {
 class WorkPool;
@@ -104,7 +105,8 @@ class PoissonColourCorrection {
   int update(std::span<const cv::Mat> frames);
 
   // Adds the fields to a panorama stitched from the same frames (8-bit BGR of the LUT's size).
-  void apply(cv::Mat& panorama);
+  // `path`: the kernels to use (kernel_path.hpp), every one giving the same bytes.
+  void apply(cv::Mat& panorama, KernelPath path = kNativeKernels);
 
   const std::vector<SeamReport>& seams() const { return seamReports_; }
 
@@ -125,7 +127,7 @@ class PoissonColourCorrection {
   // Drops the data of seams the solved field makes worse; true when any was dropped.
   bool dropWorseningSeams();
   void noteOnce(std::vector<std::uint8_t>& said, std::size_t seam, std::string note);
-  template <CorrectionField kField>
+  template <CorrectionField kField, KernelPath kPath>
   void applyRows(int first, int last, cv::Mat& panorama, std::vector<float>& columnBuffer) const;
 
   const PanoramaLut& lut_;

@@ -6,6 +6,8 @@
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#elif defined(__ARM_NEON)
+#include <arm_neon.h>
 #endif
 
 #include <fmt/format.h>
@@ -18,29 +20,27 @@ namespace {
 
 #if defined(__SSE2__)
 // Two pixels at once, the same arithmetic as bilinear() in eight 16-bit lanes: half the
-// instructions per pixel. Returns pixel a in the low 32 bits and b in the high 32 (each c0 c1 c2
-// 0).
+// instructions per pixel. kPairPath names the kernel path it serves. Returns pixel a in the low 32
+// bits and b in the high 32 (each c0 c1 c2 0).
 inline std::uint64_t bilinearPair(const std::uint8_t* sourceA, std::size_t rowBytesA,
                                   const LutTap& a, const std::uint8_t* sourceB,
                                   std::size_t rowBytesB, const LutTap& b) {
   const std::uint8_t* topA = sourceA + static_cast<std::size_t>(a.offset) * 3;
   const std::uint8_t* topB = sourceB + static_cast<std::size_t>(b.offset) * 3;
   const __m128i zero = _mm_setzero_si128();
-  const auto load = [](const std::uint8_t* p, int skip) {
-    std::uint32_t bytes = 0;
-    std::memcpy(&bytes, p + skip, 4);
-    return _mm_cvtsi32_si128(static_cast<int>(skip == 0 ? bytes : bytes >> 8));
+  const auto load = [](const std::uint8_t* p, int column) {
+    return _mm_cvtsi32_si128(static_cast<int>(pixelBytes(p, column)));
   };
-  // Left and right neighbours of both pixels in one row, 16-bit lanes: a in 0-3, b in 4-7.
-  const auto lanes = [&](const std::uint8_t* pa, const std::uint8_t* pb, int skip) {
-    return _mm_unpacklo_epi8(_mm_unpacklo_epi32(load(pa, skip), load(pb, skip)), zero);
+  // Left or right neighbours of both pixels in one row, 16-bit lanes: a in 0-3, b in 4-7.
+  const auto lanes = [&](const std::uint8_t* pa, const std::uint8_t* pb, int column) {
+    return _mm_unpacklo_epi8(_mm_unpacklo_epi32(load(pa, column), load(pb, column)), zero);
   };
   const __m128i wx1 = _mm_unpacklo_epi64(_mm_set1_epi16(static_cast<short>(a.fx)),
                                          _mm_set1_epi16(static_cast<short>(b.fx)));
   const __m128i wx0 = _mm_sub_epi16(_mm_set1_epi16(LutTap::kFractionOne), wx1);
   const auto horizontal = [&](const std::uint8_t* pa, const std::uint8_t* pb) {
     return _mm_add_epi16(_mm_mullo_epi16(lanes(pa, pb, 0), wx0),
-                         _mm_mullo_epi16(lanes(pa, pb, 2), wx1));
+                         _mm_mullo_epi16(lanes(pa, pb, 1), wx1));
   };
   const __m128i upper = horizontal(topA, topB);
   const __m128i lower = horizontal(topA + rowBytesA, topB + rowBytesB);
@@ -56,6 +56,36 @@ inline std::uint64_t bilinearPair(const std::uint8_t* sourceA, std::size_t rowBy
   const __m128i bytes = _mm_packus_epi16(words, words);
   return static_cast<std::uint64_t>(_mm_cvtsi128_si64(bytes)) & 0x00ffffff00ffffffULL;
 }
+constexpr KernelPath kPairPath = KernelPath::kSse2;
+#elif defined(__ARM_NEON)
+// The same two pixels at once in NEON's eight 16-bit lanes, a in 0-3 and b in 4-7.
+inline std::uint64_t bilinearPair(const std::uint8_t* sourceA, std::size_t rowBytesA,
+                                  const LutTap& a, const std::uint8_t* sourceB,
+                                  std::size_t rowBytesB, const LutTap& b) {
+  const std::uint8_t* topA = sourceA + static_cast<std::size_t>(a.offset) * 3;
+  const std::uint8_t* topB = sourceB + static_cast<std::size_t>(b.offset) * 3;
+  const auto lanes = [](const std::uint8_t* pa, const std::uint8_t* pb, int column) {
+    const std::uint64_t both = pixelBytes(pa, column) | std::uint64_t{pixelBytes(pb, column)} << 32;
+    return vmovl_u8(vcreate_u8(both));
+  };
+  const uint16x8_t wx1 = vcombine_u16(vdup_n_u16(static_cast<std::uint16_t>(a.fx)),
+                                      vdup_n_u16(static_cast<std::uint16_t>(b.fx)));
+  const uint16x8_t wx0 = vsubq_u16(vdupq_n_u16(LutTap::kFractionOne), wx1);
+  const auto horizontal = [&](const std::uint8_t* pa, const std::uint8_t* pb) {
+    return vmlaq_u16(vmulq_u16(lanes(pa, pb, 0), wx0), lanes(pa, pb, 1), wx1);
+  };
+  const uint16x8_t upper = horizontal(topA, topB);
+  const uint16x8_t lower = horizontal(topA + rowBytesA, topB + rowBytesB);
+  const auto vertical = [](uint16x4_t up, uint16x4_t low, const LutTap& tap) {
+    const auto wy1 = static_cast<std::uint16_t>(tap.fy);
+    const auto wy0 = static_cast<std::uint16_t>(LutTap::kFractionOne - wy1);
+    return vrshrn_n_u32(vmlal_n_u16(vmull_n_u16(up, wy0), low, wy1), 14);  // (sum + 2^13) >> 14
+  };
+  const uint16x8_t words = vcombine_u16(vertical(vget_low_u16(upper), vget_low_u16(lower), a),
+                                        vertical(vget_high_u16(upper), vget_high_u16(lower), b));
+  return vget_lane_u64(vreinterpret_u64_u8(vmovn_u16(words)), 0) & 0x00ffffff00ffffffULL;
+}
+constexpr KernelPath kPairPath = KernelPath::kNeon;
 #endif
 
 constexpr int kPrefetchAhead = 64;  // pixels
@@ -79,7 +109,11 @@ Stitcher::Stitcher(const PanoramaLut& lut, WorkPool& pool)
   }
 }
 
-void Stitcher::stitch(std::span<const cv::Mat> frames, cv::Mat& panorama) {
+void Stitcher::stitch(std::span<const cv::Mat> frames, cv::Mat& panorama, KernelPath path) {
+  if (!kernelPathBuilt(path)) {
+    throw std::invalid_argument(
+        fmt::format("stitch: this build has no {} kernels", kernelPathName(path)));
+  }
   if (frames.size() != lut_.cameraSizes.size()) {
     throw std::invalid_argument(fmt::format("stitch: {} frames for a LUT of {} cameras",
                                             frames.size(), lut_.cameraSizes.size()));
@@ -96,11 +130,14 @@ void Stitcher::stitch(std::span<const cv::Mat> frames, cv::Mat& panorama) {
   }
   panorama.create(lut_.size, CV_8UC3);
   // Chunks of rows, several per thread: rows cost unevenly (blend bands, memory locality).
+  auto rows = &Stitcher::stitchRows<KernelPath::kPortable>;
+  if (path == kNativeKernels) rows = &Stitcher::stitchRows<kNativeKernels>;
   pool_.parallelFor(
-      lut_.size.height, [&](int first, int last) { stitchRows(first, last, panorama); },
+      lut_.size.height, [&](int first, int last) { (this->*rows)(first, last, panorama); },
       pool_.threads() * 8);
 }
 
+template <KernelPath kPath>
 void Stitcher::stitchRows(int first, int last, cv::Mat& panorama) const {
   // Locals, not members: stores through the byte pointer `row` could alias any member, which
   // would make the compiler reload them for every pixel.
@@ -118,38 +155,40 @@ void Stitcher::stitchRows(int first, int last, cv::Mat& panorama) const {
     // (by the kernel or the unseen fill below); only the row's last pixel is stored in 3 bytes.
     const int spillEnd = end == width ? width - 1 : end;
     int u = begin;
-#if defined(__SSE2__)
-    for (; u + 2 <= spillEnd; u += 2) {
-      // The source pixels of a panorama row lie along a curve through the camera image that the
-      // hardware prefetcher does not follow: ask for them ahead (measured: a third faster at
-      // 1080p; per pixel beats once per cache line, which needs a branch or misses lines).
-      for (int k = 0; k < 2; ++k) {
-        if (u + k + kPrefetchAhead < end) {
-          const LutTap ahead = taps[u + k + kPrefetchAhead];
-          const std::uint8_t* at =
-              sources[ahead.camera] + static_cast<std::size_t>(ahead.offset) * 3;
-          __builtin_prefetch(at);
-          __builtin_prefetch(at + rowBytes[ahead.camera]);
+#if defined(__SSE2__) || defined(__ARM_NEON)
+    if constexpr (kPath == kPairPath) {
+      for (; u + 2 <= spillEnd; u += 2) {
+        // The source pixels of a panorama row lie along a curve through the camera image that the
+        // hardware prefetcher does not follow: ask for them ahead (measured: a third faster at
+        // 1080p; per pixel beats once per cache line, which needs a branch or misses lines).
+        for (int k = 0; k < 2; ++k) {
+          if (u + k + kPrefetchAhead < end) {
+            const LutTap ahead = taps[u + k + kPrefetchAhead];
+            const std::uint8_t* at =
+                sources[ahead.camera] + static_cast<std::size_t>(ahead.offset) * 3;
+            __builtin_prefetch(at);
+            __builtin_prefetch(at + rowBytes[ahead.camera]);
+          }
         }
+        const LutTap a = taps[u];
+        const LutTap b = taps[u + 1];
+        const std::uint64_t pair = bilinearPair(sources[a.camera], rowBytes[a.camera], a,
+                                                sources[b.camera], rowBytes[b.camera], b);
+        const auto left = static_cast<std::uint32_t>(pair);
+        const auto right = static_cast<std::uint32_t>(pair >> 32);
+        std::memcpy(out(u), &left, 4);
+        std::memcpy(out(u + 1), &right, 4);
       }
-      const LutTap a = taps[u];
-      const LutTap b = taps[u + 1];
-      const std::uint64_t pair = bilinearPair(sources[a.camera], rowBytes[a.camera], a,
-                                              sources[b.camera], rowBytes[b.camera], b);
-      const auto left = static_cast<std::uint32_t>(pair);
-      const auto right = static_cast<std::uint32_t>(pair >> 32);
-      std::memcpy(out(u), &left, 4);
-      std::memcpy(out(u + 1), &right, 4);
     }
 #endif
     for (; u < spillEnd; ++u) {
       const LutTap tap = taps[u];
-      const std::uint32_t value = bilinear(sources[tap.camera], rowBytes[tap.camera], tap);
+      const std::uint32_t value = bilinear<kPath>(sources[tap.camera], rowBytes[tap.camera], tap);
       std::memcpy(out(u), &value, 4);
     }
     if (end == width && begin < end) {
       const LutTap tap = taps[width - 1];
-      const std::uint32_t value = bilinear(sources[tap.camera], rowBytes[tap.camera], tap);
+      const std::uint32_t value = bilinear<kPath>(sources[tap.camera], rowBytes[tap.camera], tap);
       std::memcpy(out(width - 1), &value, 3);
     }
     // What no camera sees, on either side of the span (whole rows above the cameras' view).
@@ -160,7 +199,7 @@ void Stitcher::stitchRows(int first, int last, cv::Mat& panorama) const {
     for (std::uint32_t b = lut_.blendRowBegin[v]; b < lut_.blendRowBegin[v + 1]; ++b) {
       const BlendTap& blend = lut_.blendTaps[b];
       const std::uint32_t other =
-          bilinear(sources[blend.tap.camera], rowBytes[blend.tap.camera], blend.tap);
+          bilinear<kPath>(sources[blend.tap.camera], rowBytes[blend.tap.camera], blend.tap);
       std::uint8_t* pixel = out(static_cast<int>(blend.pixel - rowFirstPixel));
       const std::uint32_t w = blend.tap.weight;
       for (int c = 0; c < 3; ++c) {

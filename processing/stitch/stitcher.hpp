@@ -13,6 +13,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "processing/stitch/kernel_path.hpp"
 #include "processing/stitch/panorama_lut.hpp"
 
 namespace surroundd {
@@ -29,12 +30,15 @@ class Stitcher {
   // frames[i]: camera i's image, 8-bit 3-channel (any channel order; the panorama keeps it),
   // continuous, of the LUT's size for that camera. `panorama` is (re)allocated only if it is not
   // already 8-bit 3-channel of the LUT's size. Throws std::invalid_argument for frames that do not
-  // match; that is a wiring error, caught by the first frame.
-  void stitch(std::span<const cv::Mat> frames, cv::Mat& panorama);
+  // match; that is a wiring error, caught by the first frame. `path`: the kernels, this machine's
+  // unless a test compares them (each path stitches the same bytes); one this build lacks throws
+  // std::invalid_argument.
+  void stitch(std::span<const cv::Mat> frames, cv::Mat& panorama, KernelPath path = kNativeKernels);
 
   const PanoramaLut& lut() const { return lut_; }
 
  private:
+  template <KernelPath kPath>
   void stitchRows(int first, int last, cv::Mat& panorama) const;
 
   const PanoramaLut& lut_;

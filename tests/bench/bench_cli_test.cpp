@@ -32,6 +32,7 @@ TEST(BenchCli, StitchReportsTimingsAndAccuracyAsJson) {
   for (const auto& timing : report["timings"]) {
     EXPECT_GT(timing["stitch_ms"].as<double>(), 0);
     EXPECT_GT(timing["remap_ms"].as<double>(), 0);
+    EXPECT_GT(timing["portable_kernels_ms"].as<double>(), 0);
     EXPECT_NEAR(timing["ratio"].as<double>(),
                 timing["stitch_ms"].as<double>() / timing["remap_ms"].as<double>(), 1e-3);
   }

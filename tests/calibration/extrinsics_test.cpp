@@ -79,17 +79,22 @@ TEST(ExtrinsicCalibration, ListedPointsPastNinetyDegreesWithOutliers) {
   int pastNinety = 0;
   while (points.size() < 40) {
     const bool edge = points.size() % 2 == 1;
-    const double angle = rng.uniform(-0.5, 0.5) + (rng.uniform(0, 1) < 0.5 ? 0 : std::numbers::pi);
+    // One draw per statement, in the order x86-64 builds drew them (tools/synth/hash.hpp).
+    const double jitter = rng.uniform(-0.5, 0.5);
+    const double angle = jitter + (rng.uniform(0, 1) < 0.5 ? 0 : std::numbers::pi);
     const double radius = rng.uniform(0.95, 1.0) * lens.imageSize.width / 2;
-    const cv::Point2d pixel =
-        edge ? cv::Point2d(lens.cx + radius * std::cos(angle), lens.cy + radius * std::sin(angle))
-             : cv::Point2d(rng.uniform(0, lens.imageSize.width - 1),
-                           rng.uniform(0, lens.imageSize.height - 1));
+    cv::Point2d pixel(lens.cx + radius * std::cos(angle), lens.cy + radius * std::sin(angle));
+    if (!edge) {
+      pixel.y = rng.uniform(0, lens.imageSize.height - 1);
+      pixel.x = rng.uniform(0, lens.imageSize.width - 1);
+    }
     const auto ray = model.unproject(pixel);
     if (!ray || !model.inImage(pixel)) continue;
     pastNinety += (*ray)[2] < 0 ? 1 : 0;
     const cv::Vec3d vehicle = camera.pose.toVehicle(*ray * rng.uniform(1, 6));
-    const cv::Point2d noise(rng.uniform(-0.15, 0.15), rng.uniform(-0.15, 0.15));
+    const double noiseY = rng.uniform(-0.15, 0.15);
+    const double noiseX = rng.uniform(-0.15, 0.15);
+    const cv::Point2d noise(noiseX, noiseY);
     points.push_back({vehicle, pixel + noise, "point " + std::to_string(points.size())});
   }
   points[3].pixel += cv::Point2d(25, -10);

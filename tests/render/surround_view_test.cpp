@@ -4,10 +4,13 @@
 
 #include "render/surround_view.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <numbers>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -104,24 +107,43 @@ void expectGroundPointsLandOnTheirPixels(processing::MeshModel model,
     const cv::Point2d expected(size.width / 2.0 - ground.y * pixelsPerMetre - 0.5,
                                size.height / 2.0 - ground.x * pixelsPerMetre - 0.5);
     const cv::Point2d wanted = panorama.pixel(cv::Vec3d(ground.x, ground.y, 0) - panorama.centre);
-    double bestError = 1e9;
-    cv::Point best;
+    std::vector<std::pair<double, cv::Point>> seenFrom;  // panorama pixel error, picture pixel
     for (int y = static_cast<int>(expected.y) - 6; y <= static_cast<int>(expected.y) + 6; ++y) {
       for (int x = static_cast<int>(expected.x) - 6; x <= static_cast<int>(expected.x) + 6; ++x) {
         const cv::Point2d seen = decode(picture.at<cv::Vec3b>(y, x));
         double dc = std::abs(seen.x - wanted.x);
         dc = std::min(dc, panorama.size.width - dc);
-        const double error = std::hypot(dc, seen.y - wanted.y);
-        if (error < bestError) {
-          bestError = error;
-          best = {x, y};
-        }
+        seenFrom.emplace_back(std::hypot(dc, seen.y - wanted.y), cv::Point(x, y));
       }
     }
+    const double bestError =
+        std::ranges::min_element(seenFrom, {}, &std::pair<double, cv::Point>::first)->first;
     EXPECT_LT(bestError, 2.0) << "ground point " << ground << ": panorama pixel " << wanted
                               << " not seen near " << expected;
-    EXPECT_LE(cv::norm(cv::Point2d(best) - expected), 2.0)
-        << "ground point " << ground << " drawn at " << best << ", expected " << expected;
+    // Drawn at the middle of the pixels that see it best, to within 2 pixels or one panorama
+    // pixel's footprint there, whichever is larger: the colours say whole panorama pixels, and
+    // llvmpipe rounds them a level apart on arm64 and x86. Far out on the flat disk a panorama
+    // pixel spans several picture pixels (a point 8 m out lands 2.5 px apart).
+    cv::Point2d drawn(0, 0);
+    int best = 0;
+    for (const auto& [error, at] : seenFrom) {
+      if (error > bestError) continue;
+      drawn += cv::Point2d(at);
+      ++best;
+    }
+    drawn *= 1.0 / best;
+    const auto panoramaPixelsPerMetre = [&](cv::Vec3d step) {
+      const cv::Vec3d at(ground.x, ground.y, 0);
+      const cv::Point2d d =
+          panorama.pixel(at + step - panorama.centre) - panorama.pixel(at - step - panorama.centre);
+      const double dc = std::abs(d.x);
+      return std::hypot(std::min(dc, panorama.size.width - dc), d.y) / (2 * cv::norm(step));
+    };
+    const double footprint = pixelsPerMetre / std::min(panoramaPixelsPerMetre({0.01, 0, 0}),
+                                                       panoramaPixelsPerMetre({0, 0.01, 0}));
+    EXPECT_LE(cv::norm(drawn - expected), std::max(2.0, footprint))
+        << "ground point " << ground << " drawn at " << drawn << " (" << best
+        << " pixels), expected " << expected << "; a panorama pixel spans " << footprint;
   }
 }
 

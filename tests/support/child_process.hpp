@@ -3,11 +3,18 @@
 // that tests can check exit codes, messages and signal handling the way a user would see them.
 // Its stdout goes to the same file, or to a file of its own for a program whose stdout is data
 // (JSON) that its log lines must not be mixed into.
+//
+// In a cross build the tests run under the build's emulator (ctest puts
+// CMAKE_CROSSCOMPILING_EMULATOR in front of them), and so do the project's programs they start: a
+// program of this build (one under SURROUNDD_BINARY_DIR) is started as SURROUNDD_PROGRAM_LAUNCHER
+// (the emulator's command, a list of string literals; empty in a native build) followed by its own
+// arguments. Both are set by tests/support/CMakeLists.txt (surroundd_test_process).
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <fcntl.h>
@@ -23,6 +30,7 @@ class ChildProcess {
   ChildProcess(std::vector<std::string> arguments, std::filesystem::path stderrFile,
                std::vector<std::string> environment = {}, std::filesystem::path stdoutFile = {})
       : stderrFile_(std::move(stderrFile)), stdoutFile_(std::move(stdoutFile)) {
+    arguments = launched(std::move(arguments));
     std::vector<char*> argv;
     for (auto& argument : arguments) argv.push_back(argument.data());
     argv.push_back(nullptr);
@@ -72,6 +80,17 @@ class ChildProcess {
   std::string standardOutput() const { return contents(stdoutFile_); }
 
  private:
+  // `arguments` with the emulator in front where they start a program of this build.
+  static std::vector<std::string> launched(std::vector<std::string> arguments) {
+    const std::vector<std::string> launcher{SURROUNDD_PROGRAM_LAUNCHER};
+    constexpr std::string_view kBuild = SURROUNDD_BINARY_DIR "/";
+    if (launcher.empty() || arguments.empty() || !arguments.front().starts_with(kBuild)) {
+      return arguments;
+    }
+    arguments.insert(arguments.begin(), launcher.begin(), launcher.end());
+    return arguments;
+  }
+
   static std::string contents(const std::filesystem::path& path) {
     std::ifstream file(path);
     std::stringstream text;

@@ -89,15 +89,18 @@ void measure(const std::filesystem::path& folder, const ColourBenchmarkOptions& 
                                                                          correctionSettings, pool);
       cv::Mat corrected = raw.clone();
       const auto medians = interleavedMedians(
-          {[&] { correction->update(frames); }, [&] { correction->apply(corrected); }},
+          {[&] { correction->update(frames); }, [&] { correction->apply(corrected); },
+           [&] { correction->apply(corrected, processing::KernelPath::kPortable); }},
           options.repeats);
       raw.copyTo(corrected);
       correction->apply(corrected);
       fmt::print(
           "    per frame, {} field, {} threads: seam data + solve {:.2f} ms, upsample and apply "
-          "{:.2f} ms; colour step across the seams {:.2f} levels\n",
+          "{:.2f} ms ({} kernels; portable {:.2f} ms, {:.2f}x); colour step across the seams "
+          "{:.2f} levels\n",
           processing::correctionFieldName(field), options.threads, medians[0], medians[1],
-          seamError(corrected, frames));
+          processing::kernelPathName(processing::kNativeKernels), medians[2],
+          medians[1] / medians[2], seamError(corrected, frames));
     }
     // Cameras far apart (the generator's extreme photometrics) need gains past the default
     // gain_range: the same correction with the range a config would widen to.

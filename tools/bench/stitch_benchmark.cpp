@@ -31,6 +31,7 @@ struct ThreadTiming {
   int threads = 0;
   double stitchMs = 0;
   double remapMs = 0;
+  double portableMs = 0;  // the stitcher on its portable kernels (kernel_path.hpp)
 };
 
 struct InputReport {
@@ -105,14 +106,16 @@ InputReport measure(const std::filesystem::path& folder, int threads, int repeat
   const RemapBaseline baseline(lut);
   cv::Mat ours(lut.size, CV_8UC3);
   cv::Mat theirs(lut.size, CV_8UC3);
+  cv::Mat portable(lut.size, CV_8UC3);
   for (const int t : threads > 1 ? std::vector<int>{1, threads} : std::vector<int>{1}) {
     WorkPool timedPool(t);
     processing::Stitcher stitcher(lut, timedPool);
     cv::setNumThreads(t);
     const auto medians = interleavedMedians(
-        {[&] { stitcher.stitch(images, ours); }, [&] { baseline.stitch(images, theirs); }},
+        {[&] { stitcher.stitch(images, ours); }, [&] { baseline.stitch(images, theirs); },
+         [&] { stitcher.stitch(images, portable, processing::KernelPath::kPortable); }},
         repeats);
-    report.timings.push_back({t, medians[0], medians[1]});
+    report.timings.push_back({t, medians[0], medians[1], medians[2]});
   }
   cv::setNumThreads(-1);
 
@@ -135,9 +138,10 @@ void printText(const std::vector<InputReport>& reports) {
     for (const auto& t : r.timings) {
       fmt::print(
           "  {} thread{}: stitch {:6.2f} ms ({:5.0f} fps)   cv::remap {:6.2f} ms   "
-          "ratio {:.2f}x\n",
+          "ratio {:.2f}x   {} kernels against portable ({:.2f} ms): {:.2f}x\n",
           t.threads, t.threads > 1 ? "s" : " ", t.stitchMs, 1000 / t.stitchMs, t.remapMs,
-          t.stitchMs / t.remapMs);
+          t.stitchMs / t.remapMs, processing::kernelPathName(processing::kNativeKernels),
+          t.portableMs, t.stitchMs / t.portableMs);
     }
     for (const auto& [name, a] : {std::pair{"bowl  ", r.bowl}, std::pair{"sphere", r.sphere}}) {
       fmt::print(
@@ -157,8 +161,9 @@ void printJson(const std::vector<InputReport>& reports) {
     for (const auto& t : r.timings) {
       timings += fmt::format(
           "{}{{\"threads\": {}, \"stitch_ms\": {:.4f}, \"remap_ms\": {:.4f}, "
-          "\"ratio\": {:.4f}}}",
-          timings.empty() ? "" : ", ", t.threads, t.stitchMs, t.remapMs, t.stitchMs / t.remapMs);
+          "\"ratio\": {:.4f}, \"portable_kernels_ms\": {:.4f}}}",
+          timings.empty() ? "" : ", ", t.threads, t.stitchMs, t.remapMs, t.stitchMs / t.remapMs,
+          t.portableMs);
     }
     const auto accuracy = [](const Accuracy& a) {
       return fmt::format(

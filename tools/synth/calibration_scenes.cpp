@@ -155,9 +155,12 @@ std::vector<processing::Pose> boardPosesCoveringField(const processing::Intrinsi
     for (int attempt = 0; attempt < kAttempts && !placed; ++attempt) {
       // Half the attempts in the view's own cell; then anywhere, rather than fail.
       const bool inCell = attempt < kAttempts / 2;
-      const cv::Point2d pixel(
-          (inCell ? (cellX + rng.uniform(0.1, 0.9)) / cols : rng.uniform(0, 1)) * size.width,
-          (inCell ? (cellY + rng.uniform(0.1, 0.9)) / rows : rng.uniform(0, 1)) * size.height);
+      // y before x: the order x86-64 builds drew them in (hash.hpp, HashRng).
+      const double y =
+          (inCell ? (cellY + rng.uniform(0.1, 0.9)) / rows : rng.uniform(0, 1)) * size.height;
+      const double x =
+          (inCell ? (cellX + rng.uniform(0.1, 0.9)) / cols : rng.uniform(0, 1)) * size.width;
+      const cv::Point2d pixel(x, y);
       const auto ray = model.unproject(pixel);
       if (!ray || std::acos((*ray)[2]) > maxCornerAngle - 10 * kDegToRad) continue;
       // Facing the camera, upright, then rolled and tilted.

@@ -32,6 +32,11 @@ constexpr double unitFromHash(std::uint64_t h) {
 }
 
 // A deterministic stream of uniforms for set-up code (scene layout, camera parameters).
+//
+// One draw per statement, never two in one call's arguments: C++ leaves the order of a call's
+// arguments open (GCC takes them right to left on x86-64, left to right on arm64), and an arm64
+// build drew other colours for the same scene. Where draws were once arguments of one call, they
+// are now made one by one in the order x86-64 took, so every recording stays as it was.
 class HashRng {
  public:
   constexpr HashRng(std::uint64_t seed, std::uint64_t stream) : seed_(seed), stream_(stream) {}

@@ -95,9 +95,11 @@ std::vector<SceneBox> makeBoxes(HashRng& rng, double seconds) {
         return cv::norm(other.centre - box.centre) > 5.5;
       });
       if (!clear && attempt + 1 < 64) continue;
-      // Distinct saturated hues, evenly spaced around the colour wheel.
-      box.colour = hsvToBgr(std::fmod(hueOffset + 180.0 * i / count, 180.0), rng.uniform(190, 255),
-                            rng.uniform(170, 235));
+      // Distinct saturated hues, evenly spaced around the colour wheel. Value before saturation:
+      // the order x86-64 builds drew them in (hash.hpp, HashRng).
+      const double value = rng.uniform(170, 235);
+      const double saturation = rng.uniform(190, 255);
+      box.colour = hsvToBgr(std::fmod(hueOffset + 180.0 * i / count, 180.0), saturation, value);
       box.pattern = rng.integer(0, 1);
       boxes.push_back(box);
       break;
@@ -140,9 +142,11 @@ std::vector<SceneBox> makeNearObjects(HashRng& rng) {
       {{45, 1.4}, {135, 1.4}, {-45, 3.0}, {-135, 3.0}}};  // azimuth (degrees), widest gap (m)
   for (const auto& [azimuthDeg, widestGap] : seams) {
     const double azimuth = (azimuthDeg + rng.uniform(-2, 2)) * std::numbers::pi / 180;
-    const cv::Vec3f half(static_cast<float>(rng.uniform(0.25, 0.35)),
-                         static_cast<float>(rng.uniform(0.25, 0.35)),
-                         static_cast<float>(rng.uniform(0.8, 1.5)));
+    // Height, width, then length: the order x86-64 builds drew them in (hash.hpp, HashRng).
+    const auto height = static_cast<float>(rng.uniform(0.8, 1.5));
+    const auto halfWidth = static_cast<float>(rng.uniform(0.25, 0.35));
+    const auto halfLength = static_cast<float>(rng.uniform(0.25, 0.35));
+    const cv::Vec3f half(halfLength, halfWidth, height);
     // Out along the seam until the crate's near side is `gap` from the car.
     const double gap = rng.uniform(1.0, widestGap) + half[0];
     double lo = 0, hi = 20;
@@ -150,10 +154,14 @@ std::vector<SceneBox> makeNearObjects(HashRng& rng) {
       const double mid = (lo + hi) / 2;
       (gapTo(mid * cv::Point2d(std::cos(azimuth), std::sin(azimuth))) < gap ? lo : hi) = mid;
     }
-    objects.push_back(makeBox(
-        hi * cv::Point2d(std::cos(azimuth), std::sin(azimuth)), azimuth + rng.uniform(-0.3, 0.3),
-        half, hsvToBgr(rng.uniform(0, 180), rng.uniform(150, 230), rng.uniform(150, 220)),
-        rng.integer(0, 1)));
+    // Pattern, value, saturation, hue, then yaw: the order x86-64 builds drew them in (hash.hpp).
+    const int pattern = rng.integer(0, 1);
+    const double value = rng.uniform(150, 220);
+    const double saturation = rng.uniform(150, 230);
+    const double hue = rng.uniform(0, 180);
+    const double yaw = azimuth + rng.uniform(-0.3, 0.3);
+    objects.push_back(makeBox(hi * cv::Point2d(std::cos(azimuth), std::sin(azimuth)), yaw, half,
+                              hsvToBgr(hue, saturation, value), pattern));
   }
   return objects;
 }

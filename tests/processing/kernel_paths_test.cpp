@@ -1,0 +1,179 @@
+// Every kernel path a build has (processing/stitch/kernel_path.hpp: SSE2 on x86-64, NEON on
+// arm64) gives exactly the bytes of the portable one (issue 19.4), on the synth_small recording's
+// first frame set through its own panorama LUT: every tap of the LUT and of its seam blends sampled
+// alone, the whole stitch, the colour correction's fields applied to it, and every pair of weights
+// on pictures of random and extreme bytes.
+
+#include <array>
+#include <cstdint>
+#include <random>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "common/work_pool.hpp"
+#include "processing/colour/poisson_correction.hpp"
+#include "processing/stitch/bilinear_sample.hpp"
+#include "processing/stitch/kernel_path.hpp"
+#include "processing/stitch/stitcher.hpp"
+#include "tests/processing/panorama_test_support.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace surroundd::processing {
+namespace {
+
+#if defined(__x86_64__)
+// Or the comparisons below would compare the portable path with itself.
+static_assert(kernelPathBuilt(KernelPath::kSse2));
+#elif defined(__aarch64__)
+static_assert(kernelPathBuilt(KernelPath::kNeon));
+#endif
+
+class KernelPathsTest : public ::testing::Test {
+ protected:
+  KernelPathsTest()
+      : truth_(testing::smallRecording()),
+        lut_(buildPanoramaLut(truth_.rig, testing::settingsFor(truth_), pool_)) {
+    for (const auto& video : truth_.videos) {
+      frames_.push_back(surroundd::testing::decodeAll(video, false, 1).images.at(0));
+    }
+  }
+
+  WorkPool pool_{2};
+  const bench::RecordingTruth& truth_;
+  PanoramaLut lut_;
+  std::vector<cv::Mat> frames_;
+};
+
+// Each seen tap of the LUT, then each blend tap, sampled by path kPath.
+template <KernelPath kPath>
+std::vector<std::uint32_t> sampleEveryTap(const PanoramaLut& lut, std::span<const cv::Mat> frames) {
+  std::vector<std::uint32_t> samples;
+  const auto sample = [&](const LutTap& tap) {
+    const cv::Mat& frame = frames[tap.camera];
+    samples.push_back(bilinear<kPath>(frame.data, frame.step, tap));
+  };
+  for (const LutTap& tap : lut.taps) {
+    if (tap.camera != PanoramaLut::kUnseen) sample(tap);
+  }
+  for (const BlendTap& blend : lut.blendTaps) sample(blend.tap);
+  return samples;
+}
+
+template <std::size_t... kIndex>
+std::array<std::vector<std::uint32_t>, kKernelPaths.size()> sampleEveryTapByEveryPath(
+    const PanoramaLut& lut, std::span<const cv::Mat> frames, std::index_sequence<kIndex...>) {
+  return {sampleEveryTap<kKernelPaths[kIndex]>(lut, frames)...};
+}
+
+TEST_F(KernelPathsTest, EveryPathSamplesEveryTapOfARealLutAlike) {
+  const auto samples =
+      sampleEveryTapByEveryPath(lut_, frames_, std::make_index_sequence<kKernelPaths.size()>());
+  ASSERT_EQ(kKernelPaths[0], KernelPath::kPortable);
+  ASSERT_GT(samples[0].size(), lut_.taps.size() / 2);
+  for (std::size_t p = 1; p < kKernelPaths.size(); ++p) {
+    SCOPED_TRACE(kernelPathName(kKernelPaths[p]));
+    ASSERT_EQ(samples[p].size(), samples[0].size());
+    std::size_t differing = 0;
+    for (std::size_t i = 0; i < samples[0].size(); ++i) {
+      differing += samples[p][i] != samples[0][i] ? 1 : 0;
+    }
+    EXPECT_EQ(differing, 0u) << "of " << samples[0].size() << " taps";
+  }
+}
+
+TEST_F(KernelPathsTest, EveryPathStitchesTheSameBytes) {
+  Stitcher stitcher(lut_, pool_);
+  cv::Mat portable;
+  stitcher.stitch(frames_, portable, KernelPath::kPortable);
+  for (const KernelPath path : kKernelPaths) {
+    SCOPED_TRACE(kernelPathName(path));
+    cv::Mat panorama;
+    stitcher.stitch(frames_, panorama, path);
+    ASSERT_EQ(panorama.size(), portable.size());
+    EXPECT_EQ(cv::norm(panorama, portable, cv::NORM_INF), 0.0);
+  }
+  // The native path is the one stitch() takes by default.
+  cv::Mat native;
+  stitcher.stitch(frames_, native);
+  EXPECT_EQ(cv::norm(native, portable, cv::NORM_INF), 0.0);
+}
+
+// The colour correction's field applied by each path, both fields, over the whole stitched
+// panorama: the blend bands' pixels (a share of the source camera) and the rest.
+TEST_F(KernelPathsTest, EveryPathAppliesTheSameCorrection) {
+  Stitcher stitcher(lut_, pool_);
+  cv::Mat raw;
+  stitcher.stitch(frames_, raw);
+  for (const CorrectionField field :
+       {CorrectionField::kMultiplicative, CorrectionField::kAdditive}) {
+    SCOPED_TRACE(correctionFieldName(field));
+    ColourCorrectionSettings correction;
+    correction.field = field;
+    PoissonColourCorrection poisson(truth_.rig, testing::settingsFor(truth_), lut_, correction,
+                                    pool_);
+    poisson.update(frames_);
+    cv::Mat portable = raw.clone();
+    poisson.apply(portable, KernelPath::kPortable);
+    ASSERT_GT(cv::norm(portable, raw, cv::NORM_L1), 1000.0);  // a field that changes the picture
+    for (const KernelPath path : kKernelPaths) {
+      SCOPED_TRACE(kernelPathName(path));
+      cv::Mat panorama = raw.clone();
+      poisson.apply(panorama, path);
+      EXPECT_EQ(cv::norm(panorama, portable, cv::NORM_INF), 0.0);
+    }
+  }
+}
+
+// Every weight pair (0..128 each) on 2x2 pictures of random bytes, of all 0 and of all 255 (the
+// 16-bit lanes' and the packs' limits).
+template <KernelPath kPath>
+std::vector<std::uint32_t> sampleEveryWeight(const std::vector<cv::Mat>& pictures) {
+  std::vector<std::uint32_t> samples;
+  for (const cv::Mat& picture : pictures) {
+    for (int fy = 0; fy <= LutTap::kFractionOne; ++fy) {
+      for (int fx = 0; fx <= LutTap::kFractionOne; ++fx) {
+        LutTap tap;
+        tap.fx = static_cast<std::uint8_t>(fx);
+        tap.fy = static_cast<std::uint8_t>(fy);
+        samples.push_back(bilinear<kPath>(picture.data, picture.step, tap));
+      }
+    }
+  }
+  return samples;
+}
+
+template <std::size_t... kIndex>
+std::array<std::vector<std::uint32_t>, kKernelPaths.size()> sampleEveryWeightByEveryPath(
+    const std::vector<cv::Mat>& pictures, std::index_sequence<kIndex...>) {
+  return {sampleEveryWeight<kKernelPaths[kIndex]>(pictures)...};
+}
+
+TEST(KernelPaths, EveryPathWeighsAlike) {
+  std::vector<cv::Mat> pictures{cv::Mat(2, 2, CV_8UC3, cv::Scalar::all(0)),
+                                cv::Mat(2, 2, CV_8UC3, cv::Scalar::all(255))};
+  std::mt19937 random(19);
+  std::uniform_int_distribution<int> byte(0, 255);
+  for (int k = 0; k < 8; ++k) {
+    cv::Mat picture(2, 2, CV_8UC3);  // continuous: 12 bytes
+    for (int i = 0; i < 12; ++i) picture.data[i] = static_cast<std::uint8_t>(byte(random));
+    pictures.push_back(picture);
+  }
+  const auto samples =
+      sampleEveryWeightByEveryPath(pictures, std::make_index_sequence<kKernelPaths.size()>());
+  for (std::size_t p = 1; p < kKernelPaths.size(); ++p) {
+    SCOPED_TRACE(kernelPathName(kKernelPaths[p]));
+    EXPECT_EQ(samples[p], samples[0]);
+  }
+  // All 255 stays 255 at every weight, all 0 stays 0.
+  const std::size_t weights = (LutTap::kFractionOne + 1) * (LutTap::kFractionOne + 1);
+  for (std::size_t i = 0; i < weights; ++i) {
+    ASSERT_EQ(samples[0][i], 0u);
+    ASSERT_EQ(samples[0][weights + i], 0xffffffu);
+  }
+}
+
+}  // namespace
+}  // namespace surroundd::processing
