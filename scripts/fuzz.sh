@@ -2,7 +2,8 @@
 # Runs every libFuzzer target (tests/fuzz) for SECONDS each, one after another, and prints each
 # one's executions and findings: `scripts/fuzz.sh [SECONDS [RUNS]]` (default 60 s; with RUNS, a
 # target also stops after that many executions: `scripts/fuzz.sh 7200 1000000` is the issue's 10^6
-# each, within 2 hours each). FUZZ_TARGETS="config_fuzz rig_fuzz" runs only those.
+# each, within 2 hours each). FUZZ_TARGETS="config_fuzz rig_fuzz" runs only those; FUZZ_TIMEOUT
+# (seconds, default 10) is when one input counts as a hang.
 #
 # Builds the `fuzz` preset first (clang with ASan + UBSan; `scripts/install-deps.sh --fuzz`
 # installs clang), at most FUZZ_JOBS (default 2) compile jobs. Each target starts from its seeds in
@@ -43,9 +44,12 @@ for target in $targets; do
   log="$build/findings/$target.log"
   mkdir -p "$corpus"
   echo "fuzz: $target for ${seconds}s (seeds: $seeds)"
-  # -timeout: an input that takes 10 s is a hang; -rss_limit_mb: 2 GiB is an unbounded allocation.
+  # -timeout: an input that takes FUZZ_TIMEOUT s (default 10) is a hang; it is wall-clock time, so
+  # at nice 19 beside a busy build give it more (an input of 92 ms once took 10 s, starved).
+  # -rss_limit_mb: 2 GiB is an unbounded allocation.
   status=0
-  "$build/tests/fuzz/$target" -max_total_time="$seconds" -runs="$runs" -timeout=10 -rss_limit_mb=2048 \
+  "$build/tests/fuzz/$target" -max_total_time="$seconds" -runs="$runs" \
+    -timeout="${FUZZ_TIMEOUT:-10}" -rss_limit_mb=2048 \
     -print_final_stats=1 -artifact_prefix="$build/findings/$target-" "$corpus" "$seeds" \
     >"$log" 2>&1 || status=$?
   executions=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
