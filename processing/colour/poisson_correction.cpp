@@ -85,6 +85,7 @@ PoissonColourCorrection::PoissonColourCorrection(const Rig& rig, const PanoramaS
     const double t = (r + 0.5) / domain.block - 0.5;
     phaseWeights_.push_back(catmullRom(t - std::floor(t)));
   }
+  // One float past the last block: the vector apply reads four floats for a block's three channels.
   rowBuffers_.assign(
       static_cast<std::size_t>(pool.threads()) * 4,
       std::vector<float>(static_cast<std::size_t>(domain.grid.width + 2 * kPad) * 3 + 1));
