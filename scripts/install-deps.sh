@@ -8,7 +8,7 @@
 set -eu
 
 PACKAGES="
-  build-essential cmake pkg-config ccache
+  build-essential cmake ninja-build pkg-config ccache
   libopencv-dev libyaml-cpp-dev libspdlog-dev libfmt-dev zlib1g-dev
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   libsuitesparse-dev libeigen3-dev
