@@ -8,8 +8,8 @@
 
 #include "daemon/panorama_setup.hpp"
 #include "daemon/pipeline.hpp"
-#include "daemon/rig_yaml.hpp"
 #include "processing/stitch/panorama_ownership.hpp"
+#include "tests/daemon/replay_config.hpp"
 #include "tests/support/temp_dir.hpp"
 
 namespace surroundd::daemon {
@@ -20,25 +20,11 @@ const std::filesystem::path kRecording =
 
 TEST(CameraHealth, FaultsAreDetectedWithin200MsAndMarkedWhileTheOthersGoOn) {
   const testing::TempDir dir;
-  Config config;
-  config.file = kRecording / "rig.yaml";
-  config.cameras = loadRigFile(kRecording / "rig.yaml");
-  config.capture.pacing = capture::Pacing::kAsFastAsPossible;
+  Config config = rigReplay(kRecording / "rig.yaml",
+                            {snapshotAt(dir / "panorama.png", OutputStream::kPanorama, 0.9),
+                             snapshotAt(dir / "mosaic.png", OutputStream::kMosaic, 0.9)});
   config.pipeline.threads = 2;
-  config.panorama.widthPx = 512;
-  config.panorama.heightPx = 256;
-  config.panorama.cacheDir = dir / "lut-cache";
-  config.render.widthPx = 320;
-  config.render.heightPx = 180;
-  OutputConfig panorama;
-  panorama.kind = OutputKind::kSnapshot;
-  panorama.stream = OutputStream::kPanorama;
-  panorama.path = dir / "panorama.png";
-  panorama.atSeconds = 0.9;
-  OutputConfig mosaic = panorama;
-  mosaic.stream = OutputStream::kMosaic;
-  mosaic.path = dir / "mosaic.png";
-  config.outputs = {panorama, mosaic};
+  useSmallPanorama(config, dir / "lut-cache");
 
   Pipeline pipeline(config);
   const std::atomic<bool> stop{false};

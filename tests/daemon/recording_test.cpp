@@ -17,9 +17,7 @@ const std::filesystem::path kRecording =
     std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
 
 RunSummary replay(const std::filesystem::path& rig, const std::vector<OutputConfig>& outputs) {
-  Config config = fixtureReplay("synth_small", outputs);
-  config.file = rig;
-  config.cameras = loadRigFile(rig);
+  const Config config = rigReplay(rig, outputs);
   Pipeline pipeline(config);
   const std::atomic<bool> stop{false};
   return pipeline.run(stop);

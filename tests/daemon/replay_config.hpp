@@ -1,6 +1,6 @@
 #pragma once
-// The config the pipeline tests run: a generated recording (tests/fixtures.cmake) replayed as fast
-// as it decodes, with a small mosaic, writing `outputs`.
+// The configs the pipeline tests run: a rig file, usually a generated recording's
+// (tests/fixtures.cmake), replayed as fast as it decodes, with a small mosaic, writing `outputs`.
 
 #include <filesystem>
 #include <string_view>
@@ -11,8 +11,8 @@
 
 namespace surroundd::daemon {
 
-inline Config fixtureReplay(std::string_view fixture, std::vector<OutputConfig> outputs) {
-  const auto rig = std::filesystem::path(SURROUNDD_FIXTURE_DIR) / fixture / "rig.yaml";
+// `rig` replayed as fast as it decodes, with a small mosaic, writing `outputs`.
+inline Config rigReplay(const std::filesystem::path& rig, std::vector<OutputConfig> outputs) {
   Config config;
   config.file = rig;
   config.cameras = loadRigFile(rig);
@@ -21,6 +21,30 @@ inline Config fixtureReplay(std::string_view fixture, std::vector<OutputConfig> 
   config.render.heightPx = 180;
   config.outputs = std::move(outputs);
   return config;
+}
+
+inline Config fixtureReplay(std::string_view fixture, std::vector<OutputConfig> outputs) {
+  return rigReplay(std::filesystem::path(SURROUNDD_FIXTURE_DIR) / fixture / "rig.yaml",
+                   std::move(outputs));
+}
+
+// A quarter-size panorama (512x256) whose LUT is cached in `cacheDir`: enough for the tests that
+// look at which camera shows where.
+inline void useSmallPanorama(Config& config, const std::filesystem::path& cacheDir) {
+  config.panorama.widthPx = 512;
+  config.panorama.heightPx = 256;
+  config.panorama.cacheDir = cacheDir;
+}
+
+// A snapshot of `stream` at `path`, `atSeconds` into the stream.
+inline OutputConfig snapshotAt(const std::filesystem::path& path, OutputStream stream,
+                               double atSeconds) {
+  OutputConfig snapshot;
+  snapshot.kind = OutputKind::kSnapshot;
+  snapshot.stream = stream;
+  snapshot.path = path;
+  snapshot.atSeconds = atSeconds;
+  return snapshot;
 }
 
 // One video output (a single file) at `path`.

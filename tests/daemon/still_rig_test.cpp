@@ -12,6 +12,7 @@
 #include "capture/file_source.hpp"
 #include "daemon/pipeline.hpp"
 #include "daemon/rig_yaml.hpp"
+#include "tests/daemon/replay_config.hpp"
 #include "tests/support/temp_dir.hpp"
 
 namespace surroundd::daemon {
@@ -65,22 +66,10 @@ class StillRigTest : public ::testing::Test {
   }
 
   RunSummary run(const std::filesystem::path& rig, std::vector<capture::CameraHealth>& health) {
-    Config config;
-    config.file = rig;
-    config.cameras = loadRigFile(rig);
-    config.capture.pacing = capture::Pacing::kAsFastAsPossible;
+    Config config =
+        rigReplay(rig, {snapshotAt(dir_ / "panorama.png", OutputStream::kPanorama, 1.0)});
     config.pipeline.threads = 1;
-    config.panorama.widthPx = 512;
-    config.panorama.heightPx = 256;
-    config.panorama.cacheDir = dir_ / "lut-cache";
-    config.render.widthPx = 320;
-    config.render.heightPx = 180;
-    OutputConfig panorama;
-    panorama.kind = OutputKind::kSnapshot;
-    panorama.stream = OutputStream::kPanorama;
-    panorama.path = dir_ / "panorama.png";
-    panorama.atSeconds = 1.0;
-    config.outputs = {panorama};
+    useSmallPanorama(config, dir_ / "lut-cache");
     Pipeline pipeline(config);
     std::atomic<bool> stop{false};
     StopAfter observer(stop);
