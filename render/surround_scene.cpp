@@ -3,6 +3,8 @@
 #include <cstddef>
 #include <cstring>
 #include <stdexcept>
+#include <string>
+#include <string_view>
 
 #include <fmt/core.h>
 
@@ -24,7 +26,13 @@ precision highp float;
 uniform sampler2D u_panorama;
 in vec2 v_uv;
 out vec4 o_colour;
-void main() { o_colour = vec4(texture(u_panorama, v_uv).rgb, 1.0); })";
+void main() {
+#ifdef PANORAMA_POSITIONS
+  o_colour = vec4(v_uv, 1.0, 1.0);
+#else
+  o_colour = vec4(texture(u_panorama, v_uv).rgb, 1.0);
+#endif
+})";
 
 constexpr const char* kCarVertex = R"(#version 300 es
 layout(location = 0) in vec3 a_position;
@@ -43,7 +51,13 @@ constexpr const char* kCarFragment = R"(#version 300 es
 precision mediump float;
 in vec3 v_colour;
 out vec4 o_colour;
-void main() { o_colour = vec4(v_colour, 1.0); })";
+void main() {
+#ifdef PANORAMA_POSITIONS
+  o_colour = vec4(0.0, 0.0, 0.0, 1.0);
+#else
+  o_colour = vec4(v_colour, 1.0);
+#endif
+})";
 
 // One triangle covering the viewport. v_picture: x -1 (left) .. 1 (right), y -1 (bottom) .. 1
 // (top) of the picture; framebuffer row 0 is the top (see view_camera.hpp).
@@ -73,7 +87,11 @@ void main() {
   float elevation = atan(mix(u_tangents.y, u_tangents.x, up));
   vec2 uv = vec2(fract((azimuth + PI) / (2.0 * PI)), (u_panoramaTop - elevation) / u_panoramaSpan);
   bool outside = uv.y < 0.0 || uv.y > 1.0;
+#ifdef PANORAMA_POSITIONS
+  o_colour = outside ? vec4(0.0, 0.0, 0.0, 1.0) : vec4(uv, 1.0, 1.0);
+#else
   o_colour = outside ? vec4(0.0, 0.0, 0.0, 1.0) : vec4(texture(u_panorama, uv).rgb, 1.0);
+#endif
 })";
 
 constexpr const char* kPictureFragment = R"(#version 300 es
@@ -84,6 +102,14 @@ out vec4 o_colour;
 void main() {
   o_colour = vec4(texture(u_picture, vec2(v_picture.x + 1.0, 1.0 - v_picture.y) * 0.5).rgb, 1.0);
 })";
+
+// A fragment shader's source with PANORAMA_POSITIONS defined (after its #version line, which
+// must come first).
+std::string withPanoramaPositions(std::string_view fragment) {
+  const std::size_t body = fragment.find('\n') + 1;
+  return fmt::format("{}#define PANORAMA_POSITIONS\n{}", fragment.substr(0, body),
+                     fragment.substr(body));
+}
 
 void attribute(GLuint index, GLint components, GLsizei stride, std::size_t offset) {
   glEnableVertexAttribArray(index);
@@ -151,25 +177,33 @@ void SurroundScene::StreamedTexture::upload(const cv::Mat& bgr) {
   gl::check("uploading a texture");
 }
 
+SurroundScene::PassPrograms::PassPrograms(const processing::PanoramaGeometry& panorama,
+                                          bool panoramaPositions)
+    : mesh("surround mesh", kMeshVertex,
+           panoramaPositions ? withPanoramaPositions(kMeshFragment) : kMeshFragment),
+      car("car", kCarVertex,
+          panoramaPositions ? withPanoramaPositions(kCarFragment) : kCarFragment),
+      strip("360 strips", kFullViewportVertex,
+            panoramaPositions ? withPanoramaPositions(kStripFragment) : kStripFragment),
+      meshViewProjection(mesh.uniform("u_viewProjection")),
+      carViewProjection(car.uniform("u_viewProjection")),
+      stripTangents(strip.uniform("u_tangents")) {
+  glUseProgram(strip.name());
+  glUniform1f(strip.uniform("u_panoramaTop"), static_cast<float>(panorama.elevationTopRad));
+  glUniform1f(strip.uniform("u_panoramaSpan"),
+              static_cast<float>(panorama.elevationTopRad - panorama.elevationBottomRad));
+}
+
 SurroundScene::SurroundScene(const processing::SurroundMesh& mesh,
                              const processing::PanoramaGeometry& panorama, const CarDimensions& car,
                              cv::Size cameraSize)
     : cameraSize_(cameraSize),
-      meshProgram_("surround mesh", kMeshVertex, kMeshFragment),
-      carProgram_("car", kCarVertex, kCarFragment),
-      stripProgram_("360 strips", kFullViewportVertex, kStripFragment),
+      picturePass_(panorama, false),
+      positionsPass_(panorama, true),
       pictureProgram_("camera picture", kFullViewportVertex, kPictureFragment),
-      meshViewProjection_(meshProgram_.uniform("u_viewProjection")),
-      carViewProjection_(carProgram_.uniform("u_viewProjection")),
-      stripTangents_(stripProgram_.uniform("u_tangents")),
       panoramaTexture_(panorama.size, GL_REPEAT),  // azimuth wraps around
       cameraTexture_(cameraSize, GL_CLAMP_TO_EDGE),
       meshIndexCount_(static_cast<GLsizei>(mesh.indices.size())) {
-  glUseProgram(stripProgram_.name());
-  glUniform1f(stripProgram_.uniform("u_panoramaTop"), static_cast<float>(panorama.elevationTopRad));
-  glUniform1f(stripProgram_.uniform("u_panoramaSpan"),
-              static_cast<float>(panorama.elevationTopRad - panorama.elevationBottomRad));
-
   glBindVertexArray(meshArray_.name());
   glBindBuffer(GL_ARRAY_BUFFER, meshVertices_.name());
   glBufferData(GL_ARRAY_BUFFER,
@@ -207,24 +241,26 @@ void SurroundScene::uploadCamera(const cv::Mat& bgr) {
   cameraTexture_.upload(bgr);
 }
 
-void SurroundScene::drawSurround(const cv::Matx44f& viewProjection) const {
+void SurroundScene::drawSurround(const cv::Matx44f& viewProjection, Pass pass) const {
+  const PassPrograms& programs = this->programs(pass);
   glEnable(GL_DEPTH_TEST);
-  glUseProgram(meshProgram_.name());
-  glUniformMatrix4fv(meshViewProjection_, 1, GL_TRUE, viewProjection.val);
+  glUseProgram(programs.mesh.name());
+  glUniformMatrix4fv(programs.meshViewProjection, 1, GL_TRUE, viewProjection.val);
   glBindTexture(GL_TEXTURE_2D, panoramaTexture_.texture.name());
   glBindVertexArray(meshArray_.name());
   glDrawElements(GL_TRIANGLES, meshIndexCount_, GL_UNSIGNED_INT, nullptr);
-  glUseProgram(carProgram_.name());
-  glUniformMatrix4fv(carViewProjection_, 1, GL_TRUE, viewProjection.val);
+  glUseProgram(programs.car.name());
+  glUniformMatrix4fv(programs.carViewProjection, 1, GL_TRUE, viewProjection.val);
   glBindVertexArray(carArray_.name());
   glDrawArrays(GL_TRIANGLES, 0, carVertexCount_);
   glBindVertexArray(0);
   glDisable(GL_DEPTH_TEST);
 }
 
-void SurroundScene::drawStrips(const cv::Vec2f& stripTangents) const {
-  glUseProgram(stripProgram_.name());
-  glUniform2f(stripTangents_, stripTangents[0], stripTangents[1]);
+void SurroundScene::drawStrips(const cv::Vec2f& stripTangents, Pass pass) const {
+  const PassPrograms& programs = this->programs(pass);
+  glUseProgram(programs.strip.name());
+  glUniform2f(programs.stripTangents, stripTangents[0], stripTangents[1]);
   glBindTexture(GL_TEXTURE_2D, panoramaTexture_.texture.name());
   glBindVertexArray(emptyArray_.name());
   glDrawArrays(GL_TRIANGLES, 0, 3);

@@ -28,14 +28,37 @@ class SurroundScene {
   void uploadPanorama(const cv::Mat& bgr);
   void uploadCamera(const cv::Mat& bgr);
 
+  // What a draw writes: the picture, or where each pixel samples the panorama texture (texture
+  // coordinates in red and green, 1 in blue; 0 in blue where the panorama is not shown: the car,
+  // the 360 view's rows above and below the panorama).
+  enum class Pass { kPicture, kPanoramaPositions };
+
   // Into the current framebuffer and viewport:
-  void drawSurround(const cv::Matx44f& viewProjection) const;  // mesh and car, depth-tested
-  void drawStrips(const cv::Vec2f& stripTangents) const;       // the 360 view
-  void drawCamera() const;                                     // the camera picture, filling it
+  void drawSurround(const cv::Matx44f& viewProjection,  // mesh and car, depth-tested
+                    Pass pass = Pass::kPicture) const;
+  void drawStrips(const cv::Vec2f& stripTangents,  // the 360 view
+                  Pass pass = Pass::kPicture) const;
+  void drawCamera() const;  // the camera picture, filling it
 
   cv::Size cameraSize() const { return cameraSize_; }
+  cv::Size panoramaSize() const { return panoramaTexture_.size; }
 
  private:
+  // The programs of one pass (the panorama-positions pass compiles the shaders with
+  // PANORAMA_POSITIONS defined), and their uniforms.
+  struct PassPrograms {
+    PassPrograms(const processing::PanoramaGeometry& panorama, bool panoramaPositions);
+    ShaderProgram mesh;
+    ShaderProgram car;
+    ShaderProgram strip;
+    GLint meshViewProjection;
+    GLint carViewProjection;
+    GLint stripTangents;
+  };
+  const PassPrograms& programs(Pass pass) const {
+    return pass == Pass::kPicture ? picturePass_ : positionsPass_;
+  }
+
   // A texture fed through two pixel buffers in turn, so that filling one does not wait for the
   // transfer of the other.
   struct StreamedTexture {
@@ -49,13 +72,9 @@ class SurroundScene {
   };
 
   cv::Size cameraSize_;
-  ShaderProgram meshProgram_;
-  ShaderProgram carProgram_;
-  ShaderProgram stripProgram_;
+  PassPrograms picturePass_;
+  PassPrograms positionsPass_;
   ShaderProgram pictureProgram_;
-  GLint meshViewProjection_;
-  GLint carViewProjection_;
-  GLint stripTangents_;
   StreamedTexture panoramaTexture_;
   StreamedTexture cameraTexture_;
   gl::VertexArray meshArray_;

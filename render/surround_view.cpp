@@ -1,6 +1,8 @@
 #include "render/surround_view.hpp"
 
+#include <limits>
 #include <stdexcept>
+#include <string_view>
 
 #include <fmt/core.h>
 #include <opencv2/imgproc.hpp>
@@ -48,33 +50,39 @@ SurroundView::SurroundView(const SurroundScene& scene, cv::Size size, ViewKind v
   gl::check("creating a surround view");
 }
 
-void SurroundView::draw(double timeS) {
-  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.name());
+void SurroundView::drawScene(double timeS, SurroundScene::Pass pass) const {
   glViewport(0, 0, size_.width, size_.height);
-  glClearColor(0.08F, 0.08F, 0.08F, 1.0F);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   switch (view_) {
     case ViewKind::kTop:
-      scene_.drawSurround(topViewProjection(settings_, size_));
+      scene_.drawSurround(topViewProjection(settings_, size_), pass);
       break;
     case ViewKind::kPanorama360:
-      scene_.drawStrips(stripTangents(settings_, size_));
+      scene_.drawStrips(stripTangents(settings_, size_), pass);
       break;
     case ViewKind::kOrbit:
-      scene_.drawSurround(orbitViewProjection(settings_, size_, timeS));
+      scene_.drawSurround(orbitViewProjection(settings_, size_, timeS), pass);
       break;
     case ViewKind::kSplit: {
       // Framebuffer row 0 is the picture's top, so viewport rectangles read top-down too.
       const cv::Size half(size_.width / 2, size_.height);
       glViewport(0, 0, half.width, half.height);
-      scene_.drawSurround(orbitViewProjection(settings_, half, timeS));
-      const cv::Rect camera =
-          letterbox(scene_.cameraSize(), {half.width, 0, half.width, half.height});
-      glViewport(camera.x, camera.y, camera.width, camera.height);
-      scene_.drawCamera();
+      scene_.drawSurround(orbitViewProjection(settings_, half, timeS), pass);
+      if (pass == SurroundScene::Pass::kPicture) {
+        const cv::Rect camera =
+            letterbox(scene_.cameraSize(), {half.width, 0, half.width, half.height});
+        glViewport(camera.x, camera.y, camera.width, camera.height);
+        scene_.drawCamera();
+      }
       break;
     }
   }
+}
+
+void SurroundView::draw(double timeS) {
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.name());
+  glClearColor(0.08F, 0.08F, 0.08F, 1.0F);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  drawScene(timeS, SurroundScene::Pass::kPicture);
   glBindBuffer(GL_PIXEL_PACK_BUFFER, readBuffer_.name());
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
   glReadPixels(0, 0, size_.width, size_.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
@@ -101,6 +109,50 @@ const cv::Mat& SurroundView::collect() {
   glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
   pending_ = false;
   return picture_;
+}
+
+cv::Mat SurroundView::panoramaPositions(double timeS) const {
+  const auto* extensions = reinterpret_cast<const char*>(glGetString(GL_EXTENSIONS));
+  if (extensions == nullptr ||
+      std::string_view(extensions).find("GL_EXT_color_buffer_float") == std::string_view::npos) {
+    throw RenderError(
+        "mapping a view onto the panorama needs float render targets "
+        "(GL_EXT_color_buffer_float), which this OpenGL ES driver lacks");
+  }
+  // Texture coordinates need more than 8 bits: a 2048-pixel panorama is 1/2048 per pixel.
+  gl::Renderbuffer positions;
+  glBindRenderbuffer(GL_RENDERBUFFER, positions.name());
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, size_.width, size_.height);
+  gl::Framebuffer framebuffer;
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.name());
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                            positions.name());
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_.name());
+  const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    throw RenderError(fmt::format("panorama positions {}x{}: framebuffer incomplete (0x{:04x})",
+                                  size_.width, size_.height, status));
+  }
+  glClearColor(0, 0, 0, 0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  drawScene(timeS, SurroundScene::Pass::kPanoramaPositions);
+  cv::Mat read(size_, CV_32FC4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(0, 0, size_.width, size_.height, GL_RGBA, GL_FLOAT, read.data);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  gl::check("mapping a view onto the panorama");
+
+  const cv::Size panorama = scene_.panoramaSize();
+  cv::Mat result(size_, CV_32FC2);
+  read.forEach<cv::Vec4f>([&](const cv::Vec4f& texel, const int* at) {
+    constexpr float kNone = std::numeric_limits<float>::quiet_NaN();
+    result.at<cv::Vec2f>(at[0], at[1]) =
+        texel[2] < 0.5F ? cv::Vec2f(kNone, kNone)
+                        : cv::Vec2f(texel[0] * static_cast<float>(panorama.width) - 0.5F,
+                                    texel[1] * static_cast<float>(panorama.height) - 0.5F);
+  });
+  return result;
 }
 
 }  // namespace surroundd::render

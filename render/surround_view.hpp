@@ -29,7 +29,17 @@ class SurroundView {
   // The picture of the last draw(), 8-bit BGR; valid until the next collect().
   const cv::Mat& collect();
 
+  // Where each pixel of the view (as it is now, its eye at `timeS`) samples the panorama, in
+  // panorama pixels (centres at integers, as PanoramaGeometry): CV_32FC2, NaN where it shows no
+  // panorama (the car, the background, the split view's camera half). Rendered with the same
+  // geometry and interpolation as draw(), into a float target: needs EXT_color_buffer_float
+  // (RenderError without it). For setting up a view that does not move; it allocates, and
+  // waits for the GPU.
+  cv::Mat panoramaPositions(double timeS) const;
+
  private:
+  void drawScene(double timeS, SurroundScene::Pass pass) const;
+
   const SurroundScene& scene_;
   cv::Size size_;
   ViewKind view_;

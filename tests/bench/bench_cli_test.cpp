@@ -36,6 +36,14 @@ TEST(BenchCli, StitchReportsTimingsAndAccuracyAsJson) {
     EXPECT_NEAR(timing["ratio"].as<double>(),
                 timing["stitch_ms"].as<double>() / timing["remap_ms"].as<double>(), 1e-3);
   }
+  // The top view through its view LUT: a picture like the rendered one (view_lut_test.cpp says
+  // why not the same bytes), with both timed.
+  const YAML::Node top = report["top_view"];
+  EXPECT_EQ(top["size"][0].as<int>(), 1280);
+  EXPECT_GT(top["compose_s"].as<double>(), 0);
+  EXPECT_GT(top["view_lut_ms"].as<double>(), 0);
+  EXPECT_GT(top["rendered_ms"].as<double>(), 0);
+  EXPECT_GT(top["psnr_db"].as<double>(), 30.0);
   EXPECT_LT(report["bowl"]["seam_mean_px"].as<double>(), 0.01);
   EXPECT_GT(report["sphere"]["seam_mean_px"].as<double>(), 3.0);
   EXPECT_LT(report["bowl"]["ground_mae_levels"].as<double>(),

@@ -1,5 +1,6 @@
 #include "tools/bench/stitch_benchmark.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <numbers>
@@ -9,11 +10,16 @@
 #include <fmt/format.h>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <unistd.h>
 
 #include "common/work_pool.hpp"
 #include "processing/stitch/panorama_lut_cache.hpp"
 #include "processing/stitch/stitcher.hpp"
+#include "processing/stitch/view_lut.hpp"
+#include "processing/surround_mesh.hpp"
+#include "render/egl_context.hpp"
+#include "render/surround_view.hpp"
 #include "tools/bench/panorama_accuracy.hpp"
 #include "tools/bench/recording_truth.hpp"
 #include "tools/bench/remap_baseline.hpp"
@@ -34,6 +40,17 @@ struct ThreadTiming {
   double portableMs = 0;  // the stitcher on its portable kernels (kernel_path.hpp)
 };
 
+// The top view through its view LUT (processing/stitch/view_lut.hpp) against the panorama
+// stitched, uploaded, drawn and read back, for the same picture.
+struct TopViewTiming {
+  cv::Size size{1280, 720};
+  double composeS = 0;    // the view LUT, from the panorama's
+  double directMs = 0;    // one gather into the picture
+  double renderedMs = 0;  // stitch + upload + draw + read-back
+  double psnr = 0;        // of the direct picture against the rendered one, where both show the
+                          // panorama
+};
+
 struct InputReport {
   std::string name;
   cv::Size camera;
@@ -42,6 +59,7 @@ struct InputReport {
   double lutLoadS = 0;
   std::size_t lutBytes = 0;
   std::vector<ThreadTiming> timings;
+  TopViewTiming topView;
   Accuracy bowl;
   Accuracy sphere;
 };
@@ -77,6 +95,44 @@ Accuracy measureAccuracy(const RecordingTruth& truth, const synth::Scene& scene,
   }
   accuracy.groundError /= static_cast<double>(truth.frames.size());
   return accuracy;
+}
+
+TopViewTiming measureTopView(const processing::PanoramaLut& lut,
+                             const processing::PanoramaGeometry& geometry,
+                             const std::vector<cv::Mat>& images, WorkPool& pool, int repeats) {
+  TopViewTiming timing;
+  const render::EglContext gl;
+  render::SurroundScene scene(processing::buildSurroundMesh({}, geometry), geometry, {},
+                              lut.cameraSizes.front());
+  render::SurroundView view(scene, timing.size, render::ViewKind::kTop, {});
+  processing::PanoramaLut viewLut;
+  const cv::Mat positions = view.panoramaPositions(0);
+  timing.composeS =
+      millisecondsOf([&] { viewLut = processing::composeViewLut(lut, positions, pool); }) / 1000;
+  processing::Stitcher stitcher(lut, pool);
+  processing::Stitcher direct(viewLut, pool);
+  cv::Mat panorama(lut.size, CV_8UC3);
+  cv::Mat directPicture(timing.size, CV_8UC3);
+  cv::Mat rendered;
+  const auto medians = interleavedMedians({[&] { direct.stitch(images, directPicture); },
+                                           [&] {
+                                             stitcher.stitch(images, panorama);
+                                             scene.uploadPanorama(panorama);
+                                             view.draw(0);
+                                             rendered = view.collect();
+                                           }},
+                                          repeats);
+  timing.directMs = medians[0];
+  timing.renderedMs = medians[1];
+  cv::Mat shown;
+  cv::extractChannel(positions, shown, 0);
+  cv::compare(shown, shown, shown, cv::CMP_EQ);  // NaN where no panorama is shown
+  cv::Mat difference;
+  cv::absdiff(directPicture, rendered, difference);
+  difference.convertTo(difference, CV_32F);
+  const cv::Scalar squared = cv::mean(difference.mul(difference), shown);
+  timing.psnr = 10 * std::log10(255.0 * 255.0 * 3 / (squared[0] + squared[1] + squared[2]));
+  return timing;
 }
 
 InputReport measure(const std::filesystem::path& folder, int threads, int repeats) {
@@ -118,6 +174,7 @@ InputReport measure(const std::filesystem::path& folder, int threads, int repeat
     report.timings.push_back({t, medians[0], medians[1], medians[2]});
   }
   cv::setNumThreads(-1);
+  report.topView = measureTopView(lut, truth.panorama, images, pool, repeats);
 
   const synth::Scene scene(truth.seed, truth.seconds);
   report.bowl = measureAccuracy(truth, scene, bowlSettings, pool);
@@ -143,6 +200,13 @@ void printText(const std::vector<InputReport>& reports) {
           t.stitchMs / t.remapMs, processing::kernelPathName(processing::kNativeKernels),
           t.portableMs, t.stitchMs / t.portableMs);
     }
+    const TopViewTiming& top = r.topView;
+    fmt::print(
+        "  top view {}x{}, {} threads: view LUT {:6.2f} ms ({:5.0f} fps)   stitch + render + "
+        "read-back {:6.2f} ms   ratio {:.2f}x   PSNR against the render {:.1f} dB   view LUT "
+        "composed in {:.2f} s\n",
+        top.size.width, top.size.height, r.timings.back().threads, top.directMs,
+        1000 / top.directMs, top.renderedMs, top.directMs / top.renderedMs, top.psnr, top.composeS);
     for (const auto& [name, a] : {std::pair{"bowl  ", r.bowl}, std::pair{"sphere", r.sphere}}) {
       fmt::print(
           "  {}: ground seams {:.2f} px mean, {:.2f} px max ({} seam pixels); error vs "
@@ -174,10 +238,13 @@ void printJson(const std::vector<InputReport>& reports) {
     fmt::print(
         "{}\n  {{\"input\": \"{}\", \"camera\": [{}, {}], \"panorama\": [{}, {}], "
         "\"lut_build_s\": {:.4f}, \"lut_load_s\": {:.4f}, \"lut_bytes\": {}, "
-        "\"timings\": [{}], \"bowl\": {}, \"sphere\": {}}}",
+        "\"timings\": [{}], \"top_view\": {{\"size\": [{}, {}], \"view_lut_ms\": {:.4f}, "
+        "\"rendered_ms\": {:.4f}, \"psnr_db\": {:.2f}, \"compose_s\": {:.4f}}}, \"bowl\": {}, "
+        "\"sphere\": {}}}",
         i == 0 ? "" : ",", r.name, r.camera.width, r.camera.height, r.panorama.width,
-        r.panorama.height, r.lutBuildS, r.lutLoadS, r.lutBytes, timings, accuracy(r.bowl),
-        accuracy(r.sphere));
+        r.panorama.height, r.lutBuildS, r.lutLoadS, r.lutBytes, timings, r.topView.size.width,
+        r.topView.size.height, r.topView.directMs, r.topView.renderedMs, r.topView.psnr,
+        r.topView.composeS, accuracy(r.bowl), accuracy(r.sphere));
   }
   fmt::print("\n]}}\n");
 }

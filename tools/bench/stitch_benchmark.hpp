@@ -1,6 +1,7 @@
 #pragma once
 // surround-bench stitch: LUT build time, stitch milliseconds against cv::remap on the same maps,
-// and the panorama's accuracy against the generator's ground truth (bowl and sphere projections).
+// the top view through its view LUT against the panorama stitched and rendered, and the
+// panorama's accuracy against the generator's ground truth (bowl and sphere projections).
 
 #include <filesystem>
 #include <vector>

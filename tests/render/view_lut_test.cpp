@@ -1,0 +1,158 @@
+// A fixed view's LUT (processing/stitch/view_lut.hpp), composed from where the renderer samples
+// the panorama (SurroundView::panoramaPositions): one gather from the synth_small rig's camera
+// images gives the picture the renderer draws from the stitched panorama, for each view that can
+// hold still.
+//
+// Not the same bytes: the renderer samples the panorama bilinearly, and each panorama pixel is
+// itself a bilinear sample of a camera, so its picture is blurred twice where the view magnifies
+// the panorama; the view LUT's one camera sample per pixel blurs once. On synth_small's textured
+// ground that alone puts the two 36.5 to 38 dB apart (PSNR over the pixels that show the
+// panorama), so the bound here is 35 dB: the view LUT shifted by one pixel puts the views at 31 to
+// 34 dB, a tap from the wrong camera far lower.
+
+#include "processing/stitch/view_lut.hpp"
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "common/work_pool.hpp"
+#include "processing/stitch/stitcher.hpp"
+#include "processing/surround_mesh.hpp"
+#include "render/egl_context.hpp"
+#include "render/surround_view.hpp"
+#include "tests/processing/panorama_test_support.hpp"
+
+namespace surroundd::render {
+namespace {
+
+// The synth_small rig: its LUT, its first ground-truth frame's camera images, the panorama
+// stitched from them and the scene that draws it.
+struct RigScene {
+  RigScene()
+      : truth(processing::testing::smallRecording()),
+        settings(processing::testing::settingsFor(truth)),
+        pool(2),
+        lut(processing::buildPanoramaLut(truth.rig, settings, pool)),
+        images(processing::testing::truthImages(truth.frames.front())),
+        scene(processing::buildSurroundMesh({}, settings.geometry), settings.geometry, {},
+              lut.cameraSizes.front()) {
+    processing::Stitcher(lut, pool).stitch(images, panorama);
+    scene.uploadPanorama(panorama);
+  }
+  const bench::RecordingTruth& truth;
+  processing::PanoramaSettings settings;
+  WorkPool pool;
+  processing::PanoramaLut lut;
+  std::vector<cv::Mat> images;
+  cv::Mat panorama;
+  SurroundScene scene;
+};
+
+class ViewLutTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    context = std::make_unique<EglContext>();
+    rig = std::make_unique<RigScene>();
+  }
+  static void TearDownTestSuite() {
+    rig.reset();
+    context.reset();
+  }
+
+  inline static std::unique_ptr<EglContext> context;
+  inline static std::unique_ptr<RigScene> rig;
+};
+
+// The renderer's picture of `view` and the view LUT's, with what shows no panorama (the car, the
+// background) taken from the renderer's, as a fixed view composites them; and how much of the
+// picture shows the panorama.
+struct Pictures {
+  cv::Mat rendered, direct;
+  cv::Mat panoramaShown;  // CV_8U, 255 where the view shows the panorama
+};
+
+Pictures drawBoth(RigScene& rig, ViewKind view, double timeS) {
+  SurroundView surround(rig.scene, {640, 360}, view, ViewSettings{});
+  surround.draw(timeS);
+  Pictures pictures;
+  pictures.rendered = surround.collect().clone();
+  const cv::Mat positions = surround.panoramaPositions(timeS);
+  const processing::PanoramaLut viewLut = processing::composeViewLut(rig.lut, positions, rig.pool);
+  EXPECT_EQ(viewLut.size, positions.size());
+  processing::Stitcher(viewLut, rig.pool).stitch(rig.images, pictures.direct);
+  std::vector<cv::Mat> channels;
+  cv::split(positions, channels);
+  cv::compare(channels[0], channels[0], pictures.panoramaShown, cv::CMP_EQ);  // NaN != NaN
+  pictures.rendered.copyTo(pictures.direct, ~pictures.panoramaShown);
+  return pictures;
+}
+
+double psnrWhere(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
+  cv::Mat difference;
+  cv::absdiff(a, b, difference);
+  difference.convertTo(difference, CV_32F);
+  const cv::Scalar squared = cv::mean(difference.mul(difference), mask);
+  const double mse = (squared[0] + squared[1] + squared[2]) / 3;
+  return 10 * std::log10(255.0 * 255.0 / std::max(mse, 1e-10));
+}
+
+TEST_F(ViewLutTest, EachFixedViewMatchesTheRenderer) {
+  struct Case {
+    ViewKind view;
+    double timeS;
+  };
+  // The orbit at two poses: behind the vehicle (its start) and a quarter turn on, over a seam.
+  for (const auto& [view, timeS] : {Case{ViewKind::kTop, 0}, Case{ViewKind::kPanorama360, 0},
+                                    Case{ViewKind::kOrbit, 0}, Case{ViewKind::kOrbit, 2.5}}) {
+    SCOPED_TRACE(::testing::Message() << toString(view) << " at " << timeS << " s");
+    const Pictures pictures = drawBoth(*rig, view, timeS);
+    // Most of each view is panorama, so the comparison covers it.
+    EXPECT_GT(cv::countNonZero(pictures.panoramaShown), pictures.panoramaShown.total() / 2);
+    const double psnr = psnrWhere(pictures.rendered, pictures.direct, pictures.panoramaShown);
+    RecordProperty(std::string(toString(view)) + "_psnr", std::to_string(psnr));
+    EXPECT_GE(psnr, 35.0);
+  }
+}
+
+// The split view's camera half is a live picture, so it shows no panorama; its surround half does.
+TEST_F(ViewLutTest, SplitViewMapsOnlyItsSurroundHalf) {
+  SurroundView surround(rig->scene, {640, 360}, ViewKind::kSplit, ViewSettings{});
+  const cv::Mat positions = surround.panoramaPositions(0);
+  std::vector<cv::Mat> channels;
+  cv::split(positions, channels);
+  cv::Mat shown;
+  cv::compare(channels[0], channels[0], shown, cv::CMP_EQ);
+  EXPECT_EQ(cv::countNonZero(shown.colRange(320, 640)), 0);
+  EXPECT_GT(cv::countNonZero(shown.colRange(0, 320)), 320 * 360 / 2);
+}
+
+// Where the top view shows a ground point (on the bowl's floor, 5 m around), it samples the
+// panorama pixel that looks at it.
+TEST_F(ViewLutTest, TopViewSamplesThePanoramaWhereItsGroundIs) {
+  const cv::Size size(640, 360);
+  SurroundView surround(rig->scene, size, ViewKind::kTop, ViewSettings{});
+  const cv::Mat positions = surround.panoramaPositions(0);
+  const processing::PanoramaGeometry& panorama = rig->settings.geometry;
+  const double pixelsPerMetre = size.height / (2 * ViewSettings{}.topRangeM);
+  for (const cv::Point2d ground :
+       {cv::Point2d(4, 1), cv::Point2d(-3, -3), cv::Point2d(1.5, -4.5)}) {
+    // Front up, left on the left: x along rows upwards, y along columns leftwards.
+    const cv::Point at(static_cast<int>(size.width / 2.0 - ground.y * pixelsPerMetre),
+                       static_cast<int>(size.height / 2.0 - ground.x * pixelsPerMetre));
+    const cv::Point2d centreOfPixel(size.width / 2.0 - at.x - 0.5, size.height / 2.0 - at.y - 0.5);
+    const cv::Vec3d seen(centreOfPixel.y / pixelsPerMetre, centreOfPixel.x / pixelsPerMetre, 0);
+    const cv::Point2d wanted = panorama.pixel(seen - panorama.centre);
+    const auto& sampled = positions.at<cv::Vec2f>(at);
+    double dc = std::abs(sampled[0] - wanted.x);
+    dc = std::min(dc, panorama.size.width - dc);
+    EXPECT_LT(std::hypot(dc, sampled[1] - wanted.y), 1.0)
+        << "ground point " << ground << " at " << at << ": samples (" << sampled[0] << ", "
+        << sampled[1] << "), wanted " << wanted;
+  }
+}
+
+}  // namespace
+}  // namespace surroundd::render
