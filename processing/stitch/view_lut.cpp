@@ -53,7 +53,6 @@ class ViewLutComposer {
     const double ax = x - left;
     const double ay = y - top;
     CameraParts parts{};
-    double unseen = 0;
     for (int corner = 0; corner < 4; ++corner) {
       const double weight = ((corner & 1) != 0 ? ax : 1 - ax) * ((corner & 2) != 0 ? ay : 1 - ay);
       if (weight <= 0) continue;
@@ -63,10 +62,6 @@ class ViewLutComposer {
       const auto pixel = static_cast<std::size_t>(row) * static_cast<std::size_t>(size.width) +
                          static_cast<std::size_t>(column);
       const LutTap& tap = panorama_.taps[pixel];
-      if (tap.camera == PanoramaLut::kUnseen) {
-        unseen += weight;
-        continue;
-      }
       const std::int32_t blendIndex = blendOf_[pixel];
       double blendShare = 0;
       if (blendIndex >= 0) {
@@ -77,7 +72,6 @@ class ViewLutComposer {
       add(parts, tap, weight * (1 - blendShare), weight);
     }
     blend = {};
-    if (unseen >= 0.5) return {0, 0, 0, PanoramaLut::kUnseen, 0};
     std::partial_sort(parts.begin(), parts.begin() + 2, parts.end(),
                       [](const CameraPart& a, const CameraPart& b) { return a.share > b.share; });
     const LutTap primary = encodeOf(parts[0]);
@@ -93,11 +87,14 @@ class ViewLutComposer {
   }
 
  private:
+  // Where no camera sees, the renderer blends in the panorama's unseen colour: the stitcher's
+  // kUnseen "camera", at no position.
   void add(CameraParts& parts, const LutTap& tap, double share, double weight) const {
     for (CameraPart& part : parts) {
-      if (part.camera != PanoramaLut::kUnseen && part.camera != tap.camera) continue;
+      if (part.share > 0 && part.camera != tap.camera) continue;
       part.camera = tap.camera;
       part.share += share;
+      if (tap.camera == PanoramaLut::kUnseen) return;
       part.positionWeight += weight;
       part.weightedPosition += weight * tapPosition(tap, panorama_.cameraSizes[tap.camera]);
       return;
@@ -105,6 +102,7 @@ class ViewLutComposer {
   }
 
   LutTap encodeOf(const CameraPart& part) const {
+    if (part.camera == PanoramaLut::kUnseen) return {0, 0, 0, PanoramaLut::kUnseen, 0};
     return encodeTap(part.weightedPosition / part.positionWeight,
                      panorama_.cameraSizes[part.camera], part.camera);
   }

@@ -7,9 +7,11 @@
 // renderer samples its panorama texture (bilinear, azimuth wrapping around, elevation clamped to
 // the edge): the four panorama pixels' taps are merged per camera, a camera's share being its
 // bilinear-weighted share over the four and its position the weighted mean of its positions among
-// them; the two cameras with the largest shares make the view pixel's primary and blend taps. A
-// camera's position moves smoothly from one panorama pixel to the next, so one bilinear camera
-// sample stands for the renderer's four samples of four: the same picture, a little sharper.
+// them (the panorama's unseen colour counts as one more camera); the two with the largest shares
+// make the view pixel's primary and blend taps. A camera's position moves smoothly from one
+// panorama pixel to the next, so one bilinear camera sample stands for the renderer's four samples
+// of four. The renderer's picture is the blurrier where the panorama is coarser than the cameras
+// (it blurs twice); with a panorama fine enough not to, the two agree within PSNR 40 dB.
 //
 // The result is a PanoramaLut of the view's size (its pixels are the view's, not the panorama's),
 // applied by the Stitcher like the panorama's.
