@@ -144,26 +144,31 @@ void GainCompensation::update(std::span<const cv::Mat> frames) {
   }
 }
 
-void GainCompensation::apply(cv::Mat& panorama) {
-  const int width = lut_.size.width;
+void GainCompensation::apply(cv::Mat& picture, const PanoramaLut& lut) {
+  const int width = lut.size.width;
   pool_.parallelFor(
-      lut_.size.height,
+      lut.size.height,
       [&](int first, int last) {
         for (int v = first; v < last; ++v) {
-          auto* out = panorama.ptr<cv::Vec3b>(v);
-          const LutTap* taps = lut_.taps.data() + static_cast<std::size_t>(v) * width;
+          auto* out = picture.ptr<cv::Vec3b>(v);
+          const LutTap* taps = lut.taps.data() + static_cast<std::size_t>(v) * width;
           const std::uint32_t rowStart =
               static_cast<std::uint32_t>(v) * static_cast<std::uint32_t>(width);
-          auto blend = lut_.blendTaps.begin() + lut_.blendRowBegin[v];
-          const auto blendEnd = lut_.blendTaps.begin() + lut_.blendRowBegin[v + 1];
+          auto blend = lut.blendTaps.begin() + lut.blendRowBegin[v];
+          const auto blendEnd = lut.blendTaps.begin() + lut.blendRowBegin[v + 1];
           for (int u = 0; u < width; ++u) {
+            const LutTap* other = nullptr;
+            if (blend != blendEnd && blend->pixel == rowStart + static_cast<std::uint32_t>(u)) {
+              other = &blend->tap;
+              ++blend;
+            }
             if (taps[u].camera == PanoramaLut::kUnseen) continue;
             cv::Vec3f gain = gains_[taps[u].camera];
-            // In a seam band the pixel mixes two cameras: so do their gains.
-            if (blend != blendEnd && blend->pixel == rowStart + static_cast<std::uint32_t>(u)) {
-              const float weight = blend->tap.weight / 256.0f;
-              gain = gain * (1 - weight) + gains_[blend->tap.camera] * weight;
-              ++blend;
+            // In a seam band the pixel mixes two cameras: so do their gains. (A view's pixel at
+            // the edge of what the cameras see mixes in the unseen colour, which no gain changes.)
+            if (other != nullptr && other->camera != PanoramaLut::kUnseen) {
+              const float weight = other->weight / 256.0f;
+              gain = gain * (1 - weight) + gains_[other->camera] * weight;
             }
             for (int c = 0; c < 3; ++c)
               out[u][c] = cv::saturate_cast<std::uint8_t>(out[u][c] * gain[c]);

@@ -36,7 +36,10 @@ class GainCompensation {
   // gain stays as it was).
   void update(std::span<const cv::Mat> frames);
   // Multiplies each camera's share of every pixel of a panorama stitched from the same frames.
-  void apply(cv::Mat& panorama);
+  void apply(cv::Mat& panorama) { apply(panorama, lut_); }
+  // The same for a picture made through another LUT of this rig's cameras from the same frames (a
+  // fixed view's: processing/stitch/view_lut.hpp).
+  void apply(cv::Mat& picture, const PanoramaLut& lut);
 
   const std::vector<cv::Vec3f>& gains() const { return gains_; }
   const std::vector<std::string>& notesOfLastUpdate() const { return notes_; }

@@ -350,4 +350,88 @@ void PoissonColourCorrection::applyRows(int first, int last, cv::Mat& panorama,
   }
 }
 
+PoissonColourCorrection::ViewSamples PoissonColourCorrection::viewSamples(
+    const cv::Mat& panoramaPositions) const {
+  if (panoramaPositions.type() != CV_32FC2) {
+    throw std::invalid_argument("view samples: panorama positions must be CV_32FC2");
+  }
+  const CorrectionDomain& domain = full_->domain;
+  const cv::Size grid = domain.grid;
+  const cv::Size panorama = lut_.size;
+  ViewSamples samples;
+  samples.size = panoramaPositions.size();
+  samples.taps.resize(panoramaPositions.total());
+  for (int v = 0; v < samples.size.height; ++v) {
+    const auto* positions = panoramaPositions.ptr<cv::Point2f>(v);
+    for (int u = 0; u < samples.size.width; ++u) {
+      const cv::Point2f at = positions[u];
+      if (!std::isfinite(at.x) || !std::isfinite(at.y)) continue;
+      ViewTap& tap = samples.taps[static_cast<std::size_t>(v) * samples.size.width + u];
+      // Block centres, in the grid's coordinates, as apply() places them.
+      const double gx = (at.x + 0.5) / domain.block - 0.5;
+      const double gy = (at.y + 0.5) / domain.block - 0.5;
+      const double left = std::floor(gx);
+      double top = std::floor(gy);
+      tap.fx = static_cast<float>(gx - left);
+      tap.fy = static_cast<float>(gy - top);
+      if (top < 0 || top >= grid.height - 1) {
+        top = std::clamp(top, 0.0, grid.height - 1.0);
+        tap.fy = 0;
+      }
+      const int column = ((static_cast<int>(left) % grid.width) + grid.width) % grid.width;
+      const int row = static_cast<int>(top);
+      tap.block = static_cast<std::uint32_t>(row * grid.width + column);
+      tap.right = static_cast<std::int16_t>(column == grid.width - 1 ? 1 - grid.width : 1);
+      tap.down = static_cast<std::int16_t>(row == grid.height - 1 ? 0 : grid.width);
+      const int pu = ((static_cast<int>(std::lround(at.x)) % panorama.width) + panorama.width) %
+                     panorama.width;
+      const int pv = std::clamp(static_cast<int>(std::lround(at.y)), 0, panorama.height - 1);
+      tap.share = domain.share[static_cast<std::size_t>(pv) * panorama.width + pu];
+    }
+  }
+  return samples;
+}
+
+void PoissonColourCorrection::applyAt(const ViewSamples& samples, cv::Mat& picture) {
+  if (picture.type() != CV_8UC3 || picture.size() != samples.size) {
+    throw std::invalid_argument(
+        fmt::format("colour correction: expected an 8-bit BGR picture of {}x{}", samples.size.width,
+                    samples.size.height));
+  }
+  const auto rows = settings_.field == CorrectionField::kMultiplicative
+                        ? &PoissonColourCorrection::applyAtRows<CorrectionField::kMultiplicative>
+                        : &PoissonColourCorrection::applyAtRows<CorrectionField::kAdditive>;
+  pool_.parallelFor(
+      samples.size.height,
+      [&](int first, int last) { (this->*rows)(first, last, samples, picture); },
+      pool_.threads() * 4);
+}
+
+template <CorrectionField kField>
+void PoissonColourCorrection::applyAtRows(int first, int last, const ViewSamples& samples,
+                                          cv::Mat& picture) const {
+  const auto* field = field_.ptr<float>();
+  for (int v = first; v < last; ++v) {
+    const ViewTap* taps = samples.taps.data() + static_cast<std::size_t>(v) * samples.size.width;
+    auto* pixel = picture.ptr<std::uint8_t>(v);
+    for (int u = 0; u < samples.size.width; ++u, pixel += 3) {
+      const ViewTap& tap = taps[u];
+      if (tap.share == 0) continue;
+      const float* topLeft = field + static_cast<std::size_t>(tap.block) * 3;
+      const float* topRight = topLeft + static_cast<std::ptrdiff_t>(tap.right) * 3;
+      const float* bottomLeft = topLeft + static_cast<std::ptrdiff_t>(tap.down) * 3;
+      const float* bottomRight = bottomLeft + static_cast<std::ptrdiff_t>(tap.right) * 3;
+      const float weight = tap.share * (1.0f / 256);
+      const bool whole = tap.share == 256;
+      for (int c = 0; c < 3; ++c) {
+        const float upper = topLeft[c] + tap.fx * (topRight[c] - topLeft[c]);
+        const float lower = bottomLeft[c] + tap.fx * (bottomRight[c] - bottomLeft[c]);
+        const float value = upper + tap.fy * (lower - upper);
+        pixel[c] = roundedLevel(
+            correctedLevel<kField>(static_cast<float>(pixel[c]), value, weight, whole));
+      }
+    }
+  }
+}
+
 }  // namespace surroundd::processing

@@ -108,6 +108,30 @@ class PoissonColourCorrection {
   // `path`: the kernels to use (kernel_path.hpp), every one giving the same bytes.
   void apply(cv::Mat& panorama, KernelPath path = kNativeKernels);
 
+  // A picture that shows the panorama elsewhere (a fixed view through its view LUT,
+  // processing/stitch/view_lut.hpp): for each of its pixels, the 2x2 blocks of the field around
+  // where it samples the panorama, and the source cameras' share of the panorama pixel nearest
+  // to it (0: nothing to correct).
+  struct ViewTap {
+    std::uint32_t block = 0;  // top-left of the 2x2: row * grid width + column
+    std::int16_t right = 1;   // from a block to the one on its right (columns wrap around)
+    std::int16_t down = 0;    // to the one below (0 on the grid's last row)
+    float fx = 0, fy = 0;
+    std::uint16_t share = 0;  // 0..256
+  };
+  struct ViewSamples {
+    cv::Size size;
+    std::vector<ViewTap> taps;  // row-major
+  };
+  // Built once per view from where its pixels sample the panorama, in panorama pixels (NaN where
+  // they do not), as composeViewLut() takes them.
+  ViewSamples viewSamples(const cv::Mat& panoramaPositions) const;
+  // Adds the fields to a picture of samples.size made from the same frames as the last update().
+  // The fields are sampled bilinearly from the block grid, where apply() upsamples them
+  // bicubically: they are smooth, so the two differ by a fraction of a level, at a quarter of the
+  // taps.
+  void applyAt(const ViewSamples& samples, cv::Mat& picture);
+
   const std::vector<SeamReport>& seams() const { return seamReports_; }
 
   // The field at block resolution, CV_32FC3: the levels it adds to a pixel at 255, the most it
@@ -129,6 +153,8 @@ class PoissonColourCorrection {
   void noteOnce(std::vector<std::uint8_t>& said, std::size_t seam, std::string note);
   template <CorrectionField kField, KernelPath kPath>
   void applyRows(int first, int last, cv::Mat& panorama, std::vector<float>& columnBuffer) const;
+  template <CorrectionField kField>
+  void applyAtRows(int first, int last, const ViewSamples& samples, cv::Mat& picture) const;
 
   const PanoramaLut& lut_;
   WorkPool& pool_;

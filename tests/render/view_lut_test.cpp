@@ -19,6 +19,8 @@
 #include <gtest/gtest.h>
 
 #include "common/work_pool.hpp"
+#include "processing/colour/gain_compensation.hpp"
+#include "processing/colour/poisson_correction.hpp"
 #include "processing/stitch/stitcher.hpp"
 #include "processing/surround_mesh.hpp"
 #include "render/egl_context.hpp"
@@ -28,29 +30,101 @@
 namespace surroundd::render {
 namespace {
 
+// How the panorama is corrected, and so each view's picture.
+enum class Correction { kNone, kPoissonMultiplicative, kPoissonAdditive, kGain };
+
+const char* nameOf(Correction correction) {
+  switch (correction) {
+    case Correction::kNone:
+      return "no correction";
+    case Correction::kPoissonMultiplicative:
+      return "Poisson, multiplicative";
+    case Correction::kPoissonAdditive:
+      return "Poisson, additive";
+    case Correction::kGain:
+      return "gain compensation";
+  }
+  return "?";
+}
+
 // The synth_small rig with a panorama of `scale` times its own size: its LUT, its first
-// ground-truth frame's camera images, the panorama stitched from them and the scene that draws it.
+// ground-truth frame's camera images, the colour corrections fitted to them, and the scene that
+// draws the panorama stitched from them.
 struct RigScene {
   explicit RigScene(int scale)
       : truth(processing::testing::smallRecording()),
         settings(scaled(processing::testing::settingsFor(truth), scale)),
         pool(2),
         lut(processing::buildPanoramaLut(truth.rig, settings, pool)),
-        images(processing::testing::truthImages(truth.frames.front())),
+        images(withOneCameraDarker(processing::testing::truthImages(truth.frames.front()))),
+        multiplicative(truth.rig, settings, lut, {}, pool),
+        additive(truth.rig, settings, lut, additiveSettings(), pool),
+        gains(lut, pool),
         scene(processing::buildSurroundMesh({}, settings.geometry), settings.geometry, {},
               lut.cameraSizes.front()) {
-    processing::Stitcher(lut, pool).stitch(images, panorama);
-    scene.uploadPanorama(panorama);
+    multiplicative.update(images);
+    additive.update(images);
+    gains.update(images);
   }
   static processing::PanoramaSettings scaled(processing::PanoramaSettings settings, int scale) {
     settings.geometry.size = settings.geometry.size * scale;
     return settings;
   }
+  static std::vector<cv::Mat> withOneCameraDarker(std::vector<cv::Mat> images) {
+    images[1].convertTo(images[1], -1, 0.75);
+    return images;
+  }
+  static processing::ColourCorrectionSettings additiveSettings() {
+    processing::ColourCorrectionSettings additive;
+    additive.field = processing::CorrectionField::kAdditive;
+    return additive;
+  }
+
+  // Stitches and corrects the panorama and uploads it.
+  void show(Correction correction) {
+    processing::Stitcher(lut, pool).stitch(images, panorama);
+    switch (correction) {
+      case Correction::kNone:
+        break;
+      case Correction::kPoissonMultiplicative:
+        multiplicative.apply(panorama);
+        break;
+      case Correction::kPoissonAdditive:
+        additive.apply(panorama);
+        break;
+      case Correction::kGain:
+        gains.apply(panorama);
+        break;
+    }
+    scene.uploadPanorama(panorama);
+  }
+
+  // The same correction on a view's picture made through its view LUT.
+  void correct(Correction correction, const processing::PanoramaLut& viewLut,
+               const cv::Mat& positions, cv::Mat& picture) {
+    switch (correction) {
+      case Correction::kNone:
+        break;
+      case Correction::kPoissonMultiplicative:
+        multiplicative.applyAt(multiplicative.viewSamples(positions), picture);
+        break;
+      case Correction::kPoissonAdditive:
+        additive.applyAt(additive.viewSamples(positions), picture);
+        break;
+      case Correction::kGain:
+        gains.apply(picture, viewLut);
+        break;
+    }
+  }
+
   const bench::RecordingTruth& truth;
   processing::PanoramaSettings settings;
   WorkPool pool;
   processing::PanoramaLut lut;
   std::vector<cv::Mat> images;
+  processing::PoissonColourCorrection multiplicative;
+  processing::PoissonColourCorrection additive;
+  processing::GainCompensation gains;
   cv::Mat panorama;
   SurroundScene scene;
 };
@@ -81,7 +155,7 @@ struct Pictures {
   cv::Mat panoramaShown;  // CV_8U, 255 where the view shows the panorama
 };
 
-Pictures drawBoth(RigScene& rig, ViewKind view, double timeS) {
+Pictures drawBoth(RigScene& rig, ViewKind view, double timeS, Correction correction) {
   SurroundView surround(rig.scene, {640, 360}, view, ViewSettings{});
   surround.draw(timeS);
   Pictures pictures;
@@ -90,6 +164,7 @@ Pictures drawBoth(RigScene& rig, ViewKind view, double timeS) {
   const processing::PanoramaLut viewLut = processing::composeViewLut(rig.lut, positions, rig.pool);
   EXPECT_EQ(viewLut.size, positions.size());
   processing::Stitcher(viewLut, rig.pool).stitch(rig.images, pictures.direct);
+  rig.correct(correction, viewLut, positions, pictures.direct);
   std::vector<cv::Mat> channels;
   cv::split(positions, channels);
   cv::compare(channels[0], channels[0], pictures.panoramaShown, cv::CMP_EQ);  // NaN != NaN
@@ -106,11 +181,21 @@ double psnrWhere(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
   return 10 * std::log10(255.0 * 255.0 / std::max(mse, 1e-10));
 }
 
+// With each colour correction: the view's picture corrected through the view (the field sampled
+// where each pixel samples the panorama, the gains by the view LUT's cameras) against the render
+// of the corrected panorama; and what each correction changes in the view, both ways. One camera
+// is set a quarter darker than the rest, so that each correction has something to do.
 TEST_F(ViewLutTest, EachFixedViewMatchesTheRenderer) {
   struct Case {
     ViewKind view;
     double timeS;
   };
+  // The orbit at two poses: behind the vehicle (its start) and an eighth of a turn on, looking
+  // across a seam.
+  const std::vector<Case> cases{{ViewKind::kTop, 0},
+                                {ViewKind::kPanorama360, 0},
+                                {ViewKind::kOrbit, 0},
+                                {ViewKind::kOrbit, 2.5}};
   struct Panorama {
     const char* name;
     RigScene* rig;
@@ -118,17 +203,39 @@ TEST_F(ViewLutTest, EachFixedViewMatchesTheRenderer) {
   };
   for (const auto& [name, scene, minimumPsnr] :
        {Panorama{"the rig's", rig.get(), 36.0}, Panorama{"a finer", fineRig.get(), 40.0}}) {
-    // The orbit at two poses: behind the vehicle (its start) and an eighth of a turn on, looking
-    // across a seam.
-    for (const auto& [view, timeS] : {Case{ViewKind::kTop, 0}, Case{ViewKind::kPanorama360, 0},
-                                      Case{ViewKind::kOrbit, 0}, Case{ViewKind::kOrbit, 2.5}}) {
-      SCOPED_TRACE(::testing::Message()
-                   << toString(view) << " at " << timeS << " s, " << name << " panorama");
-      const Pictures pictures = drawBoth(*scene, view, timeS);
-      // Most of each view is panorama, so the comparison covers it.
-      EXPECT_GT(cv::countNonZero(pictures.panoramaShown), pictures.panoramaShown.total() / 2);
-      const double psnr = psnrWhere(pictures.rendered, pictures.direct, pictures.panoramaShown);
-      EXPECT_GE(psnr, minimumPsnr);
+    std::vector<Pictures> uncorrected;
+    for (const Correction correction : {Correction::kNone, Correction::kPoissonMultiplicative,
+                                        Correction::kPoissonAdditive, Correction::kGain}) {
+      scene->show(correction);
+      for (std::size_t k = 0; k < cases.size(); ++k) {
+        const auto [view, timeS] = cases[k];
+        SCOPED_TRACE(::testing::Message() << toString(view) << " at " << timeS << " s, " << name
+                                          << " panorama, " << nameOf(correction));
+        const Pictures pictures = drawBoth(*scene, view, timeS, correction);
+        // Most of each view is panorama, so the comparison covers it.
+        EXPECT_GT(cv::countNonZero(pictures.panoramaShown), pictures.panoramaShown.total() / 2);
+        EXPECT_GE(psnrWhere(pictures.rendered, pictures.direct, pictures.panoramaShown),
+                  minimumPsnr);
+        if (correction == Correction::kNone) {
+          uncorrected.push_back(pictures);
+          continue;
+        }
+        // What the correction changed: levels, per pixel and channel.
+        const auto change = [&](const cv::Mat& corrected, const cv::Mat& before) {
+          cv::Mat difference;
+          cv::subtract(corrected, before, difference, cv::noArray(), CV_16S);
+          return difference;
+        };
+        const cv::Mat renderedChange = change(pictures.rendered, uncorrected[k].rendered);
+        const cv::Mat directChange = change(pictures.direct, uncorrected[k].direct);
+        const cv::Scalar size = cv::mean(cv::abs(renderedChange), pictures.panoramaShown);
+        const cv::Scalar miss =
+            cv::mean(cv::abs(directChange - renderedChange), pictures.panoramaShown);
+        const double changed = (size[0] + size[1] + size[2]) / 3;
+        const double missed = (miss[0] + miss[1] + miss[2]) / 3;
+        EXPECT_GT(changed, 1.0);
+        EXPECT_LT(missed, 0.1 * changed) << "changed " << changed << " levels on average";
+      }
     }
   }
 }

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "common/work_pool.hpp"
+#include "processing/colour/poisson_correction.hpp"
 #include "processing/stitch/panorama_lut_cache.hpp"
 #include "processing/stitch/stitcher.hpp"
 #include "processing/stitch/view_lut.hpp"
@@ -40,13 +41,14 @@ struct ThreadTiming {
   double portableMs = 0;  // the stitcher on its portable kernels (kernel_path.hpp)
 };
 
-// The top view through its view LUT (processing/stitch/view_lut.hpp) against the panorama
-// stitched, uploaded, drawn and read back, for the same picture.
+// The top view through its view LUT (processing/stitch/view_lut.hpp) and the Poisson field
+// applied to it, against the panorama stitched and corrected, uploaded, drawn and read back, for
+// the same picture.
 struct TopViewTiming {
   cv::Size size{1280, 720};
   double composeS = 0;    // the view LUT, from the panorama's
-  double directMs = 0;    // one gather into the picture
-  double renderedMs = 0;  // stitch + upload + draw + read-back
+  double directMs = 0;    // one gather into the picture, the field applied to it
+  double renderedMs = 0;  // stitch + field + upload + draw + read-back
   double psnr = 0;        // of the direct picture against the rendered one, where both show the
                           // panorama
 };
@@ -97,10 +99,14 @@ Accuracy measureAccuracy(const RecordingTruth& truth, const synth::Scene& scene,
   return accuracy;
 }
 
-TopViewTiming measureTopView(const processing::PanoramaLut& lut,
-                             const processing::PanoramaGeometry& geometry,
-                             const std::vector<cv::Mat>& images, WorkPool& pool, int repeats) {
+TopViewTiming measureTopView(const processing::Rig& rig,
+                             const processing::PanoramaSettings& settings,
+                             const processing::PanoramaLut& lut, const std::vector<cv::Mat>& images,
+                             WorkPool& pool, int repeats) {
   TopViewTiming timing;
+  const processing::PanoramaGeometry& geometry = settings.geometry;
+  processing::PoissonColourCorrection correction(rig, settings, lut, {}, pool);
+  correction.update(images);
   const render::EglContext gl;
   render::SurroundScene scene(processing::buildSurroundMesh({}, geometry), geometry, {},
                               lut.cameraSizes.front());
@@ -109,14 +115,20 @@ TopViewTiming measureTopView(const processing::PanoramaLut& lut,
   const cv::Mat positions = view.panoramaPositions(0);
   timing.composeS =
       millisecondsOf([&] { viewLut = processing::composeViewLut(lut, positions, pool); }) / 1000;
+  const processing::PoissonColourCorrection::ViewSamples fieldSamples =
+      correction.viewSamples(positions);
   processing::Stitcher stitcher(lut, pool);
   processing::Stitcher direct(viewLut, pool);
   cv::Mat panorama(lut.size, CV_8UC3);
   cv::Mat directPicture(timing.size, CV_8UC3);
   cv::Mat rendered;
-  const auto medians = interleavedMedians({[&] { direct.stitch(images, directPicture); },
+  const auto medians = interleavedMedians({[&] {
+                                             direct.stitch(images, directPicture);
+                                             correction.applyAt(fieldSamples, directPicture);
+                                           },
                                            [&] {
                                              stitcher.stitch(images, panorama);
+                                             correction.apply(panorama);
                                              scene.uploadPanorama(panorama);
                                              view.draw(0);
                                              rendered = view.collect();
@@ -174,7 +186,7 @@ InputReport measure(const std::filesystem::path& folder, int threads, int repeat
     report.timings.push_back({t, medians[0], medians[1], medians[2]});
   }
   cv::setNumThreads(-1);
-  report.topView = measureTopView(lut, truth.panorama, images, pool, repeats);
+  report.topView = measureTopView(truth.rig, bowlSettings, lut, images, pool, repeats);
 
   const synth::Scene scene(truth.seed, truth.seconds);
   report.bowl = measureAccuracy(truth, scene, bowlSettings, pool);
@@ -202,9 +214,9 @@ void printText(const std::vector<InputReport>& reports) {
     }
     const TopViewTiming& top = r.topView;
     fmt::print(
-        "  top view {}x{}, {} threads: view LUT {:6.2f} ms ({:5.0f} fps)   stitch + render + "
-        "read-back {:6.2f} ms   ratio {:.2f}x   PSNR against the render {:.1f} dB   view LUT "
-        "composed in {:.2f} s\n",
+        "  top view {}x{}, {} threads, Poisson field: view LUT {:6.2f} ms ({:5.0f} fps)   stitch "
+        "+ render + read-back {:6.2f} ms   ratio {:.2f}x   PSNR against the render {:.1f} dB   "
+        "view LUT composed in {:.2f} s\n",
         top.size.width, top.size.height, r.timings.back().threads, top.directMs,
         1000 / top.directMs, top.renderedMs, top.directMs / top.renderedMs, top.psnr, top.composeS);
     for (const auto& [name, a] : {std::pair{"bowl  ", r.bowl}, std::pair{"sphere", r.sphere}}) {
