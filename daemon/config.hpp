@@ -109,6 +109,7 @@ struct RenderConfig {
   render::ViewSettings views;
   std::string splitCamera;    // the camera beside the 3D view in the split view; empty: the first
   render::CarDimensions car;  // from the vehicle
+  bool viewLut = true;        // top and 360 views gathered from the frames through a view LUT
 
   bool operator==(const RenderConfig&) const = default;
 };

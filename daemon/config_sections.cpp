@@ -237,6 +237,9 @@ const ConfigKeys<RenderConfig>& renderKeys() {
                   {-60.0, 60.0, false, "degrees"}, "360: elevation at the top of each strip"),
       Key::text("split_camera", &RenderConfig::splitCamera, "the camera shown in the split view",
                 Shown::kExample),
+      Key::flag("view_lut", &RenderConfig::viewLut,
+                "views that do not move (top, 360) gathered from the camera frames through a "
+                "look-up table of their own, not drawn by OpenGL"),
   };
   return kKeys;
 }

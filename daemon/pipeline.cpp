@@ -55,7 +55,7 @@ Pipeline::Pipeline(const Config& config, RunStart start)
   auto mosaic = std::make_unique<MosaicStage>(config);
   const MosaicStage& mosaicStage = *mosaic;
   stages_.push_back(std::move(mosaic));
-  const PanoramaStage* panorama = nullptr;
+  PanoramaStage* panorama = nullptr;
   if (configured(config, OutputStream::kPanorama) || configured(config, OutputStream::kSurround)) {
     auto stage = std::make_unique<PanoramaStage>(config, pool_);
     panorama = stage.get();
@@ -65,6 +65,8 @@ Pipeline::Pipeline(const Config& config, RunStart start)
     auto stage = std::make_unique<SurroundStage>(config, *panorama);
     surround_ = stage.get();
     stages_.push_back(std::move(stage));
+    panorama->setWanted(
+        [surround = surround_](FrameWork& work) { return surround->needsPanorama(work.outputs); });
   }
   stages_.push_back(std::make_unique<StreamOutputStage>());
   openOutputs(config, mosaicStage, panorama);

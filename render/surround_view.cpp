@@ -155,4 +155,12 @@ cv::Mat SurroundView::panoramaPositions(double timeS) const {
   return result;
 }
 
+cv::Mat SurroundView::panoramaShown(const cv::Mat& panoramaPositions) {
+  cv::Mat column;
+  cv::extractChannel(panoramaPositions, column, 0);
+  cv::Mat shown;
+  cv::compare(column, column, shown, cv::CMP_EQ);  // false for NaN alone
+  return shown;
+}
+
 }  // namespace surroundd::render

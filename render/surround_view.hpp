@@ -36,6 +36,8 @@ class SurroundView {
   // (RenderError without it). For setting up a view that does not move; it allocates, and
   // waits for the GPU.
   cv::Mat panoramaPositions(double timeS) const;
+  // Where such positions show the panorama: CV_8U, 255 there, 0 elsewhere.
+  static cv::Mat panoramaShown(const cv::Mat& panoramaPositions);
 
  private:
   void drawScene(double timeS, SurroundScene::Pass pass) const;

@@ -4,6 +4,7 @@
 
 #include "daemon/panorama_setup.hpp"
 #include "daemon/pipeline_ends.hpp"
+#include "processing/stitch/view_lut.hpp"
 
 namespace surroundd::daemon {
 
@@ -11,7 +12,8 @@ PanoramaStage::PanoramaStage(const Config& config, WorkPool& pool)
     : PanoramaStage(config, pool, rigOf(config, pool)) {}
 
 PanoramaStage::PanoramaStage(const Config& config, WorkPool& pool, const processing::Rig& rig)
-    : lut_(obtainPanoramaLut(config, rig, pool)),
+    : pool_(pool),
+      lut_(obtainPanoramaLut(config, rig, pool)),
       stitcher_(lut_, pool),
       ownership_(lut_),
       corrected_(config.cameras.size()),
@@ -46,25 +48,47 @@ void PanoramaStage::process(FrameWork& work, StageTimes& times) {
     corrected_[c] = image != nullptr && work.faults[c] == nullptr ? *image : cv::Mat();
     stitched_[c] = image != nullptr ? *image : blackFrames_[c];
   }
-  stitcher_.stitch(stitched_, panorama_);
+  const bool wanted = !wanted_ || wanted_(work);
+  if (wanted) stitcher_.stitch(stitched_, panorama_);
   times.lap(Stage::kStitch);
   if (poisson_) {
     poisson_->update(corrected_);
     for (const auto& note : poisson_->notesOfLastUpdate()) {
       spdlog::warn("colour correction: {}", note);
     }
-    poisson_->apply(panorama_);
+    if (wanted) poisson_->apply(panorama_);
   } else if (gains_) {
     gains_->update(corrected_);
     for (const auto& note : gains_->notesOfLastUpdate()) {
       spdlog::warn("colour correction: {}", note);
     }
-    gains_->apply(panorama_);
+    if (wanted) gains_->apply(panorama_);
   }
-  for (std::size_t c = 0; c < work.set.cameraCount; ++c) {
+  for (std::size_t c = 0; c < work.set.cameraCount && wanted; ++c) {
     if (work.faults[c] != nullptr) ownership_.markFaulty(panorama_, c);
   }
   times.lap(Stage::kCorrect);
+}
+
+PanoramaStage::ViewPicture::ViewPicture(const PanoramaStage& stage,
+                                        const cv::Mat& panoramaPositions)
+    : lut_(processing::composeViewLut(stage.lut_, panoramaPositions, stage.pool_)),
+      stitcher_(lut_, stage.pool_),
+      ownership_(lut_) {
+  if (stage.poisson_) fieldSamples_ = stage.poisson_->viewSamples(panoramaPositions);
+}
+
+void PanoramaStage::draw(ViewPicture& view, const FrameWork& work, cv::Mat& picture) {
+  // The same frames as the panorama's, corrected by the fields and gains its last update() fitted.
+  view.stitcher_.stitch(stitched_, picture);
+  if (poisson_) {
+    poisson_->applyAt(view.fieldSamples_, picture);
+  } else if (gains_) {
+    gains_->apply(picture, view.lut_);
+  }
+  for (std::size_t c = 0; c < work.set.cameraCount; ++c) {
+    if (work.faults[c] != nullptr) view.ownership_.markFaulty(picture, c);
+  }
 }
 
 }  // namespace surroundd::daemon

@@ -4,7 +4,9 @@
 // each faulty camera's part marked. Made for every set, shown or not: colour correction follows
 // the pictures over time.
 
+#include <functional>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -27,16 +29,41 @@ class PanoramaStage final : public PipelineStage {
   // panorama.
   PanoramaStage(const Config& config, WorkPool& pool);
 
+  // Whether the panorama itself is wanted for a set: by an output of it, or a view drawn from
+  // it. When not, process() only updates the colour correction (it follows the pictures over
+  // time; views gathered through their own LUTs apply it). Unset: always.
+  void setWanted(std::function<bool(FrameWork&)> wanted) { wanted_ = std::move(wanted); }
+
   void process(FrameWork& work, StageTimes& times) override;
 
   // The corrected panorama of the last set, reused for every set; of lut().size.
   const cv::Mat& picture() const { return panorama_; }
   const processing::PanoramaLut& lut() const { return lut_; }
 
+  // A view that does not move, made the way the panorama is made but through the view's own LUT
+  // (processing/stitch/view_lut.hpp): gathered from the set's frames straight into the view's
+  // picture, colour-corrected and each faulty camera's part marked. Built on the pool from where
+  // each of the view's pixels samples the panorama (SurroundView::panoramaPositions()).
+  class ViewPicture {
+   public:
+    ViewPicture(const PanoramaStage& stage, const cv::Mat& panoramaPositions);
+    cv::Size size() const { return lut_.size; }
+
+   private:
+    friend class PanoramaStage;
+    processing::PanoramaLut lut_;
+    processing::Stitcher stitcher_;  // borrows lut_
+    processing::PanoramaOwnership ownership_;
+    processing::PoissonColourCorrection::ViewSamples fieldSamples_;  // colour_correction: poisson
+  };
+  // The view's picture of the set process() was last given: 8-bit BGR of its size.
+  void draw(ViewPicture& view, const FrameWork& work, cv::Mat& picture);
+
  private:
   PanoramaStage(const Config& config, WorkPool& pool, const processing::Rig& rig);
   void setUpColourCorrection(const Config& config, const processing::Rig& rig, WorkPool& pool);
 
+  WorkPool& pool_;
   processing::PanoramaLut lut_;
   processing::Stitcher stitcher_;  // borrows lut_
   processing::PanoramaOwnership ownership_;
@@ -46,6 +73,7 @@ class PanoramaStage final : public PipelineStage {
   std::vector<cv::Mat> stitched_;   // this set's frames (headers), black for missing cameras
   std::vector<cv::Mat> blackFrames_;
   cv::Mat panorama_;
+  std::function<bool(FrameWork&)> wanted_;
 };
 
 }  // namespace surroundd::daemon

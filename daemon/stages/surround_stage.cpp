@@ -2,15 +2,22 @@
 
 #include <algorithm>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
 #include "daemon/panorama_setup.hpp"
 #include "daemon/pipeline_ends.hpp"
+#include "render/render_error.hpp"
 
 namespace surroundd::daemon {
 
-SurroundStage::SurroundStage(const Config& config, const PanoramaStage& panorama)
-    : views_(config.render.views), gl_(config.render.platform), panorama_(panorama.picture()) {
+SurroundStage::SurroundStage(const Config& config, PanoramaStage& panorama)
+    : views_(config.render.views),
+      gl_(config.render.platform),
+      panoramaStage_(panorama),
+      panorama_(panorama.picture()),
+      viewLut_(config.render.viewLut) {
   spdlog::info("render: {}", gl_.description());
   const processing::PanoramaSettings settings = panoramaSettings(config);
   processing::SurroundMesh mesh;
@@ -35,14 +42,71 @@ std::unique_ptr<render::SurroundView> SurroundStage::makeView(cv::Size size, Vie
   return std::make_unique<render::SurroundView>(*scene_, size, view, views_);
 }
 
+SurroundStage::FixedView* SurroundStage::fixedView(render::SurroundView& view) {
+  const ViewKind kind = view.view();
+  if (!viewLut_ || (kind != ViewKind::kTop && kind != ViewKind::kPanorama360)) return nullptr;
+  const auto key = std::pair{static_cast<const render::SurroundView*>(&view), kind};
+  if (const auto known = fixedViews_.find(key); known != fixedViews_.end()) {
+    return known->second.view ? &known->second : nullptr;
+  }
+  FixedView& fixed = fixedViews_[key];
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    const cv::Mat positions = view.panoramaPositions(0);
+    fixed.view = std::make_unique<PanoramaStage::ViewPicture>(panoramaStage_, positions);
+    view.draw(0);
+    fixed.overlay = view.collect().clone();
+    cv::bitwise_not(render::SurroundView::panoramaShown(positions), fixed.overlayMask);
+    fixed.picture.create(view.size(), CV_8UC3);
+  } catch (const render::RenderError& e) {
+    spdlog::warn("render: the {} view is drawn by OpenGL: {}", toString(kind), e.what());
+    fixed.view.reset();
+    return nullptr;
+  }
+  spdlog::info(
+      "render: the {} view {}x{} is gathered from the camera frames through its own "
+      "look-up table (made in {:.2f} s)",
+      toString(kind), view.size().width, view.size().height,
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  return &fixed;
+}
+
+bool SurroundStage::needsPanorama(PipelineOutputs& outputs) {
+  panoramaSkipped_ = false;
+  for (auto& output : outputs.pictures()) {
+    // An output of the panorama takes it whether or not it wants this set: the run's end hands
+    // it the last one.
+    if (output.picture == &panorama_ && output.sink) return true;
+    if (!output.view || !output.sink) continue;
+    // A view with a read-back pending is mapped after it is collected, in process().
+    if (output.view->pending() || fixedView(*output.view) == nullptr) return true;
+  }
+  panoramaSkipped_ = true;
+  return false;
+}
+
 void SurroundStage::process(FrameWork& work, StageTimes& times) {
   deliver(work.outputs, &times);
   lastStreamTime_ = work.streamTime;
   bool panoramaUploaded = false;
   bool cameraUploaded = false;
+  bool anyFixed = false;
   for (auto& output : work.outputs.pictures()) {
-    if (!output.view || !output.sink || !output.sink->wantsFrame(work.streamTime)) continue;
+    if (!output.view || !output.sink) continue;
+    const bool wanted = output.sink->wantsFrame(work.streamTime);
     work.outputs.guarded(output, [&] {
+      if (FixedView* fixed = fixedView(*output.view)) {
+        // Without a panorama this set, also when not wanted: the run's end hands over the last
+        // set's picture, and there is no panorama to draw it from.
+        if (!wanted && !panoramaSkipped_) return;
+        panoramaStage_.draw(*fixed->view, work, fixed->picture);
+        fixed->overlay.copyTo(fixed->picture, fixed->overlayMask);
+        fixed->drawnAt = work.streamTime;
+        fixed->handOver = wanted;
+        anyFixed = anyFixed || wanted;
+        return;
+      }
+      if (!wanted) return;
       if (!panoramaUploaded) {
         scene_->uploadPanorama(panorama_);
         panoramaUploaded = true;
@@ -58,6 +122,15 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
     });
   }
   times.lap(Stage::kRender);
+  if (!anyFixed) return;
+  for (auto& output : work.outputs.pictures()) {
+    if (!output.view) continue;
+    const auto fixed = fixedViews_.find({output.view.get(), output.view->view()});
+    if (fixed == fixedViews_.end() || !fixed->second.handOver) continue;
+    fixed->second.handOver = false;
+    work.outputs.handOver(output, fixed->second.picture, work.streamTime, work.origin);
+  }
+  times.lap(Stage::kOutput);
 }
 
 void SurroundStage::deliver(PipelineOutputs& outputs, StageTimes* times) {
@@ -77,6 +150,11 @@ void SurroundStage::deliver(PipelineOutputs& outputs, StageTimes* times) {
 void SurroundStage::finish(PipelineOutputs& outputs) { deliver(outputs, nullptr); }
 
 cv::Mat SurroundStage::redraw(PipelineOutputs::PictureOutput& output) {
+  const auto fixed = fixedViews_.find({output.view.get(), output.view->view()});
+  if (fixed != fixedViews_.end() && fixed->second.view &&
+      fixed->second.drawnAt == lastStreamTime_) {
+    return fixed->second.picture;
+  }
   scene_->uploadPanorama(panorama_);
   output.view->draw(std::chrono::duration<double>(lastStreamTime_).count());
   return output.view->collect();

@@ -4,12 +4,20 @@
 // read-back is collected while the next set is stitched, so each output gets its picture one set
 // later (and the last one when the run ends).
 //
+// Views that do not move (top, 360; render.view_lut) are not drawn per set: the first time an
+// output shows one, the renderer maps where each of its pixels samples the panorama and draws the
+// car and background once; from then on the panorama stage gathers its picture from the camera
+// frames (PanoramaStage::ViewPicture) and the car and background are laid over it. The output
+// gets it in the same set. Kept for when the output shows that view again.
+//
 // Threads: the EGL context is made current on the thread that constructs the stage, which must be
 // the one that runs it.
 
 #include <chrono>
+#include <map>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include <opencv2/core.hpp>
 
@@ -26,10 +34,15 @@ class SurroundStage final : public PipelineStage {
  public:
   // Opens the EGL context and builds the scene; `panorama` must outlive the stage. Throws
   // RenderError, or std::runtime_error naming the config for a mesh that cannot be built.
-  SurroundStage(const Config& config, const PanoramaStage& panorama);
+  SurroundStage(const Config& config, PanoramaStage& panorama);
 
   // A view for an output of `size` (even sides), first showing `view`.
   std::unique_ptr<render::SurroundView> makeView(cv::Size size, ViewKind view) const;
+
+  // Whether this set needs the panorama: an output shows it, or a view drawn from it. Each output's
+  // view that does not move is mapped here the first time (so that one the renderer cannot map is
+  // drawn from the panorama too). For PanoramaStage::setWanted().
+  bool needsPanorama(PipelineOutputs& outputs);
 
   void process(FrameWork& work, StageTimes& times) override;
   void finish(PipelineOutputs& outputs) override;
@@ -42,12 +55,30 @@ class SurroundStage final : public PipelineStage {
   // Hands each view's pending picture (the previous set's) to its output.
   void deliver(PipelineOutputs& outputs, StageTimes* times);
 
+  // A fixed view's picture, and the renderer's car and background to lay over it.
+  struct FixedView {
+    std::unique_ptr<PanoramaStage::ViewPicture> view;
+    cv::Mat overlay;                       // 8-bit BGR, the renderer's picture of the view
+    cv::Mat overlayMask;                   // CV_8U: where it shows no panorama
+    cv::Mat picture;                       // the last drawn
+    std::chrono::nanoseconds drawnAt{-1};  // the stream time of its set
+    bool handOver = false;                 // drawn this set for its output
+  };
+  // The output's fixed view, built the first time it shows it; null for a view that moves, with
+  // render.view_lut off, or where the renderer cannot map views (said once).
+  FixedView* fixedView(render::SurroundView& view);
+
   render::ViewSettings views_;
   // The context first, so that it outlives the GL objects of the scene (and of the outputs' views,
   // which the pipeline destroys before its stages).
   render::EglContext gl_;
   std::unique_ptr<render::SurroundScene> scene_;
+  PanoramaStage& panoramaStage_;
   const cv::Mat& panorama_;
+  bool viewLut_;
+  bool panoramaSkipped_ = false;  // this set: needsPanorama() said no
+  // Per output's view (its address; each lives as long as the pipeline) and the kind it shows.
+  std::map<std::pair<const render::SurroundView*, ViewKind>, FixedView> fixedViews_;
   std::size_t splitCamera_ = 0;
   std::chrono::nanoseconds lastStreamTime_{0};
 };

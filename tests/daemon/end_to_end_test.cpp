@@ -27,8 +27,10 @@ namespace {
 
 using ::testing::HasSubstr;
 
-const std::filesystem::path kRecording =
-    std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
+std::filesystem::path recording() {
+  return std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
+}
+// NOLINTNEXTLINE(cert-err58-cpp): cv::Size stores two ints; its constructor throws nothing.
 const cv::Size kOutputSize(640, 360);
 
 std::filesystem::path writeConfig(const testing::TempDir& dir, std::string_view extra = "") {
@@ -38,8 +40,8 @@ outputs:
   - {{type: video, path: out/mosaic.mp4, crf: 16}}
   - {{type: snapshot, path: out/mosaic.png, at_s: 0.5}}
 {})",
-                                              (kRecording / "rig.yaml").string(), kOutputSize.width,
-                                              kOutputSize.height, extra));
+                                              (recording() / "rig.yaml").string(),
+                                              kOutputSize.width, kOutputSize.height, extra));
 }
 
 TEST(EndToEnd, MosaicVideoMatchesTheSourceFrames) {
@@ -49,7 +51,7 @@ TEST(EndToEnd, MosaicVideoMatchesTheSourceFrames) {
                                   dir / "log.txt");
   ASSERT_EQ(surroundd.wait(), 0) << surroundd.output();
 
-  const auto rig = daemon::loadRigFile(kRecording / "rig.yaml");
+  const auto rig = daemon::loadRigFile(recording() / "rig.yaml");
   std::vector<std::string> names;
   std::vector<std::vector<cv::Mat>> sources;
   for (const auto& camera : rig) {
@@ -64,6 +66,7 @@ TEST(EndToEnd, MosaicVideoMatchesTheSourceFrames) {
   cv::Mat expected(kOutputSize, CV_8UC3);
   for (const std::size_t k : {std::size_t{0}, video.size() / 2, video.size() - 1}) {
     std::vector<const cv::Mat*> frames;
+    frames.reserve(sources.size());
     for (const auto& camera : sources) frames.push_back(&camera[k]);
     mosaic.compose(frames, expected);
     EXPECT_GE(cv::PSNR(expected, video[k]), 35.0) << "frame " << k;
@@ -128,7 +131,7 @@ outputs:
   - {{type: video, stream: panorama, path: out/panorama.mp4, crf: 12}}
   - {{type: snapshot, stream: panorama, path: out/panorama.png, at_s: 0.5}}
 )",
-                                                           (kRecording / "rig.yaml").string()));
+                                                           (recording() / "rig.yaml").string()));
   const auto run = [&](std::string_view expectedLog) {
     testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--config", config.string()},
                                     dir / "log.txt");
@@ -152,7 +155,7 @@ outputs:
 
 // The surround outputs: an orbit video with a picture for every frame set (the read-back of the
 // last one included), and snapshots of other views, each the scene rendered from the panorama of
-// its frame set.
+// its frame set (or for a view that does not move, gathered through its own LUT).
 TEST(EndToEnd, SurroundOutputsShowTheRenderedPanoramaOfEachFrameSet) {
   const testing::TempDir dir;
   const auto config = dir.write("config.yaml", fmt::format(R"(rig: {{file: {}}}
@@ -165,7 +168,7 @@ outputs:
   - {{type: snapshot, stream: surround, view: top, path: out/top.png, at_s: 0.52}}
   - {{type: snapshot, stream: surround, view: 360, path: out/360.png, at_s: 1000}}
 )",
-                                                           (kRecording / "rig.yaml").string()));
+                                                           (recording() / "rig.yaml").string()));
   testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--config", config.string()},
                                   dir / "log.txt");
   ASSERT_EQ(surroundd.wait(), 0) << surroundd.output();
@@ -193,13 +196,56 @@ outputs:
   }
   std::size_t snapshotAt = 0;  // the first frame set at or after 0.52 s (between two frames)
   while (replay.streamTime(snapshotAt) < 0.52) ++snapshotAt;
+  // The top view does not move, so it is gathered through its own LUT: a little sharper than the
+  // render, which blurs twice (tests/render/view_lut_test.cpp).
+  EXPECT_THAT(surroundd.output(), HasSubstr("the top view 320x240 is gathered from the camera"));
   EXPECT_GE(cv::PSNR(rendered(snapshotAt, render::ViewKind::kTop),
                      cv::imread((dir / "out/top.png").string())),
-            40.0);
+            36.0);
   // Asked for after the end: the last frame set's picture.
   EXPECT_GE(cv::PSNR(rendered(replay.frameSets() - 1, render::ViewKind::kPanorama360),
                      cv::imread((dir / "out/360.png").string())),
             40.0);
+
+  // The same rig with other render settings and outputs; returns the daemon's output.
+  const auto runWith = [&](const std::string& name, const std::string& render,
+                           const std::string& outputs) {
+    const auto other = dir.write(name + ".yaml",
+                                 fmt::format(R"(rig: {{file: {}}}
+capture: {{pacing: as_fast_as_possible}}
+pipeline: {{threads: 2}}
+panorama: {{width_px: 512, height_px: 256, cache_dir: lut-cache}}
+render: {{width_px: 320, height_px: 240{}}}
+outputs:
+{})",
+                                             (recording() / "rig.yaml").string(), render, outputs));
+    testing::ChildProcess run({SURROUNDD_EXECUTABLE, "--config", other.string()},
+                              dir / (name + "-log.txt"));
+    EXPECT_EQ(run.wait(), 0) << run.output();
+    return run.output();
+  };
+  // With render.view_lut off the top view is rendered like the views that move.
+  EXPECT_THAT(
+      runWith("rendered", ", view_lut: false",
+              "  - {type: snapshot, stream: surround, view: top, path: out/top-rendered.png, "
+              "at_s: 0.52}"),
+      Not(HasSubstr("gathered from the camera")));
+  EXPECT_GE(cv::PSNR(rendered(snapshotAt, render::ViewKind::kTop),
+                     cv::imread((dir / "out/top-rendered.png").string())),
+            40.0);
+  // With every output's view gathered through its own LUT no panorama is made; the picture asked
+  // for after the end is still the last frame set's.
+  runWith("gathered", "",
+          "  - {type: snapshot, stream: surround, view: top, path: out/top-gathered.png, at_s: "
+          "0.52}\n"
+          "  - {type: snapshot, stream: surround, view: 360, path: out/360-gathered.png, at_s: "
+          "1000}");
+  EXPECT_GE(cv::PSNR(rendered(snapshotAt, render::ViewKind::kTop),
+                     cv::imread((dir / "out/top-gathered.png").string())),
+            36.0);
+  EXPECT_GE(cv::PSNR(rendered(replay.frameSets() - 1, render::ViewKind::kPanorama360),
+                     cv::imread((dir / "out/360-gathered.png").string())),
+            36.0);
 }
 
 // A mosaic snapshot asked for after the end, with no other mosaic output: the last frame set's
@@ -212,12 +258,12 @@ render: {{width_px: {}, height_px: {}}}
 outputs:
   - {{type: snapshot, stream: mosaic, path: out/last.png, at_s: 1000}}
 )",
-                                                           (kRecording / "rig.yaml").string(),
+                                                           (recording() / "rig.yaml").string(),
                                                            kOutputSize.width, kOutputSize.height));
   testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--config", config.string()},
                                   dir / "log.txt");
   ASSERT_EQ(surroundd.wait(), 0) << surroundd.output();
-  const auto rig = daemon::loadRigFile(kRecording / "rig.yaml");
+  const auto rig = daemon::loadRigFile(recording() / "rig.yaml");
   std::vector<std::string> names;
   std::vector<cv::Mat> last;
   for (const auto& camera : rig) {
@@ -225,6 +271,7 @@ outputs:
     last.push_back(testing::decodeAll(camera.source->path).images.back());
   }
   std::vector<const cv::Mat*> frames;
+  frames.reserve(last.size());
   for (const auto& image : last) frames.push_back(&image);
   cv::Mat expected(kOutputSize, CV_8UC3);
   render::Mosaic(kOutputSize, names).compose(frames, expected);
@@ -265,7 +312,7 @@ TEST(EndToEnd, BadConfigOpensNothing) {
 // A live rig whose camera is not plugged in: one message naming the camera and its device path.
 TEST(EndToEnd, ALiveCameraThatIsNotThereIsNamed) {
   const testing::TempDir dir;
-  const auto rig = daemon::loadRigFile(kRecording / "rig.yaml");
+  const auto rig = daemon::loadRigFile(recording() / "rig.yaml");
   std::vector<daemon::RigCamera> live(rig.begin(), rig.end());
   for (auto& camera : live) {
     camera.source.reset();
@@ -309,7 +356,7 @@ outputs:
   - {{type: network, stream: surround, url: "udp://127.0.0.1:{}", crf: 18}}
   - {{type: video, stream: surround, path: out/orbit.mkv, crf: 0, pixel_format: yuv444p}}
 )",
-                                           (kRecording / "rig.yaml").string(), port));
+                                           (recording() / "rig.yaml").string(), port));
   testing::StreamReceiver receiver(port, std::chrono::seconds(3));
   testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--config", config.string()},
                                   dir / "log.txt");

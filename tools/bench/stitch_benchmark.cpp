@@ -136,9 +136,7 @@ TopViewTiming measureTopView(const processing::Rig& rig,
                                           repeats);
   timing.directMs = medians[0];
   timing.renderedMs = medians[1];
-  cv::Mat shown;
-  cv::extractChannel(positions, shown, 0);
-  cv::compare(shown, shown, shown, cv::CMP_EQ);  // NaN where no panorama is shown
+  const cv::Mat shown = render::SurroundView::panoramaShown(positions);
   cv::Mat difference;
   cv::absdiff(directPicture, rendered, difference);
   difference.convertTo(difference, CV_32F);
