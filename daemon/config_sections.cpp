@@ -230,7 +230,12 @@ const ConfigKeys<RenderConfig>& renderKeys() {
       Key::number("orbit_height_m", views(&ViewSettings::orbitHeightM), distance,
                   "orbit: the eye's height", followsVehicle),
       Key::number("orbit_period_s", views(&ViewSettings::orbitPeriodS),
-                  {0.5, 3600.0, false, "seconds"}, "orbit: one turn in this much stream time"),
+                  {0.0, 3600.0, false, "seconds"},
+                  "orbit: one turn in this much stream time; 0: the eye stays where it starts"),
+      Key::number("orbit_start_deg", views(&ViewSettings::orbitStartDeg),
+                  {-180.0, 180.0, false, "degrees"},
+                  "orbit: the eye's azimuth at stream time 0, from straight ahead, positive to "
+                  "the left; 180: behind the car"),
       Key::number("orbit_fov_deg", views(&ViewSettings::orbitFovDeg),
                   {10.0, 150.0, false, "degrees"}, "orbit: vertical field of view"),
       Key::number("strip_top_deg", views(&ViewSettings::stripTopDeg),
@@ -238,8 +243,9 @@ const ConfigKeys<RenderConfig>& renderKeys() {
       Key::text("split_camera", &RenderConfig::splitCamera, "the camera shown in the split view",
                 Shown::kExample),
       Key::flag("view_lut", &RenderConfig::viewLut,
-                "views that do not move (top, 360) gathered from the camera frames through a "
-                "look-up table of their own, not drawn by OpenGL"),
+                "views that do not move (top, 360, and orbit and split with orbit_period_s 0) "
+                "gathered from the camera frames through a look-up table of their own, not drawn "
+                "by OpenGL"),
   };
   return kKeys;
 }

@@ -50,6 +50,16 @@ SurroundView::SurroundView(const SurroundScene& scene, cv::Size size, ViewKind v
   gl::check("creating a surround view");
 }
 
+bool SurroundView::moves() const {
+  return (view_ == ViewKind::kOrbit || view_ == ViewKind::kSplit) && orbitMoves(settings_);
+}
+
+std::optional<cv::Rect> SurroundView::cameraArea() const {
+  if (view_ != ViewKind::kSplit) return std::nullopt;
+  const int half = size_.width / 2;
+  return letterbox(scene_.cameraSize(), {half, 0, half, size_.height});
+}
+
 void SurroundView::drawScene(double timeS, SurroundScene::Pass pass) const {
   glViewport(0, 0, size_.width, size_.height);
   switch (view_) {
@@ -68,8 +78,7 @@ void SurroundView::drawScene(double timeS, SurroundScene::Pass pass) const {
       glViewport(0, 0, half.width, half.height);
       scene_.drawSurround(orbitViewProjection(settings_, half, timeS), pass);
       if (pass == SurroundScene::Pass::kPicture) {
-        const cv::Rect camera =
-            letterbox(scene_.cameraSize(), {half.width, 0, half.width, half.height});
+        const cv::Rect camera = *cameraArea();
         glViewport(camera.x, camera.y, camera.width, camera.height);
         scene_.drawCamera();
       }

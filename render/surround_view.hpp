@@ -6,6 +6,8 @@
 // frame's stitch) while the GPU finishes; collect() then waits for the pixels. Nothing is
 // allocated per frame.
 
+#include <optional>
+
 #include <opencv2/core.hpp>
 
 #include "render/gl_objects.hpp"
@@ -22,6 +24,12 @@ class SurroundView {
   void setView(ViewKind view) { view_ = view; }
   ViewKind view() const { return view_; }
   cv::Size size() const { return size_; }
+  // Whether its picture changes with stream time for the same panorama: the orbiting eye of the
+  // orbit and split views (ViewSettings::orbitPeriodS).
+  bool moves() const;
+  // Where the split view shows its camera's own picture, letterboxed in the right half; none for
+  // the other views.
+  std::optional<cv::Rect> cameraArea() const;
 
   // Renders the scene as it was last uploaded; `timeS` moves the orbiting eye.
   void draw(double timeS);

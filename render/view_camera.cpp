@@ -78,13 +78,16 @@ cv::Matx44f topViewProjection(const ViewSettings& settings, cv::Size viewport) {
 }
 
 cv::Matx44f orbitViewProjection(const ViewSettings& settings, cv::Size viewport, double timeS) {
-  const double angle = std::numbers::pi + 2 * std::numbers::pi * timeS / settings.orbitPeriodS;
+  const double turns = orbitMoves(settings) ? timeS / settings.orbitPeriodS : 0;
+  const double angle = settings.orbitStartDeg * kDegToRad + 2 * std::numbers::pi * turns;
   const cv::Vec3f eye(static_cast<float>(settings.orbitRadiusM * std::cos(angle)),
                       static_cast<float>(settings.orbitRadiusM * std::sin(angle)),
                       static_cast<float>(settings.orbitHeightM));
   return perspective(settings.orbitFovDeg * kDegToRad, aspectOf(viewport)) *
          lookAt(eye, {0, 0, 0.5F}, {0, 0, 1});
 }
+
+bool orbitMoves(const ViewSettings& settings) { return settings.orbitPeriodS > 0; }
 
 cv::Vec2f stripTangents(const ViewSettings& settings, cv::Size viewport) {
   // A strip is half a turn wide; at the horizon a radian takes as many rows as columns.

@@ -29,7 +29,8 @@ struct ViewSettings {
   double topHeightM = 14.0;    // eye height of the top view
   double orbitRadiusM = 8.0;   // horizontal distance of the orbiting eye from the vehicle
   double orbitHeightM = 4.5;   // its height
-  double orbitPeriodS = 20.0;  // one turn, in stream time; the eye starts behind the vehicle
+  double orbitPeriodS = 20.0;  // one turn, in stream time; 0: the eye stays where it starts
+  double orbitStartDeg = 180;  // the eye's azimuth at stream time 0 (180: behind the vehicle)
   double orbitFovDeg = 60.0;   // vertical field of view
   double stripTopDeg = 15.0;   // 360 view: elevation at the top of each strip
 
@@ -38,6 +39,8 @@ struct ViewSettings {
 
 cv::Matx44f topViewProjection(const ViewSettings& settings, cv::Size viewport);
 cv::Matx44f orbitViewProjection(const ViewSettings& settings, cv::Size viewport, double timeS);
+// Whether the orbit view's eye moves with stream time.
+bool orbitMoves(const ViewSettings& settings);
 
 // The 360 view's strips: elevations (tan) at the top and bottom of a strip of `viewport` / 2
 // rows that keeps angles at the horizon undistorted.

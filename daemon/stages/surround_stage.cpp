@@ -44,7 +44,7 @@ std::unique_ptr<render::SurroundView> SurroundStage::makeView(cv::Size size, Vie
 
 SurroundStage::FixedView* SurroundStage::fixedView(render::SurroundView& view) {
   const ViewKind kind = view.view();
-  if (!viewLut_ || (kind != ViewKind::kTop && kind != ViewKind::kPanorama360)) return nullptr;
+  if (!viewLut_ || view.moves()) return nullptr;
   const auto key = std::pair{static_cast<const render::SurroundView*>(&view), kind};
   if (const auto known = fixedViews_.find(key); known != fixedViews_.end()) {
     return known->second.view ? &known->second : nullptr;
@@ -57,7 +57,9 @@ SurroundStage::FixedView* SurroundStage::fixedView(render::SurroundView& view) {
     view.draw(0);
     fixed.overlay = view.collect().clone();
     cv::bitwise_not(render::SurroundView::panoramaShown(positions), fixed.overlayMask);
-    fixed.picture.create(view.size(), CV_8UC3);
+    // The split view's camera half is the camera's own picture, scaled in each set.
+    if (const auto camera = view.cameraArea()) fixed.overlayMask(*camera).setTo(0);
+    fixed.picture = fixed.overlay.clone();
   } catch (const render::RenderError& e) {
     spdlog::warn("render: the {} view is drawn by OpenGL: {}", toString(kind), e.what());
     fixed.view.reset();
@@ -95,12 +97,19 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
     if (!output.view || !output.sink) continue;
     const bool wanted = output.sink->wantsFrame(work.streamTime);
     work.outputs.guarded(output, [&] {
+      const capture::Frame* camera = work.set.frame(splitCamera_);
       if (FixedView* fixed = fixedView(*output.view)) {
         // Without a panorama this set, also when not wanted: the run's end hands over the last
         // set's picture, and there is no panorama to draw it from.
         if (!wanted && !panoramaSkipped_) return;
         panoramaStage_.draw(*fixed->view, work, fixed->picture);
         fixed->overlay.copyTo(fixed->picture, fixed->overlayMask);
+        // As the renderer samples it (bilinear, pixel centres at halves); a missing frame leaves
+        // the last one shown.
+        if (const auto area = output.view->cameraArea(); area && camera != nullptr) {
+          cv::Mat into = fixed->picture(*area);
+          cv::resize(camera->image, into, area->size(), 0, 0, cv::INTER_LINEAR);
+        }
         fixed->drawnAt = work.streamTime;
         fixed->handOver = wanted;
         anyFixed = anyFixed || wanted;
@@ -111,7 +120,6 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
         scene_->uploadPanorama(panorama_);
         panoramaUploaded = true;
       }
-      const capture::Frame* camera = work.set.frame(splitCamera_);
       if (output.view->view() == ViewKind::kSplit && !cameraUploaded && camera != nullptr) {
         scene_->uploadCamera(camera->image);
         cameraUploaded = true;

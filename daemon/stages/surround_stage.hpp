@@ -4,11 +4,12 @@
 // read-back is collected while the next set is stitched, so each output gets its picture one set
 // later (and the last one when the run ends).
 //
-// Views that do not move (top, 360; render.view_lut) are not drawn per set: the first time an
-// output shows one, the renderer maps where each of its pixels samples the panorama and draws the
-// car and background once; from then on the panorama stage gathers its picture from the camera
-// frames (PanoramaStage::ViewPicture) and the car and background are laid over it. The output
-// gets it in the same set. Kept for when the output shows that view again.
+// Views that do not move (top, 360, and orbit and split with a still eye; render.view_lut) are
+// not drawn per set: the first time an output shows one, the renderer maps where each of its
+// pixels samples the panorama and draws the car and background once; from then on the panorama
+// stage gathers its picture from the camera frames (PanoramaStage::ViewPicture), the car and
+// background are laid over it, and the split view's camera picture is scaled into its half. The
+// output gets it in the same set. Kept for when the output shows that view again.
 //
 // Threads: the EGL context is made current on the thread that constructs the stage, which must be
 // the one that runs it.

@@ -246,6 +246,33 @@ outputs:
   EXPECT_GE(cv::PSNR(rendered(replay.frameSets() - 1, render::ViewKind::kPanorama360),
                      cv::imread((dir / "out/360-gathered.png").string())),
             36.0);
+
+  // With a still eye the orbit and split views do not move either, and are gathered too; the
+  // split view's camera half is the first camera's own picture, scaled as the renderer scales it.
+  const std::string still =
+      runWith("still", ", orbit_period_s: 0, orbit_start_deg: 135",
+              "  - {type: snapshot, stream: surround, view: split, path: out/split-still.png, "
+              "at_s: 0.52}\n"
+              "  - {type: snapshot, stream: surround, view: orbit, path: out/orbit-still.png, "
+              "at_s: 0.52}");
+  EXPECT_THAT(still, HasSubstr("the split view 320x240 is gathered from the camera"));
+  EXPECT_THAT(still, HasSubstr("the orbit view 320x240 is gathered from the camera"));
+  render::ViewSettings stillEye = loaded.render.views;
+  stillEye.orbitPeriodS = 0;
+  stillEye.orbitStartDeg = 135;
+  render::SurroundView stillView(scene, {320, 240}, render::ViewKind::kSplit, stillEye);
+  scene.uploadPanorama(replay.panorama(snapshotAt));
+  scene.uploadCamera(replay.sources[0][snapshotAt]);
+  stillView.draw(0);
+  const cv::Mat split = stillView.collect().clone();
+  const cv::Mat splitGathered = cv::imread((dir / "out/split-still.png").string());
+  EXPECT_GE(cv::PSNR(split, splitGathered), 36.0);
+  const cv::Rect cameraArea = *stillView.cameraArea();
+  EXPECT_GE(cv::PSNR(split(cameraArea), splitGathered(cameraArea)), 40.0);
+  stillView.setView(render::ViewKind::kOrbit);
+  stillView.draw(0);
+  EXPECT_GE(cv::PSNR(stillView.collect(), cv::imread((dir / "out/orbit-still.png").string())),
+            36.0);
 }
 
 // A mosaic snapshot asked for after the end, with no other mosaic output: the last frame set's

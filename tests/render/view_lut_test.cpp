@@ -238,6 +238,44 @@ TEST_F(ViewLutTest, EachFixedViewMatchesTheRenderer) {
   }
 }
 
+// With orbit_period_s 0 the orbit's eye stays where it starts: the picture of the moving orbit
+// at that azimuth, at any stream time. Only the moving orbit and split views move.
+TEST_F(ViewLutTest, AStillOrbitHoldsItsStartingPose) {
+  ViewSettings still;
+  still.orbitPeriodS = 0;
+  still.orbitStartDeg = 225;  // the moving orbit's eye 2.5 s into its 20 s turn
+  SurroundView moving(rig->scene, {640, 360}, ViewKind::kOrbit, ViewSettings{});
+  SurroundView held(rig->scene, {640, 360}, ViewKind::kOrbit, still);
+  rig->show(Correction::kNone);
+  moving.draw(2.5);
+  const cv::Mat expected = moving.collect().clone();
+  for (const double timeS : {0.0, 7.0, 1000.0}) {
+    held.draw(timeS);
+    EXPECT_GE(cv::PSNR(expected, held.collect()), 50.0) << timeS << " s";
+  }
+  moving.draw(0);
+  EXPECT_LT(cv::PSNR(expected, moving.collect()), 30.0);  // the moving one did move
+
+  EXPECT_TRUE(moving.moves());
+  EXPECT_FALSE(held.moves());
+  moving.setView(ViewKind::kSplit);
+  held.setView(ViewKind::kSplit);
+  EXPECT_TRUE(moving.moves());
+  EXPECT_FALSE(held.moves());
+  for (const ViewKind view : {ViewKind::kTop, ViewKind::kPanorama360}) {
+    moving.setView(view);
+    EXPECT_FALSE(moving.moves()) << toString(view);
+    EXPECT_FALSE(moving.cameraArea()) << toString(view);
+  }
+  // As large as fits in the right half, of the camera's shape.
+  const cv::Rect area = *held.cameraArea();
+  const cv::Size camera = rig->lut.cameraSizes.front();
+  EXPECT_EQ(area & cv::Rect(320, 0, 320, 360), area);
+  EXPECT_TRUE(area.width == 320 || area.height == 360) << area;
+  EXPECT_NEAR(static_cast<double>(area.width) / area.height,
+              static_cast<double>(camera.width) / camera.height, 0.02);
+}
+
 // The split view's camera half is a live picture, so it shows no panorama; its surround half does.
 TEST_F(ViewLutTest, SplitViewMapsOnlyItsSurroundHalf) {
   SurroundView surround(rig->scene, {640, 360}, ViewKind::kSplit, ViewSettings{});
