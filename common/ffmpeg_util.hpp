@@ -42,6 +42,10 @@ struct PacketDeleter {
   void operator()(AVPacket* packet) const noexcept { av_packet_free(&packet); }
 };
 
+struct BufferDeleter {
+  void operator()(AVBufferRef* buffer) const noexcept { av_buffer_unref(&buffer); }
+};
+
 struct SwsContextDeleter {
   void operator()(SwsContext* context) const noexcept { sws_freeContext(context); }
 };
@@ -52,6 +56,7 @@ using CodecContextPtr = std::unique_ptr<AVCodecContext, CodecContextDeleter>;
 using FramePtr = std::unique_ptr<AVFrame, FrameDeleter>;
 using PacketPtr = std::unique_ptr<AVPacket, PacketDeleter>;
 using SwsContextPtr = std::unique_ptr<SwsContext, SwsContextDeleter>;
+using BufferPtr = std::unique_ptr<AVBufferRef, BufferDeleter>;
 
 // av_err2str() is a C macro built on a compound literal, which C++ does not have.
 inline std::string errorText(int error) {

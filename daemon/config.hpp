@@ -191,6 +191,7 @@ struct OutputConfig {
   int crf = 23;
   std::string preset = "veryfast";
   std::string pixelFormat = "yuv420p";
+  std::string encoder = "auto";  // H.264: auto | libx264 | an FFmpeg encoder's name
   double segmentS = 0.0;  // video: a new file every this many seconds of stream time; 0 = one file
   std::string url;        // network: udp://HOST:PORT (MPEG-TS)
   // http: MJPEG and the live page

@@ -28,6 +28,18 @@ Key presetKey() {
                      "x264 speed preset");
 }
 
+Key encoderKey() {
+  return Key::text("encoder", &OutputConfig::encoder,
+                   "the H.264 encoder: auto (the first of h264_nvenc, h264_vaapi, h264_v4l2m2m "
+                   "that opens here, else libx264; the log says which) | libx264 | an FFmpeg "
+                   "encoder's name");
+}
+
+// An encoder this FFmpeg has, and H.264 (whether its device is there shows only when it opens).
+void checkEncoder(YamlObject& item, OutputConfig& o) {
+  if (const auto problem = render::h264EncoderProblem(o.encoder)) item.error("encoder", *problem);
+}
+
 Key pixelFormatKey() {
   return Key::choice("pixel_format", &OutputConfig::pixelFormat,
                      {{"yuv420p", "yuv420p"}, {"yuv444p", "yuv444p"}}, "the encoded pixel format");
@@ -35,6 +47,7 @@ Key pixelFormatKey() {
 
 // The container is chosen by the file's extension.
 void checkVideo(YamlObject& item, OutputConfig& o) {
+  checkEncoder(item, o);
   const auto extension = o.path.extension().string();
   if (extension != ".mp4" && extension != ".mkv") {
     item.error("path",
@@ -43,6 +56,7 @@ void checkVideo(YamlObject& item, OutputConfig& o) {
 }
 
 void checkNetwork(YamlObject& item, OutputConfig& o) {
+  checkEncoder(item, o);
   if (!o.url.starts_with("udp://") || o.url.size() <= 6) {
     item.error("url", fmt::format("expected udp://HOST:PORT, got '{}'", o.url));
   }
@@ -59,6 +73,7 @@ std::unique_ptr<render::FrameSink> openVideo(const OutputConfig& output,
   settings.preset = output.preset;
   settings.pixelFormat = output.pixelFormat;
   settings.url = output.url;
+  settings.encoder = output.encoder;
   auto video = std::make_unique<render::VideoSink>(
       std::move(settings), std::chrono::duration_cast<std::chrono::nanoseconds>(
                                std::chrono::duration<double>(output.segmentS)));
@@ -77,6 +92,7 @@ OutputType videoOutputType() {
   type.name = "video";
   type.keys = {
       Key::requiredPath("path", &OutputConfig::path, "the file: .mp4 or .mkv (H.264)"),
+      encoderKey(),
       crfKey(),
       presetKey(),
       pixelFormatKey(),
@@ -97,6 +113,7 @@ OutputType networkOutputType() {
   type.keys = {
       Key::text("url", &OutputConfig::url, "where the stream goes, udp://HOST:PORT",
                 Shown::kExample),
+      encoderKey(),
       crfKey(),
       presetKey(),
       pixelFormatKey(),

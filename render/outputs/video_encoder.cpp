@@ -3,13 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "common/ffmpeg_util.hpp"
 
 extern "C" {
+#include <libavutil/hwcontext.h>
 #include <libavutil/opt.h>
 #include <libavutil/pixdesc.h>
 }
@@ -24,7 +27,24 @@ constexpr AVRational kMicroseconds{1, 1'000'000};
 // defaults to milliseconds: the whole file would then be shifted by up to 1 ms.
 constexpr const char* kMp4MovieTimescale = "1000000";
 
+bool takes(const AVCodec* encoder, AVPixelFormat format) {
+  // An encoder that lists none (v4l2m2m) learns its device's formats only when it opens.
+  if (encoder->pix_fmts == nullptr) return format == AV_PIX_FMT_YUV420P;
+  for (const AVPixelFormat* f = encoder->pix_fmts; *f != AV_PIX_FMT_NONE; ++f) {
+    if (*f == format) return true;
+  }
+  return false;
+}
+
 }  // namespace
+
+std::optional<std::string> h264EncoderProblem(std::string_view name) {
+  if (name == "auto") return std::nullopt;
+  const AVCodec* encoder = avcodec_find_encoder_by_name(std::string(name).c_str());
+  if (encoder == nullptr) return fmt::format("this FFmpeg has no encoder '{}'", name);
+  if (encoder->id != AV_CODEC_ID_H264) return fmt::format("'{}' does not encode H.264", name);
+  return std::nullopt;
+}
 
 struct VideoEncoder::Impl {
   VideoEncoderSettings settings;
@@ -34,6 +54,10 @@ struct VideoEncoder::Impl {
   ffmpeg::FramePtr frame;
   ffmpeg::PacketPtr packet;
   ffmpeg::SwsContextPtr sws;
+  AVPixelFormat pictureFormat = AV_PIX_FMT_NONE;  // what sws writes into `frame`
+  ffmpeg::BufferPtr hwDevice;  // a VA-API encoder's device and frame pool; null for the others
+  ffmpeg::BufferPtr hwFrames;
+  ffmpeg::FramePtr hwFrame;
   AVStream* stream = nullptr;  // owned by `format`
   std::uint64_t framesWritten = 0;
   std::optional<std::int64_t> lastPts;
@@ -42,14 +66,19 @@ struct VideoEncoder::Impl {
   bool network() const { return !settings.url.empty(); }
   std::string target() const { return network() ? settings.url : settings.path.string(); }
 
+  const char* kind() const { return network() ? "stream" : "video"; }
+
   [[noreturn]] void fail(std::string_view what, int error = 0) const {
-    const char* kind = network() ? "stream" : "video";
-    throw EncoderError(error == 0 ? fmt::format("{} '{}': {}", kind, target(), what)
-                                  : fmt::format("{} '{}': {}: {}", kind, target(), what,
+    throw EncoderError(error == 0 ? fmt::format("{} '{}': {}", kind(), target(), what)
+                                  : fmt::format("{} '{}': {}: {}", kind(), target(), what,
                                                 ffmpeg::errorText(error)));
   }
 
   void open();
+  void openCodec(AVPixelFormat pixelFormat);
+  // Empty when `encoder` opened; else why not (and nothing of it kept).
+  std::string tryCodec(const AVCodec* encoder, AVPixelFormat pixelFormat);
+  std::string useHardwareFrames();
   void drain(bool flushing);
 };
 
@@ -75,19 +104,12 @@ void VideoEncoder::Impl::open() {
     fail(fmt::format("pixel format must be yuv420p, yuv444p or bgr24, got '{}'",
                      settings.pixelFormat));
   }
-  // bgr24 is H.264 on the pictures' own channels (libx264rgb): with crf 0 the frames come back
-  // bit for bit.
-  const bool rgb = pixelFormat == AV_PIX_FMT_BGR24;
   if (!(settings.nominalFps > 0 && settings.nominalFps <= 1000)) {
     fail(fmt::format("nominal frame rate must be in (0, 1000], got {}", settings.nominalFps));
   }
   if (settings.crf < 0 || settings.crf > 51) {
     fail(fmt::format("crf must be in 0..51 (0 = lossless), got {}", settings.crf));
   }
-  const char* encoderName = rgb ? "libx264rgb" : "libx264";
-  const AVCodec* encoder = avcodec_find_encoder_by_name(encoderName);
-  if (encoder == nullptr) fail(fmt::format("this FFmpeg has no {} encoder", encoderName));
-
   // A file is written under a temporary name until it is finalized; a stream has no name to keep.
   std::string destination = settings.url;
   if (!network()) {
@@ -106,41 +128,7 @@ void VideoEncoder::Impl::open() {
   }
   format.reset(rawFormat);
 
-  codec.reset(avcodec_alloc_context3(encoder));
-  if (!codec) fail("out of memory");
-  codec->width = settings.size.width;
-  codec->height = settings.size.height;
-  codec->pix_fmt = pixelFormat;
-  codec->time_base = kMicroseconds;
-  // A large bound keeps NTSC rates exact (29.97 -> 30000/1001).
-  codec->framerate = av_d2q(settings.nominalFps, 1 << 16);
-  codec->thread_count = settings.threads;
-  // BT.601 limited range, tagged, so that every decoder converts back the way sws converted here.
-  codec->colorspace = rgb ? AVCOL_SPC_RGB : AVCOL_SPC_SMPTE170M;
-  codec->color_primaries = AVCOL_PRI_SMPTE170M;
-  codec->color_trc = AVCOL_TRC_SMPTE170M;
-  codec->color_range = rgb ? AVCOL_RANGE_JPEG : AVCOL_RANGE_MPEG;
-  if (settings.bitExact) codec->flags |= AV_CODEC_FLAG_BITEXACT;
-  if ((format->oformat->flags & AVFMT_GLOBALHEADER) != 0)
-    codec->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
-  av_opt_set(codec->priv_data, "preset", settings.preset.c_str(), 0);
-  av_opt_set(codec->priv_data, "crf", std::to_string(settings.crf).c_str(), 0);
-  // x264's AVX-512 macroblock-tree kernel makes the output depend on leftover heap contents (seen
-  // with x264 164 r3095); without mbtree the same input gives the same bytes on every CPU.
-  if (settings.bitExact) av_opt_set(codec->priv_data, "x264-params", "mbtree=0", 0);
-  if (pixelFormat == AV_PIX_FMT_YUV444P) av_opt_set(codec->priv_data, "profile", "high444", 0);
-  if (network()) {
-    // A viewer sees each picture as soon as it is encoded (no look-ahead, no B-frames), and one
-    // that joins late waits at most a second for a keyframe.
-    av_opt_set(codec->priv_data, "tune", "zerolatency", 0);
-    codec->gop_size = std::max(1, static_cast<int>(std::lround(settings.nominalFps)));
-  }
-  // x264 checks the preset only here.
-  if (const int error = avcodec_open2(codec.get(), encoder, nullptr); error < 0) {
-    fail(fmt::format("cannot open the H.264 encoder (preset '{}', crf {}, {})", settings.preset,
-                     settings.crf, settings.pixelFormat),
-         error);
-  }
+  openCodec(pixelFormat);
 
   stream = avformat_new_stream(format.get(), nullptr);
   if (stream == nullptr) fail("cannot add a video stream");
@@ -164,20 +152,165 @@ void VideoEncoder::Impl::open() {
   frame.reset(av_frame_alloc());
   packet.reset(av_packet_alloc());
   if (!frame || !packet) fail("out of memory");
-  frame->format = pixelFormat;
+  frame->format = pictureFormat;
   frame->width = settings.size.width;
   frame->height = settings.size.height;
   if (const int error = av_frame_get_buffer(frame.get(), 0); error < 0)
     fail("out of memory", error);
   sws.reset(sws_getContext(settings.size.width, settings.size.height, AV_PIX_FMT_BGR24,
-                           settings.size.width, settings.size.height, pixelFormat,
+                           settings.size.width, settings.size.height, pictureFormat,
                            SWS_BICUBIC | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT | SWS_BITEXACT,
                            nullptr, nullptr, nullptr));
   if (!sws) fail("cannot set up the colour conversion");
-  if (!rgb) {
+  if (hwFrames) {
+    hwFrame.reset(av_frame_alloc());
+    if (!hwFrame) fail("out of memory");
+  }
+  if (pixelFormat != AV_PIX_FMT_BGR24) {
     const int* bt601 = sws_getCoefficients(SWS_CS_ITU601);
     sws_setColorspaceDetails(sws.get(), bt601, 1, bt601, 0, 0, 1 << 16, 1 << 16);
   }
+}
+
+void VideoEncoder::Impl::openCodec(AVPixelFormat pixelFormat) {
+  const std::string& wanted = settings.encoder;
+  // bgr24 is H.264 on the pictures' own channels (libx264rgb): with crf 0 the frames come back
+  // bit for bit.
+  const bool rgb = pixelFormat == AV_PIX_FMT_BGR24;
+  const bool x264Only = rgb || settings.bitExact;
+  if (x264Only && wanted != "libx264" && wanted != "auto") {
+    fail(fmt::format("{} needs libx264, not {}", rgb ? "pixel format bgr24" : "bit-exact output",
+                     wanted));
+  }
+  if (x264Only || wanted == "libx264" || wanted == "auto") {
+    // What only x264 does, or the fallback after the hardware encoders.
+    std::vector<std::string> notOpened;
+    if (!x264Only && wanted == "auto") {
+      for (const char* name : kHardwareH264Encoders) {
+        const AVCodec* encoder = avcodec_find_encoder_by_name(name);
+        std::string why =
+            encoder == nullptr ? "not in this FFmpeg" : tryCodec(encoder, pixelFormat);
+        if (why.empty()) {
+          spdlog::info("{} '{}': H.264 by {}", kind(), target(), name);
+          return;
+        }
+        notOpened.push_back(fmt::format("{}: {}", name, why));
+      }
+    }
+    const char* name = rgb ? "libx264rgb" : "libx264";
+    const AVCodec* encoder = avcodec_find_encoder_by_name(name);
+    if (encoder == nullptr) fail(fmt::format("this FFmpeg has no {} encoder", name));
+    if (std::string why = tryCodec(encoder, pixelFormat); !why.empty()) fail(why);
+    if (!notOpened.empty()) {
+      spdlog::info("{} '{}': H.264 by {}, as no hardware encoder opens here ({})", kind(), target(),
+                   name, fmt::join(notOpened, "; "));
+    }
+    return;
+  }
+  if (const auto problem = h264EncoderProblem(wanted)) fail(*problem);
+  if (std::string why = tryCodec(avcodec_find_encoder_by_name(wanted.c_str()), pixelFormat);
+      !why.empty()) {
+    fail(why);
+  }
+}
+
+std::string VideoEncoder::Impl::tryCodec(const AVCodec* encoder, AVPixelFormat pixelFormat) {
+  const bool x264 = std::string_view(encoder->name).starts_with("libx264");
+  codec.reset(avcodec_alloc_context3(encoder));
+  if (!codec) fail("out of memory");
+  codec->width = settings.size.width;
+  codec->height = settings.size.height;
+  codec->time_base = kMicroseconds;
+  // A large bound keeps NTSC rates exact (29.97 -> 30000/1001).
+  codec->framerate = av_d2q(settings.nominalFps, 1 << 16);
+  codec->thread_count = settings.threads;
+  // BT.601 limited range, tagged, so that every decoder converts back the way sws converted here.
+  const bool rgb = pixelFormat == AV_PIX_FMT_BGR24;
+  codec->colorspace = rgb ? AVCOL_SPC_RGB : AVCOL_SPC_SMPTE170M;
+  codec->color_primaries = AVCOL_PRI_SMPTE170M;
+  codec->color_trc = AVCOL_TRC_SMPTE170M;
+  codec->color_range = rgb ? AVCOL_RANGE_JPEG : AVCOL_RANGE_MPEG;
+  if (settings.bitExact) codec->flags |= AV_CODEC_FLAG_BITEXACT;
+  if ((format->oformat->flags & AVFMT_GLOBALHEADER) != 0)
+    codec->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
+  const std::string crf = std::to_string(settings.crf);
+  if (network()) {
+    // A viewer sees each picture as soon as it is encoded (no look-ahead, no B-frames), and one
+    // that joins late waits at most a second for a keyframe.
+    codec->gop_size = std::max(1, static_cast<int>(std::lround(settings.nominalFps)));
+    codec->max_b_frames = 0;
+  }
+  pictureFormat = pixelFormat;
+  if (x264) {
+    codec->pix_fmt = pixelFormat;
+    av_opt_set(codec->priv_data, "preset", settings.preset.c_str(), 0);
+    av_opt_set(codec->priv_data, "crf", crf.c_str(), 0);
+    // x264's AVX-512 macroblock-tree kernel makes the output depend on leftover heap contents
+    // (seen with x264 164 r3095); without mbtree the same input gives the same bytes on every CPU.
+    if (settings.bitExact) av_opt_set(codec->priv_data, "x264-params", "mbtree=0", 0);
+    if (pixelFormat == AV_PIX_FMT_YUV444P) av_opt_set(codec->priv_data, "profile", "high444", 0);
+    if (network()) av_opt_set(codec->priv_data, "tune", "zerolatency", 0);
+  } else {
+    if (takes(encoder, pixelFormat)) {
+      codec->pix_fmt = pixelFormat;
+    } else if (pixelFormat == AV_PIX_FMT_YUV420P && takes(encoder, AV_PIX_FMT_NV12)) {
+      codec->pix_fmt = pictureFormat = AV_PIX_FMT_NV12;  // the same 4:2:0 samples, interleaved
+    } else if (pixelFormat == AV_PIX_FMT_YUV420P && takes(encoder, AV_PIX_FMT_VAAPI)) {
+      if (std::string why = useHardwareFrames(); !why.empty()) {
+        codec.reset();
+        return why;
+      }
+    } else {
+      codec.reset();
+      return fmt::format("takes no {} pictures", settings.pixelFormat);
+    }
+    // Constant quality where the encoder has it (the option is ignored where it does not), and a
+    // bit rate for those that only follow one.
+    av_opt_set(codec->priv_data, "rc", "vbr", 0);  // nvenc
+    av_opt_set(codec->priv_data, "cq", crf.c_str(), 0);
+    av_opt_set(codec->priv_data, "rc_mode", "CQP", 0);  // vaapi
+    av_opt_set(codec->priv_data, "qp", crf.c_str(), 0);
+    codec->bit_rate = static_cast<std::int64_t>(0.1 * settings.size.area() * settings.nominalFps);
+    if (network()) av_opt_set(codec->priv_data, "zerolatency", "1", 0);  // nvenc
+  }
+  // x264 checks the preset only here; a hardware encoder finds its device here.
+  if (const int error = avcodec_open2(codec.get(), encoder, nullptr); error < 0) {
+    codec.reset();
+    hwFrames.reset();
+    hwDevice.reset();
+    return x264 ? fmt::format("cannot open the H.264 encoder (preset '{}', crf {}, {}): {}",
+                              settings.preset, settings.crf, settings.pixelFormat,
+                              ffmpeg::errorText(error))
+                : fmt::format("cannot open {}: {}", encoder->name, ffmpeg::errorText(error));
+  }
+  return {};
+}
+
+std::string VideoEncoder::Impl::useHardwareFrames() {
+  AVBufferRef* device = nullptr;
+  if (const int error =
+          av_hwdevice_ctx_create(&device, AV_HWDEVICE_TYPE_VAAPI, nullptr, nullptr, 0);
+      error < 0) {
+    return fmt::format("no VA-API device: {}", ffmpeg::errorText(error));
+  }
+  hwDevice.reset(device);
+  hwFrames.reset(av_hwframe_ctx_alloc(device));
+  if (!hwFrames) fail("out of memory");
+  auto* frames = reinterpret_cast<AVHWFramesContext*>(hwFrames->data);
+  frames->format = AV_PIX_FMT_VAAPI;
+  frames->sw_format = AV_PIX_FMT_NV12;
+  frames->width = settings.size.width;
+  frames->height = settings.size.height;
+  frames->initial_pool_size = 4;
+  if (const int error = av_hwframe_ctx_init(hwFrames.get()); error < 0) {
+    hwFrames.reset();
+    hwDevice.reset();
+    return fmt::format("cannot make VA-API frames: {}", ffmpeg::errorText(error));
+  }
+  codec->pix_fmt = AV_PIX_FMT_VAAPI;
+  codec->hw_frames_ctx = av_buffer_ref(hwFrames.get());
+  pictureFormat = AV_PIX_FMT_NV12;
+  return {};
 }
 
 void VideoEncoder::Impl::drain(bool flushing) {
@@ -237,9 +370,19 @@ void VideoEncoder::write(const cv::Mat& bgr, std::chrono::nanoseconds timestamp)
   const int sourceStride[] = {static_cast<int>(bgr.step[0])};
   sws_scale(s.sws.get(), source, sourceStride, 0, bgr.rows, s.frame->data, s.frame->linesize);
   s.frame->pts = pts;
-  if (const int error = avcodec_send_frame(s.codec.get(), s.frame.get()); error < 0) {
-    s.fail("encoding failed", error);
+  AVFrame* picture = s.frame.get();
+  if (s.hwFrames) {
+    // Into one of the device's frames (from its pool): the encoder reads only those.
+    if (const int error = av_hwframe_get_buffer(s.hwFrames.get(), s.hwFrame.get(), 0); error < 0)
+      s.fail("no VA-API frame to encode into", error);
+    if (const int error = av_hwframe_transfer_data(s.hwFrame.get(), s.frame.get(), 0); error < 0)
+      s.fail("cannot upload the picture to the VA-API device", error);
+    s.hwFrame->pts = pts;
+    picture = s.hwFrame.get();
   }
+  const int sent = avcodec_send_frame(s.codec.get(), picture);
+  if (s.hwFrames) av_frame_unref(s.hwFrame.get());
+  if (sent < 0) s.fail("encoding failed", sent);
   s.drain(false);
   s.lastPts = pts;
   ++s.framesWritten;
@@ -285,5 +428,7 @@ const std::filesystem::path& VideoEncoder::path() const { return impl_->settings
 std::string VideoEncoder::target() const { return impl_->target(); }
 
 std::uint64_t VideoEncoder::framesWritten() const { return impl_->framesWritten; }
+
+std::string VideoEncoder::encoderName() const { return impl_->codec->codec->name; }
 
 }  // namespace surroundd::render

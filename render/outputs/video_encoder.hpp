@@ -1,7 +1,8 @@
 #pragma once
-// H.264 (libx264 through FFmpeg's libavcodec) into MP4 or MKV (chosen by the file extension), or
-// as MPEG-TS to a network address (`url`, e.g. udp://239.0.0.1:5600: tuned for latency, no
-// B-frames, a keyframe with its parameter sets every second so that a receiver can join any time).
+// H.264 (libx264, or a hardware encoder, through FFmpeg's libavcodec) into MP4 or MKV (chosen by
+// the file extension), or as MPEG-TS to a network address (`url`, e.g. udp://239.0.0.1:5600: tuned
+// for latency, no B-frames, a keyframe with its parameter sets every second so that a receiver can
+// join any time).
 //
 // The file is written as "<path>.part" and renamed to <path> only when it has been finalized
 // (trailer written), so a finished name always plays and nothing half-written carries it. close()
@@ -14,15 +15,25 @@
 // their relative start offsets. MP4 keeps them to the microsecond; Matroska to the millisecond (its
 // muxer forces a 1/1000 time base), so frames there must be at least 1 ms apart.
 //
+// The encoder: libx264, any H.264 encoder of this FFmpeg by name (h264_nvenc, h264_vaapi through
+// a VA-API device's frames, h264_v4l2m2m, ...), or "auto": the first hardware one of
+// kHardwareH264Encoders that opens here, else libx264, with one log line that says which and why.
+// x264's crf and preset apply to libx264; a hardware encoder gets the crf as its constant quality
+// where it has one (nvenc cq, vaapi qp) and a bit rate of 0.1 bit per pixel otherwise. bgr24 and
+// bit-exact output are libx264's only.
+//
 // Error policy: the constructor, write() and close() throw EncoderError with a message naming the
 // file; the caller decides whether to stop or drop the output. close() after zero frames throws
 // ("no frames written") and leaves no file: an empty video is not a useful output.
 
+#include <array>
 #include <chrono>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include <opencv2/core.hpp>
 
@@ -45,9 +56,17 @@ struct VideoEncoderSettings {
   int threads = 0;        // encoder threads; 0 = codec's choice. Fix it for identical bytes.
   bool bitExact = false;  // leave out version strings so the same input gives the same bytes
   std::string url;        // udp://HOST:PORT: MPEG-TS over UDP instead of a file
+  std::string encoder = "libx264";  // libx264 | auto | an FFmpeg H.264 encoder's name
 
   bool operator==(const VideoEncoderSettings&) const = default;
 };
+
+// The hardware H.264 encoders "auto" tries, in this order.
+inline constexpr std::array<const char*, 3> kHardwareH264Encoders{"h264_nvenc", "h264_vaapi",
+                                                                  "h264_v4l2m2m"};
+// Why `name` cannot be a VideoEncoderSettings::encoder here (not an H.264 encoder this FFmpeg
+// has); none if it can.
+std::optional<std::string> h264EncoderProblem(std::string_view name);
 
 class VideoEncoder {
  public:
@@ -66,6 +85,8 @@ class VideoEncoder {
   // The file's path or the URL, for messages.
   std::string target() const;
   std::uint64_t framesWritten() const;
+  // The FFmpeg encoder that writes it: "auto" resolved.
+  std::string encoderName() const;
 
  private:
   struct Impl;

@@ -63,6 +63,12 @@ void VideoSink::openSegment() {
   if (segmentLength_.count() > 0) settings.path = segmentPath(++segment_);
   encoder_.reset();  // finalizes the previous segment first
   encoder_.emplace(std::move(settings));
+  // The next segments go on with the encoder this one found, without trying the others again.
+  if (settings_.encoder == "auto" && !encoder_->encoderName().starts_with("libx264")) {
+    settings_.encoder = encoder_->encoderName();
+  } else if (settings_.encoder == "auto") {
+    settings_.encoder = "libx264";
+  }
 }
 
 void VideoSink::consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) {

@@ -5,11 +5,9 @@
 #include "capture/source_recovery.hpp"
 
 #include <fstream>
-#include <sstream>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
 
 #include "capture/camera_stream.hpp"
@@ -17,6 +15,7 @@
 #include "capture/v4l2_source.hpp"
 #include "render/outputs/video_encoder.hpp"
 #include "tests/capture/fake_v4l2_device.hpp"
+#include "tests/support/log_capture.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -30,31 +29,7 @@ using Step = SourceRecovery::Step;
 // NOLINTNEXTLINE(cert-err58-cpp): cv::Size stores two ints; its constructor throws nothing.
 const cv::Size kSize(320, 240);
 
-// Catches what is logged while it lives; the default logger is put back after.
-class LogCapture {
- public:
-  LogCapture() : previous_(spdlog::default_logger()) {
-    auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(text_);
-    sink->set_pattern("[%l] %v");
-    auto logger = std::make_shared<spdlog::logger>("capture", sink);
-    logger->set_level(spdlog::level::info);
-    spdlog::set_default_logger(logger);
-  }
-  ~LogCapture() { spdlog::set_default_logger(previous_); }
-  LogCapture(const LogCapture&) = delete;
-  LogCapture& operator=(const LogCapture&) = delete;
-
-  std::vector<std::string> lines() const {
-    std::vector<std::string> lines;
-    std::istringstream in(text_.str());
-    for (std::string line; std::getline(in, line);) lines.push_back(line);
-    return lines;
-  }
-
- private:
-  std::shared_ptr<spdlog::logger> previous_;
-  std::ostringstream text_;
-};
+using testing::LogCapture;
 
 RecoverySettings fastSettings() {
   RecoverySettings settings;

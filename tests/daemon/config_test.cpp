@@ -156,7 +156,20 @@ TEST_F(ConfigTest, SegmentedVideoNetworkStreamAndTheControlSocket) {
   EXPECT_EQ(config.outputs[2].kind, OutputKind::kNetwork);
   EXPECT_EQ(config.outputs[2].url, "udp://239.0.0.1:5600");
   EXPECT_EQ(config.outputs[2].crf, 28);
+  EXPECT_EQ(config.outputs[1].encoder, "auto");
   EXPECT_TRUE(config.outputs[2].path.empty());
+  // The H.264 encoder by name: one this FFmpeg has, and H.264.
+  EXPECT_EQ(loadConfig(configWith("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                                  "  - {type: video, path: out/a.mp4, encoder: libx264}"))
+                .outputs[1]
+                .encoder,
+            "libx264");
+  expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "  - {type: video, path: out/a.mp4, encoder: h264_warp}",
+                 {"outputs[1].encoder: this FFmpeg has no encoder 'h264_warp'"});
+  expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "  - {type: network, url: \"udp://127.0.0.1:5600\", encoder: mjpeg}",
+                 {"outputs[1].encoder: 'mjpeg' does not encode H.264"});
   EXPECT_EQ(config.control.socket, dir_ / "run/control.sock");
   const Config pages = loadConfig(
       configWith("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",

@@ -10,6 +10,7 @@
 
 #include "common/ffmpeg_util.hpp"
 #include "render/outputs/video_sink.hpp"
+#include "tests/support/log_capture.hpp"
 #include "tests/support/stream_receiver.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/support/test_support.hpp"
@@ -23,6 +24,7 @@ using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
+// NOLINTNEXTLINE(cert-err58-cpp): cv::Size stores two ints; its constructor throws nothing.
 const cv::Size kSize(320, 240);
 
 cv::Mat testPicture(int index) { return testing::syntheticPicture(kSize, index); }
@@ -208,6 +210,75 @@ TEST(VideoEncoder, RejectsBadSettingsNamingTheFile) {
   settings = settingsFor(dir / "no-such-folder" / "clip.mp4");
   rejects(settings, "cannot create");
   EXPECT_TRUE(std::filesystem::is_empty(dir.path()));  // nothing half-made, nothing renamed
+}
+
+// encoder: auto takes the first hardware encoder that opens, else libx264 and says why each did
+// not; on a machine without one (CI's) that is libx264, and the file plays the same.
+TEST(VideoEncoder, AutoFallsBackToLibx264SayingWhyEachHardwareEncoderDidNot) {
+  const testing::TempDir dir;
+  auto settings = settingsFor(dir / "auto.mp4");
+  settings.encoder = "auto";
+  settings.pixelFormat = "yuv420p";
+  settings.bitExact = false;
+  const testing::LogCapture log;
+  std::string name;
+  {
+    VideoEncoder encoder(settings);
+    name = encoder.encoderName();
+    for (int i = 0; i < 5; ++i) encoder.write(testPicture(i), timestampOf(i));
+    encoder.close();
+  }
+  const auto decoded = testing::decodeAll(settings.path);
+  ASSERT_EQ(decoded.images.size(), 5u);
+  EXPECT_GE(cv::PSNR(decoded.images[4], testPicture(4)), 30.0);
+  const auto lines = log.lines();
+  ASSERT_EQ(lines.size(), 1u);
+  const std::string& line = lines[0];
+  EXPECT_THAT(line, HasSubstr(settings.path.string()));
+  if (name == "libx264") {
+    EXPECT_THAT(line, HasSubstr("H.264 by libx264, as no hardware encoder opens here"));
+    for (const char* hardware : kHardwareH264Encoders) EXPECT_THAT(line, HasSubstr(hardware));
+  } else {
+    EXPECT_THAT(kHardwareH264Encoders, ::testing::Contains(name));
+    EXPECT_THAT(line, HasSubstr("H.264 by " + name));
+  }
+}
+
+// A named encoder is that one or an error naming it; what only x264 does is refused to the others.
+TEST(VideoEncoder, ANamedEncoderIsThatOneOrAClearError) {
+  const testing::TempDir dir;
+  auto settings = settingsFor(dir / "named.mp4");
+  settings.encoder = "libx264";
+  EXPECT_EQ(VideoEncoder(settings).encoderName(), "libx264");
+  std::filesystem::remove(settings.path.string() + ".part");
+  settings.pixelFormat = "bgr24";
+  EXPECT_EQ(VideoEncoder(settings).encoderName(), "libx264rgb");
+  std::filesystem::remove(settings.path.string() + ".part");
+
+  settings.encoder = "h264_nvenc";
+  EXPECT_THAT([&] { VideoEncoder{settings}; },
+              ThrowsMessage<EncoderError>(HasSubstr("pixel format bgr24 needs libx264")));
+  settings.pixelFormat = "yuv420p";
+  EXPECT_THAT([&] { VideoEncoder{settings}; },
+              ThrowsMessage<EncoderError>(HasSubstr("bit-exact output needs libx264")));
+  settings.bitExact = false;
+  settings.encoder = "mjpeg";
+  EXPECT_THAT([&] { VideoEncoder{settings}; },
+              ThrowsMessage<EncoderError>(HasSubstr("'mjpeg' does not encode H.264")));
+  settings.encoder = "h264_warp";
+  EXPECT_THAT([&] { VideoEncoder{settings}; },
+              ThrowsMessage<EncoderError>(HasSubstr("no encoder 'h264_warp'")));
+  EXPECT_FALSE(h264EncoderProblem("auto"));
+  EXPECT_FALSE(h264EncoderProblem("h264_vaapi"));
+  // Without a VA-API device (a machine with no GPU, as CI's) the encoder says so, and nothing is
+  // left behind.
+  if (!std::filesystem::exists("/dev/dri/renderD128")) {
+    settings.encoder = "h264_vaapi";
+    EXPECT_THAT([&] { VideoEncoder{settings}; },
+                ThrowsMessage<EncoderError>(
+                    AllOf(HasSubstr(settings.path.string()), HasSubstr("no VA-API device"))));
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
 }
 
 TEST(VideoEncoder, RejectsPicturesOfTheWrongShape) {
