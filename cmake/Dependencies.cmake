@@ -10,6 +10,8 @@ find_package(ZLIB REQUIRED)
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 pkg_check_modules(FFMPEG REQUIRED IMPORTED_TARGET libavformat libavcodec libavutil libswscale)
 pkg_check_modules(SYSTEMD REQUIRED IMPORTED_TARGET libsystemd)  # sd_notify: readiness, watchdog
+# tinygltf (libtinygltf-dev, a shared library in Debian): the car's own glTF model.
+pkg_check_modules(TINYGLTF REQUIRED IMPORTED_TARGET tinygltf)
 
 # SuiteSparse CHOLMOD (libsuitesparse-dev). SuiteSparse 7 installs a CMake config with this
 # target; Debian 12's 5.12 has neither that nor a pkg-config file, so look for it directly.

@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "render/gltf_car.hpp"
+
 namespace surroundd::daemon {
 
 processing::VehicleBody VehicleConfig::body() const {
@@ -24,6 +26,7 @@ render::CarDimensions VehicleConfig::car() const {
   car.frontOverhangM = frontOverhangM;
   car.rearOverhangM = rearOverhangM;
   car.marginM = marginM;
+  car.model = model;
   // The model is a box car: a footprint polygon draws as its bounding box.
   const auto corners = body().footprint;
   double minX = corners[0].x, maxX = minX, minY = corners[0].y, maxY = minY;
@@ -48,6 +51,18 @@ namespace {
 
 void readFootprint(YamlObject& v, VehicleConfig& c) {
   if (auto polygon = v.points("footprint", 3)) c.footprint = *polygon;
+}
+
+// Read whole here, so that a model that cannot be drawn is a config error, not a failed start.
+void readModel(YamlObject& v, VehicleConfig& c) {
+  if (!v.has("model")) return;
+  c.model = v.existingFile("model").value_or("");
+  if (c.model.empty()) return;
+  try {
+    render::loadGltfCar(c.model, c.car());
+  } catch (const render::CarModelError& e) {
+    v.error("model", e.what());
+  }
 }
 
 // The box and the polygon are two ways to give one shape; the overhangs must leave a wheelbase.
@@ -96,6 +111,13 @@ const ConfigKeys<VehicleConfig>& vehicleKeys() {
                   "the dark ground patch drawn around the model reaches this far out"),
       Key::flag("body_masks", &VehicleConfig::bodyMasks,
                 "mask the body out of the cameras that see it"),
+      Key::custom(
+          "model",
+          "the car's own 3D model drawn in the box instead of the procedural car: glTF 2.0 "
+          "(.glb or .gltf), front towards +Z and +Y up, scaled to length_m, width_m and height_m",
+          readModel,
+          [](const VehicleConfig& a, const VehicleConfig& b) { return a.model == b.model; }, {},
+          Shown::kExample),
   };
   return kKeys;
 }
@@ -151,6 +173,7 @@ void emitVehicle(YAML::Emitter& out, const VehicleConfig& v) {
   out << YAML::Key << "rear_overhang_m" << YAML::Value << v.rearOverhangM;
   out << YAML::Key << "margin_m" << YAML::Value << v.marginM;
   out << YAML::Key << "body_masks" << YAML::Value << v.bodyMasks;
+  if (!v.model.empty()) out << YAML::Key << "model" << YAML::Value << v.model.string();
   out << YAML::EndMap;
 }
 

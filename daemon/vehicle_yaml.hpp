@@ -2,8 +2,8 @@
 // The ego vehicle in YAML: one `vehicle:` block (in the config, or in a rig file) that feeds the
 // car model of the render, the body masks of the stitcher and the default sizes of the views. Its
 // keys (the box's length, width and height, ground clearance, overhangs, offset, or a footprint
-// polygon instead; the ground patch's margin; body_masks) are vehicleKeys()'s table, with their
-// ranges and docs; config/surroundd.reference.yaml shows them.
+// polygon instead; the ground patch's margin; body_masks; the car's own glTF model) are
+// vehicleKeys()'s table, with their ranges and docs; config/surroundd.reference.yaml shows them.
 //
 // Per camera, `body_mask:` adds to or replaces the computed mask: `{file: mask.png}` (white =
 // body, the lens's size) and/or `{polygon: [[u, v], ...]}` in pixels, `mode: add | replace`.
@@ -31,6 +31,7 @@ struct VehicleConfig {
   std::vector<std::array<double, 2>> footprint;  // empty: the length x width box
   double marginM = 0.3;
   bool bodyMasks = true;
+  std::filesystem::path model;  // glTF 2.0; empty: the procedural car
 
   processing::VehicleBody body() const;
   render::CarDimensions car() const;

@@ -7,6 +7,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "render/gltf_car.hpp"
+
 namespace surroundd::render {
 namespace {
 
@@ -34,7 +36,8 @@ class CarBuilder {
       for (const auto& corner : {p[0], p[k], p[k + 1]}) {
         out_.push_back({{corner[0], corner[1], corner[2]},
                         {normal[0], normal[1], normal[2]},
-                        {colour[0], colour[1], colour[2]}});
+                        {colour[0], colour[1], colour[2]},
+                        {0, 0}});
       }
     }
   }
@@ -89,8 +92,11 @@ class CarBuilder {
 
 }  // namespace
 
-std::vector<CarVertex> buildCarModel(const CarDimensions& car, double footprintRadiusM) {
-  std::vector<CarVertex> vertices;
+CarModel buildCarModel(const CarDimensions& car, double footprintRadiusM) {
+  CarModel model;
+  if (!car.model.empty()) model = loadGltfCar(car.model, car);
+  std::vector<CarVertex>& vertices = model.vertices;
+  const std::size_t first = vertices.size();
   CarBuilder build(vertices);
   const auto l = static_cast<float>(car.lengthM / 2);
   const auto w = static_cast<float>(car.widthM / 2);
@@ -107,6 +113,10 @@ std::vector<CarVertex> buildCarModel(const CarDimensions& car, double footprintR
   const float y1 = std::max(cy + w + margin, ring);
   build.face({{x0, y0, 0.01F}, {x1, y0, 0.01F}, {x1, y1, 0.01F}, {x0, y1, 0.01F}}, kFootprint,
              {0, 0, -1});
+  if (!car.model.empty()) {
+    model.parts.push_back({first, vertices.size() - first, -1});
+    return model;
+  }
 
   const float wheelRadius = std::min({0.34F, h * 0.23F, l * 0.3F});
   const float sill = std::max(static_cast<float>(car.groundClearanceM), wheelRadius * 0.9F);
@@ -134,7 +144,8 @@ std::vector<CarVertex> buildCarModel(const CarDimensions& car, double footprintR
                  light, {cx, cy, (belt + sill) / 2});
     }
   }
-  return vertices;
+  model.parts.push_back({first, vertices.size() - first, -1});
+  return model;
 }
 
 }  // namespace surroundd::render

@@ -38,9 +38,12 @@ constexpr const char* kCarVertex = R"(#version 300 es
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec3 a_colour;
+layout(location = 3) in vec2 a_uv;
 uniform mat4 u_viewProjection;
 out vec3 v_colour;
+out vec2 v_uv;
 void main() {
+  v_uv = a_uv;
   // One light from above, a little ahead and to the left, and some ambient.
   float lambert = max(dot(a_normal, normalize(vec3(0.3, 0.4, 1.0))), 0.0);
   v_colour = a_colour * (0.35 + 0.65 * lambert);
@@ -49,13 +52,15 @@ void main() {
 
 constexpr const char* kCarFragment = R"(#version 300 es
 precision mediump float;
+uniform sampler2D u_texture;  // the part's, or one white texel
 in vec3 v_colour;
+in vec2 v_uv;
 out vec4 o_colour;
 void main() {
 #ifdef PANORAMA_POSITIONS
   o_colour = vec4(0.0, 0.0, 0.0, 1.0);
 #else
-  o_colour = vec4(v_colour, 1.0);
+  o_colour = vec4(v_colour * texture(u_texture, v_uv).rgb, 1.0);
 #endif
 })";
 
@@ -125,6 +130,24 @@ void requireBgr(const cv::Mat& image, cv::Size size, const char* what) {
                                             what, size.width, size.height, image.cols, image.rows,
                                             image.type()));
   }
+}
+
+// A texture of the car model: 8-bit RGBA, repeated as glTF's default sampler does, mipmapped as the
+// car is often seen small.
+gl::Texture carTexture(const cv::Mat& rgba) {
+  gl::Texture texture;
+  glBindTexture(GL_TEXTURE_2D, texture.name());
+  const cv::Mat rows = rgba.isContinuous() ? rgba : rgba.clone();
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, rows.cols, rows.rows, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+               rows.data);
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  gl::check("uploading a car model texture");
+  return texture;
 }
 
 }  // namespace
@@ -217,16 +240,20 @@ SurroundScene::SurroundScene(const processing::SurroundMesh& mesh,
                static_cast<GLsizeiptr>(mesh.indices.size() * sizeof(std::uint32_t)),
                mesh.indices.data(), GL_STATIC_DRAW);
 
-  const std::vector<CarVertex> carModel = buildCarModel(car, mesh.innerRadiusM);
-  carVertexCount_ = static_cast<GLsizei>(carModel.size());
+  const CarModel carModel = buildCarModel(car, mesh.innerRadiusM);
+  carParts_ = carModel.parts;
   glBindVertexArray(carArray_.name());
   glBindBuffer(GL_ARRAY_BUFFER, carVertices_.name());
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(carModel.size() * sizeof(CarVertex)),
-               carModel.data(), GL_STATIC_DRAW);
+  glBufferData(GL_ARRAY_BUFFER,
+               static_cast<GLsizeiptr>(carModel.vertices.size() * sizeof(CarVertex)),
+               carModel.vertices.data(), GL_STATIC_DRAW);
   constexpr auto kCarStride = static_cast<GLsizei>(sizeof(CarVertex));
   attribute(0, 3, kCarStride, offsetof(CarVertex, position));
   attribute(1, 3, kCarStride, offsetof(CarVertex, normal));
   attribute(2, 3, kCarStride, offsetof(CarVertex, colour));
+  attribute(3, 2, kCarStride, offsetof(CarVertex, uv));
+  for (const cv::Mat& texture : carModel.textures) carTextures_.push_back(carTexture(texture));
+  carTextures_.push_back(carTexture(cv::Mat(1, 1, CV_8UC4, cv::Scalar::all(255))));
   glBindVertexArray(0);
   gl::check("setting up the surround scene");
 }
@@ -252,7 +279,13 @@ void SurroundScene::drawSurround(const cv::Matx44f& viewProjection, Pass pass) c
   glUseProgram(programs.car.name());
   glUniformMatrix4fv(programs.carViewProjection, 1, GL_TRUE, viewProjection.val);
   glBindVertexArray(carArray_.name());
-  glDrawArrays(GL_TRIANGLES, 0, carVertexCount_);
+  for (const CarModel::Part& part : carParts_) {
+    glBindTexture(GL_TEXTURE_2D,
+                  carTextures_[part.texture < 0 ? carTextures_.size() - 1
+                                                : static_cast<std::size_t>(part.texture)]
+                      .name());
+    glDrawArrays(GL_TRIANGLES, static_cast<GLint>(part.first), static_cast<GLsizei>(part.count));
+  }
   glBindVertexArray(0);
   glDisable(GL_DEPTH_TEST);
 }

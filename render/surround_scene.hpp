@@ -6,6 +6,7 @@
 
 #include <array>
 #include <optional>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -83,8 +84,9 @@ class SurroundScene {
   GLsizei meshIndexCount_;
   gl::VertexArray carArray_;
   gl::Buffer carVertices_;
-  GLsizei carVertexCount_;
-  gl::VertexArray emptyArray_;  // full-screen passes make their vertices from gl_VertexID
+  std::vector<CarModel::Part> carParts_;
+  std::vector<gl::Texture> carTextures_;  // the model's, then one white texel for parts without
+  gl::VertexArray emptyArray_;            // full-screen passes make their vertices from gl_VertexID
 };
 
 }  // namespace surroundd::render

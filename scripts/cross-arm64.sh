@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 scripts/install-deps.sh --cross-arm64
 
 sysroot="$PWD/build/arm64-sysroot"
-packages="libc6-dev,libstdc++-12-dev,libopencv-dev,libyaml-cpp-dev,libspdlog-dev,libfmt-dev,\
+packages="libc6-dev,libstdc++-12-dev,libopencv-dev,libyaml-cpp-dev,libtinygltf-dev,libspdlog-dev,libfmt-dev,\
 zlib1g-dev,libavcodec-dev,libavformat-dev,libavutil-dev,libswscale-dev,libsuitesparse-dev,\
 libegl-dev,libgles-dev,libx11-dev,libxext-dev,libdrm-dev,libgbm-dev,libturbojpeg0-dev,\
 libcamera-dev,libsystemd-dev,libgtest-dev,libgmock-dev,libmicrohttpd-dev,libeigen3-dev,libegl-mesa0,\

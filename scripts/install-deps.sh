@@ -9,7 +9,7 @@ set -eu
 
 PACKAGES="
   build-essential cmake ninja-build pkg-config ccache
-  libopencv-dev libyaml-cpp-dev libspdlog-dev libfmt-dev zlib1g-dev
+  libopencv-dev libyaml-cpp-dev libspdlog-dev libfmt-dev zlib1g-dev libtinygltf-dev
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   libsuitesparse-dev libeigen3-dev
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri

@@ -29,6 +29,12 @@ TEST_F(ConfigTest, TheVehicleSizesTheCarTheViewsAndTheBowl) {
           "vehicle: {length_m: 0.5, width_m: 0.4, height_m: 0.3, ground_clearance_m: 0.05, "
           "front_overhang_m: 0.1, rear_overhang_m: 0.1, x_m: 0.1, margin_m: 0.05}\n"));
   ASSERT_TRUE(robot.vehicle.has_value());
+  EXPECT_TRUE(robot.render.car.model.empty());
+  const std::filesystem::path model =
+      std::filesystem::path(SURROUNDD_SOURCE_DIR) / "tests/render/models/test_car.gltf";
+  const Config modelled = loadConfig(dir_.write(
+      "modelled.yaml", std::string(kGoodConfig) + "vehicle: {model: " + model.string() + "}\n"));
+  EXPECT_EQ(modelled.render.car.model, model);
   EXPECT_DOUBLE_EQ(robot.render.car.lengthM, 0.5);
   EXPECT_DOUBLE_EQ(robot.render.car.centreXM, 0.1);
   EXPECT_DOUBLE_EQ(robot.render.car.marginM, 0.05);
@@ -60,6 +66,12 @@ TEST_F(ConfigTest, VehicleAndBodyMaskMistakesAreNamed) {
                  {"vehicle.ground_clearance_m", "less than height_m"});
   expectOneError("capture:", "vehicle: {length_m: 1, front_overhang_m: 0.6}\ncapture:",
                  {"vehicle.front_overhang_m", "no wheelbase"});
+  // The car's own model is read whole at load, so that --check-config finds what cannot be drawn.
+  dir_.write("car.gltf", "{\"asset\": {\"version\": \"2.0\"}}");
+  expectOneError("capture:", "vehicle: {model: car.gltf}\ncapture:",
+                 {"vehicle.model", "car.gltf", "no scene"});
+  expectOneError(
+      "capture:", "vehicle: {model: nowhere.glb}\ncapture:", {"vehicle.model", "nowhere.glb"});
   expectOneError("      source: {file: left.mkv}",
                  "      source: {file: left.mkv}\n      body_mask: {mode: add}",
                  {"body_mask", "expected 'file'"});

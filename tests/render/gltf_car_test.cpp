@@ -1,0 +1,165 @@
+// The car's own glTF model (render/gltf_car.hpp) on tests/render/models/test_car.gltf, made for
+// these tests (CC0): a box body of one colour (indexed, no normals), a small yellow marker placed
+// at the back and turned half a turn about the model's up axis by its node (so it ends at the
+// front), and a roof quad textured with a 2x2 picture: red, green / blue, white, its first texel
+// at the front left. The model spans 2 x 1.5 x 4 (width, height, length) in glTF's axes.
+
+#include "render/gltf_car.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "processing/surround_mesh.hpp"
+#include "render/egl_context.hpp"
+#include "render/surround_view.hpp"
+#include "tests/support/temp_dir.hpp"
+
+namespace surroundd::render {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
+
+std::filesystem::path testCar() {
+  return std::filesystem::path(SURROUNDD_SOURCE_DIR) / "tests/render/models/test_car.gltf";
+}
+
+bool isMarker(const CarVertex& v) { return v.colour[0] > 0.99F && v.colour[2] < 0.01F; }
+
+TEST(GltfCar, FillsTheVehiclesBoxFrontForwardWithItsColoursAndTexture) {
+  CarDimensions car;  // 4.5 x 1.85 x 1.5
+  car.centreXM = 0.5;
+  const CarModel model = loadGltfCar(testCar(), car);
+  ASSERT_FALSE(model.vertices.empty());
+  cv::Vec3f lo(1e9F, 1e9F, 1e9F);
+  cv::Vec3f hi = -lo;
+  for (const CarVertex& v : model.vertices) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], v.position[k]);
+      hi[k] = std::max(hi[k], v.position[k]);
+    }
+  }
+  EXPECT_NEAR(lo[0], 0.5 - 2.25, 1e-5);
+  EXPECT_NEAR(hi[0], 0.5 + 2.25, 1e-5);
+  EXPECT_NEAR(lo[1], -0.925, 1e-5);
+  EXPECT_NEAR(hi[1], 0.925, 1e-5);
+  EXPECT_NEAR(lo[2], 0.0, 1e-5);
+  EXPECT_NEAR(hi[2], 1.5, 1e-5);
+
+  // The marker, turned to the front by its node: glTF's +Z is the vehicle's +x.
+  std::size_t markers = 0;
+  for (const CarVertex& v : model.vertices) {
+    if (!isMarker(v)) continue;
+    ++markers;
+    EXPECT_GE(v.position[0], 0.5F + 1.6F * 1.125F - 1e-4F);
+    EXPECT_LE(std::abs(v.position[1]), 0.3F * 0.925F + 1e-4F);
+  }
+  EXPECT_EQ(markers, 36u);  // six faces of two triangles
+
+  // Three parts: body and marker untextured (one part), the roof with the texture.
+  ASSERT_EQ(model.textures.size(), 1u);
+  const cv::Mat& texture = model.textures[0];
+  ASSERT_EQ(texture.type(), CV_8UC4);
+  ASSERT_EQ(texture.size(), cv::Size(2, 2));
+  EXPECT_EQ(texture.at<cv::Vec4b>(0, 0), cv::Vec4b(255, 0, 0, 255));  // RGBA
+  EXPECT_EQ(texture.at<cv::Vec4b>(1, 1), cv::Vec4b(255, 255, 255, 255));
+  ASSERT_EQ(model.parts.size(), 2u);
+  EXPECT_EQ(model.parts[0].texture, -1);
+  EXPECT_EQ(model.parts[1].texture, 0);
+  EXPECT_EQ(model.parts[1].count, 6u);
+  for (std::size_t i = model.parts[1].first; i < model.parts[1].first + 6; ++i) {
+    const CarVertex& roof = model.vertices[i];
+    EXPECT_NEAR(roof.position[2], 1.5F, 1e-5F);
+    EXPECT_NEAR(roof.normal[2], 1.0F, 1e-5F);  // the file's normal, up
+    // Its first texel's corner at the front left.
+    if (roof.uv[0] == 0 && roof.uv[1] == 0) {
+      EXPECT_GT(roof.position[0], 0.5F);
+      EXPECT_GT(roof.position[1], 0.0F);
+    }
+  }
+  // The faces without normals in the file get their own, pointing out of the box.
+  for (const CarVertex& v : model.vertices) {
+    const cv::Vec3f centre(0.5F, 0, 0.6F);
+    const cv::Vec3f out = cv::Vec3f(v.position[0], v.position[1], v.position[2]) - centre;
+    if (!isMarker(v)) {
+      EXPECT_GT(out.dot(cv::Vec3f(v.normal[0], v.normal[1], v.normal[2])), 0);
+    }
+  }
+  // The body's base colour factor (linear 0.5, 0.05, 0.05) as shown.
+  EXPECT_NEAR(model.vertices[0].colour[0], std::pow(0.5, 1 / 2.2), 1e-5);
+  EXPECT_NEAR(model.vertices[0].colour[1], std::pow(0.05, 1 / 2.2), 1e-5);
+}
+
+TEST(GltfCar, AFileThatIsNoUsableGltfIsOneClearError) {
+  const testing::TempDir dir;
+  const auto refuses = [](const std::filesystem::path& file, const std::string& why) {
+    EXPECT_THAT([&] { loadGltfCar(file, {}); },
+                ThrowsMessage<CarModelError>(AllOf(HasSubstr(file.string()), HasSubstr(why))))
+        << why;
+  };
+  refuses(dir / "none.glb", "not a file");
+  refuses(dir.write("car.obj", "v 0 0 0\n"), "expected a .glb or .gltf file");
+  refuses(dir.write("text.gltf", "a car\n"), "not glTF 2.0 that can be read");
+  refuses(dir.write("truncated.glb", "glTF\x02"), "not glTF 2.0 that can be read");
+
+  // The test car edited: no triangles (its primitives as points), then an index past its vertices.
+  std::ifstream in(testCar());
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string points = text;
+  for (std::size_t at = 0; (at = points.find("\"attributes\"", at)) != std::string::npos; ++at) {
+    points.insert(at, "\"mode\": 0, ");
+    at += 12;
+  }
+  refuses(dir.write("points.gltf", points), "its default scene has no triangles");
+  // The roof's four vertices given the body's indices, up to 7.
+  std::string badIndex = text;
+  const std::string roofIndices = "\"indices\": 6,";
+  ASSERT_NE(badIndex.find(roofIndices), std::string::npos);
+  badIndex.replace(badIndex.find(roofIndices), roofIndices.size(), "\"indices\": 1,");
+  refuses(dir.write("index.gltf", badIndex), "an index past its vertices");
+}
+
+// Drawn from above: the roof shows its texture the right way round (front up, left on the left),
+// the marker its colour at the front, each lit as the procedural car is.
+TEST(GltfCar, TheTopViewShowsTheModelTexturedTheRightWayRound) {
+  const EglContext context;
+  processing::PanoramaGeometry panorama;
+  panorama.size = {512, 256};
+  CarDimensions car;
+  car.model = testCar();
+  SurroundScene scene(processing::buildSurroundMesh({}, panorama), panorama, car, {320, 180});
+  scene.uploadPanorama(cv::Mat(panorama.size, CV_8UC3, cv::Scalar(90, 90, 90)));
+  const cv::Size size(640, 480);
+  const ViewSettings settings;
+  SurroundView view(scene, size, ViewKind::kTop, settings);
+  view.draw(0);
+  const cv::Mat picture = view.collect().clone();
+  const double pixelsPerMetre = size.height / (2 * settings.topRangeM);
+  const auto at = [&](double x, double y, double z) {
+    const double k = settings.topHeightM / (settings.topHeightM - z);  // nearer the eye, larger
+    return picture.at<cv::Vec3b>(
+        static_cast<int>(std::lround(size.height / 2.0 - x * pixelsPerMetre * k - 0.5)),
+        static_cast<int>(std::lround(size.width / 2.0 - y * pixelsPerMetre * k - 0.5)));
+  };
+  // Lit from above: 0.35 + 0.65 x cos(the light's angle from straight up).
+  const double lit = 255 * (0.35 + 0.65 / std::sqrt(1.25));
+  const auto expectColour = [&](const cv::Vec3b& seen, cv::Vec3d bgr, const char* what) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(seen[c], bgr[c] * lit, 3.0) << what << " " << seen;
+  };
+  expectColour(at(0.675, 0.37, 1.5), {0, 0, 1}, "roof, front left: red");
+  expectColour(at(0.675, -0.37, 1.5), {0, 1, 0}, "roof, front right: green");
+  expectColour(at(-0.675, 0.37, 1.5), {1, 0, 0}, "roof, back left: blue");
+  expectColour(at(-0.675, -0.37, 1.5), {1, 1, 1}, "roof, back right: white");
+  expectColour(at(2.05, 0, 1.4), {0, 1, 1}, "marker, front: yellow");
+  expectColour(at(-2.0, 0, 1.2),
+               {std::pow(0.05, 1 / 2.2), std::pow(0.05, 1 / 2.2), std::pow(0.5, 1 / 2.2)},
+               "body, back: its paint");
+}
+
+}  // namespace
+}  // namespace surroundd::render
