@@ -240,6 +240,9 @@ const ConfigKeys<RenderConfig>& renderKeys() {
                   {10.0, 150.0, false, "degrees"}, "orbit: vertical field of view"),
       Key::number("strip_top_deg", views(&ViewSettings::stripTopDeg),
                   {-60.0, 60.0, false, "degrees"}, "360: elevation at the top of each strip"),
+      Key::number("transition_s", views(&ViewSettings::transitionS), {0.0, 5.0, false, "seconds"},
+                  "a switch of view moves the eye there (top and orbit) or fades the pictures "
+                  "(the others) over this much stream time; 0: it cuts"),
       Key::text("split_camera", &RenderConfig::splitCamera, "the camera shown in the split view",
                 Shown::kExample),
       Key::flag("view_lut", &RenderConfig::viewLut,

@@ -25,7 +25,12 @@ cv::Rect letterbox(cv::Size picture, const cv::Rect& area) {
 
 SurroundView::SurroundView(const SurroundScene& scene, cv::Size size, ViewKind view,
                            ViewSettings settings)
-    : scene_(scene), size_(size), view_(view), settings_(settings), picture_(size, CV_8UC3) {
+    : scene_(scene),
+      size_(size),
+      view_(view),
+      settings_(settings),
+      from_(view),
+      picture_(size, CV_8UC3) {
   if (size.width <= 0 || size.height <= 0 || size.width % 2 != 0 || size.height % 2 != 0) {
     throw std::invalid_argument(fmt::format(
         "surround view: size must be even and positive, got {}x{}", size.width, size.height));
@@ -50,8 +55,30 @@ SurroundView::SurroundView(const SurroundScene& scene, cv::Size size, ViewKind v
   gl::check("creating a surround view");
 }
 
+void SurroundView::setView(ViewKind view) {
+  if (view == view_) return;
+  from_ = view_;
+  view_ = view;
+  transitioning_ = settings_.transitionS > 0;
+  transitionStartS_.reset();
+}
+
 bool SurroundView::moves() const {
-  return (view_ == ViewKind::kOrbit || view_ == ViewKind::kSplit) && orbitMoves(settings_);
+  return transitioning_ ||
+         ((view_ == ViewKind::kOrbit || view_ == ViewKind::kSplit) && orbitMoves(settings_));
+}
+
+double SurroundView::transitionProgress(double timeS) {
+  if (!transitioning_) return 1;
+  if (!transitionStartS_) transitionStartS_ = timeS;
+  const double t = (timeS - *transitionStartS_) / settings_.transitionS;
+  // Before its start: stream time went back (a replay that loops); the switch ends there. The
+  // margin: 2.4 - 2.0 is 0.39999... in doubles.
+  if (t >= 1 - 1e-9 || t < 0) {
+    transitioning_ = false;
+    return 1;
+  }
+  return t;
 }
 
 std::optional<cv::Rect> SurroundView::cameraArea() const {
@@ -60,9 +87,9 @@ std::optional<cv::Rect> SurroundView::cameraArea() const {
   return letterbox(scene_.cameraSize(), {half, 0, half, size_.height});
 }
 
-void SurroundView::drawScene(double timeS, SurroundScene::Pass pass) const {
+void SurroundView::drawScene(ViewKind view, double timeS, SurroundScene::Pass pass) const {
   glViewport(0, 0, size_.width, size_.height);
-  switch (view_) {
+  switch (view) {
     case ViewKind::kTop:
       scene_.drawSurround(topViewProjection(settings_, size_), pass);
       break;
@@ -78,7 +105,8 @@ void SurroundView::drawScene(double timeS, SurroundScene::Pass pass) const {
       glViewport(0, 0, half.width, half.height);
       scene_.drawSurround(orbitViewProjection(settings_, half, timeS), pass);
       if (pass == SurroundScene::Pass::kPicture) {
-        const cv::Rect camera = *cameraArea();
+        const cv::Rect camera =
+            letterbox(scene_.cameraSize(), {half.width, 0, half.width, half.height});
         glViewport(camera.x, camera.y, camera.width, camera.height);
         scene_.drawCamera();
       }
@@ -91,7 +119,31 @@ void SurroundView::draw(double timeS) {
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.name());
   glClearColor(0.08F, 0.08F, 0.08F, 1.0F);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  drawScene(timeS, SurroundScene::Pass::kPicture);
+  constexpr auto kPicture = SurroundScene::Pass::kPicture;
+  const double progress = transitionProgress(timeS);
+  const auto perspective = [](ViewKind view) {
+    return view == ViewKind::kTop || view == ViewKind::kOrbit;
+  };
+  if (progress >= 1) {
+    drawScene(view_, timeS, kPicture);
+  } else if (perspective(from_) && perspective(view_)) {
+    const auto pose = [&](ViewKind view) {
+      return view == ViewKind::kTop ? topViewPose(settings_, size_)
+                                    : orbitViewPose(settings_, timeS);
+    };
+    glViewport(0, 0, size_.width, size_.height);
+    scene_.drawSurround(viewProjection(poseBetween(pose(from_), pose(view_), progress), size_),
+                        kPicture);
+  } else {
+    // The new view over the old, more of it as the switch goes on.
+    drawScene(from_, timeS, kPicture);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_BLEND);
+    glBlendColor(0, 0, 0, static_cast<float>(transitionWeight(progress)));
+    glBlendFunc(GL_CONSTANT_ALPHA, GL_ONE_MINUS_CONSTANT_ALPHA);
+    drawScene(view_, timeS, kPicture);
+    glDisable(GL_BLEND);
+  }
   glBindBuffer(GL_PIXEL_PACK_BUFFER, readBuffer_.name());
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
   glReadPixels(0, 0, size_.width, size_.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
@@ -145,7 +197,7 @@ cv::Mat SurroundView::panoramaPositions(double timeS) const {
   }
   glClearColor(0, 0, 0, 0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  drawScene(timeS, SurroundScene::Pass::kPanoramaPositions);
+  drawScene(view_, timeS, SurroundScene::Pass::kPanoramaPositions);
   cv::Mat read(size_, CV_32FC4);
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
   glReadPixels(0, 0, size_.width, size_.height, GL_RGBA, GL_FLOAT, read.data);

@@ -21,11 +21,14 @@ class SurroundView {
   // `size`: even width and height. The scene must outlive the view.
   SurroundView(const SurroundScene& scene, cv::Size size, ViewKind view, ViewSettings settings);
 
-  void setView(ViewKind view) { view_ = view; }
+  // Shows `view` from the next draw() on: moving there over settings.transitionS of stream time
+  // (the eye's pose in between for top and orbit; the two pictures faded for the others), or at
+  // once with transitionS 0.
+  void setView(ViewKind view);
   ViewKind view() const { return view_; }
   cv::Size size() const { return size_; }
   // Whether its picture changes with stream time for the same panorama: the orbiting eye of the
-  // orbit and split views (ViewSettings::orbitPeriodS).
+  // orbit and split views (ViewSettings::orbitPeriodS), and a switch of view under way.
   bool moves() const;
   // Where the split view shows its camera's own picture, letterboxed in the right half; none for
   // the other views.
@@ -48,7 +51,10 @@ class SurroundView {
   static cv::Mat panoramaShown(const cv::Mat& panoramaPositions);
 
  private:
-  void drawScene(double timeS, SurroundScene::Pass pass) const;
+  void drawScene(ViewKind view, double timeS, SurroundScene::Pass pass) const;
+  // How far the switch of view has come at `timeS`, 0..1; 1 when none is under way (and it ends
+  // there). Its start is the first draw after setView().
+  double transitionProgress(double timeS);
 
   const SurroundScene& scene_;
   cv::Size size_;
@@ -59,6 +65,9 @@ class SurroundView {
   gl::Renderbuffer depth_;
   gl::Buffer readBuffer_;
   bool pending_ = false;
+  ViewKind from_;  // the view a switch under way started from
+  bool transitioning_ = false;
+  std::optional<double> transitionStartS_;
   cv::Mat picture_;
 };
 

@@ -67,24 +67,51 @@ std::optional<ViewKind> parseViewKind(std::string_view name) {
   return kind == kViewKinds.end() ? std::nullopt : std::optional(*kind);
 }
 
-cv::Matx44f topViewProjection(const ViewSettings& settings, cv::Size viewport) {
+ViewPose topViewPose(const ViewSettings& settings, cv::Size viewport) {
   const double aspect = aspectOf(viewport);
   // Half the picture's height on the ground: the range itself, or more where the picture is
   // taller than wide and its width is the shorter side.
   const double halfHeightM = aspect >= 1 ? settings.topRangeM : settings.topRangeM / aspect;
-  const double fovy = 2 * std::atan(halfHeightM / settings.topHeightM);
-  const cv::Vec3f eye(0, 0, static_cast<float>(settings.topHeightM));
-  return perspective(fovy, aspect) * lookAt(eye, {0, 0, 0}, {1, 0, 0});
+  return {{0, 0, settings.topHeightM},
+          {0, 0, 0},
+          {1, 0, 0},
+          2 * std::atan(halfHeightM / settings.topHeightM)};
+}
+
+ViewPose orbitViewPose(const ViewSettings& settings, double timeS) {
+  const double turns = orbitMoves(settings) ? timeS / settings.orbitPeriodS : 0;
+  const double angle = settings.orbitStartDeg * kDegToRad + 2 * std::numbers::pi * turns;
+  return {{settings.orbitRadiusM * std::cos(angle), settings.orbitRadiusM * std::sin(angle),
+           settings.orbitHeightM},
+          {0, 0, 0.5},
+          {0, 0, 1},
+          settings.orbitFovDeg * kDegToRad};
+}
+
+double transitionWeight(double t) {
+  const double s = std::clamp(t, 0.0, 1.0);
+  return s * s * (3 - 2 * s);
+}
+
+ViewPose poseBetween(const ViewPose& from, const ViewPose& to, double t) {
+  const double eased = transitionWeight(t);
+  const auto lerp = [eased](const auto& a, const auto& b) { return a + (b - a) * eased; };
+  return {lerp(from.eye, to.eye), lerp(from.target, to.target), cv::normalize(lerp(from.up, to.up)),
+          lerp(from.fovyRad, to.fovyRad)};
+}
+
+cv::Matx44f viewProjection(const ViewPose& pose, cv::Size viewport) {
+  const auto vec = [](const cv::Vec3d& v) { return cv::Vec3f(v); };
+  return perspective(pose.fovyRad, aspectOf(viewport)) *
+         lookAt(vec(pose.eye), vec(pose.target), vec(pose.up));
+}
+
+cv::Matx44f topViewProjection(const ViewSettings& settings, cv::Size viewport) {
+  return viewProjection(topViewPose(settings, viewport), viewport);
 }
 
 cv::Matx44f orbitViewProjection(const ViewSettings& settings, cv::Size viewport, double timeS) {
-  const double turns = orbitMoves(settings) ? timeS / settings.orbitPeriodS : 0;
-  const double angle = settings.orbitStartDeg * kDegToRad + 2 * std::numbers::pi * turns;
-  const cv::Vec3f eye(static_cast<float>(settings.orbitRadiusM * std::cos(angle)),
-                      static_cast<float>(settings.orbitRadiusM * std::sin(angle)),
-                      static_cast<float>(settings.orbitHeightM));
-  return perspective(settings.orbitFovDeg * kDegToRad, aspectOf(viewport)) *
-         lookAt(eye, {0, 0, 0.5F}, {0, 0, 1});
+  return viewProjection(orbitViewPose(settings, timeS), viewport);
 }
 
 bool orbitMoves(const ViewSettings& settings) { return settings.orbitPeriodS > 0; }

@@ -33,9 +33,27 @@ struct ViewSettings {
   double orbitStartDeg = 180;  // the eye's azimuth at stream time 0 (180: behind the vehicle)
   double orbitFovDeg = 60.0;   // vertical field of view
   double stripTopDeg = 15.0;   // 360 view: elevation at the top of each strip
+  double transitionS = 0.4;    // a switch of view moves there over this much stream time; 0: cuts
 
   bool operator==(const ViewSettings&) const = default;
 };
+
+// Where a perspective view's eye is and what it looks at (top, orbit).
+struct ViewPose {
+  cv::Vec3d eye;
+  cv::Vec3d target;
+  cv::Vec3d up;
+  double fovyRad = 1;  // vertical field of view
+};
+ViewPose topViewPose(const ViewSettings& settings, cv::Size viewport);
+ViewPose orbitViewPose(const ViewSettings& settings, double timeS);
+// How far a view switch has come at `t` of its time (0..1): eased in and out (smoothstep), so that
+// the eye starts and stops gently.
+double transitionWeight(double t);
+// transitionWeight(t) of the way from `from` to `to`: eye, target, up and field of view each in a
+// straight line.
+ViewPose poseBetween(const ViewPose& from, const ViewPose& to, double t);
+cv::Matx44f viewProjection(const ViewPose& pose, cv::Size viewport);
 
 cv::Matx44f topViewProjection(const ViewSettings& settings, cv::Size viewport);
 cv::Matx44f orbitViewProjection(const ViewSettings& settings, cv::Size viewport, double timeS);

@@ -181,7 +181,9 @@ outputs:
       processing::buildSurroundMesh(daemon::meshSettings(loaded),
                                     daemon::panoramaSettings(loaded).geometry),
       daemon::panoramaSettings(loaded).geometry, loaded.render.car, replay.lut.cameraSizes[0]);
-  render::SurroundView view(scene, {320, 240}, render::ViewKind::kOrbit, loaded.render.views);
+  render::ViewSettings cutting = loaded.render.views;  // the reference switches views at once
+  cutting.transitionS = 0;
+  render::SurroundView view(scene, {320, 240}, render::ViewKind::kOrbit, cutting);
   const auto rendered = [&](std::size_t k, render::ViewKind kind) {
     scene.uploadPanorama(replay.panorama(k));
     view.setView(kind);
@@ -257,7 +259,7 @@ outputs:
               "at_s: 0.52}");
   EXPECT_THAT(still, HasSubstr("the split view 320x240 is gathered from the camera"));
   EXPECT_THAT(still, HasSubstr("the orbit view 320x240 is gathered from the camera"));
-  render::ViewSettings stillEye = loaded.render.views;
+  render::ViewSettings stillEye = cutting;
   stillEye.orbitPeriodS = 0;
   stillEye.orbitStartDeg = 135;
   render::SurroundView stillView(scene, {320, 240}, render::ViewKind::kSplit, stillEye);

@@ -8,7 +8,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <numbers>
+#include <numeric>
 #include <utility>
 #include <vector>
 
@@ -55,10 +57,18 @@ processing::PanoramaGeometry testPanorama() {
   return p;
 }
 
+// Views switched at once: their pictures are compared with their golden ones (the switch itself:
+// TransitionsMove...).
+ViewSettings cutting() {
+  ViewSettings settings;
+  settings.transitionS = 0;
+  return settings;
+}
+
 struct Rendering {
   Rendering(processing::MeshModel model, cv::Size size, ViewKind view)
       : scene(mesh(model), testPanorama(), CarDimensions{}, {320, 180}),
-        surround(scene, size, view, ViewSettings{}) {
+        surround(scene, size, view, cutting()) {
     scene.uploadPanorama(codedPanorama(testPanorama().size));
     scene.uploadCamera(surroundd::testing::syntheticPicture({320, 180}, 3));
   }
@@ -78,19 +88,15 @@ struct Rendering {
 
 class SurroundViewTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { context_ = new EglContext(); }
-  static void TearDownTestSuite() {
-    delete context_;
-    context_ = nullptr;
-  }
-  static EglContext* context_;
+  static void SetUpTestSuite() { context = std::make_unique<EglContext>(); }
+  static void TearDownTestSuite() { context.reset(); }
+  inline static std::unique_ptr<EglContext> context;
 };
-EglContext* SurroundViewTest::context_ = nullptr;
 
 TEST_F(SurroundViewTest, MakesAHeadlessContext) {
-  RecordProperty("egl", context_->description());
-  EXPECT_NE(context_->description().find("OpenGL ES 3"), std::string::npos)
-      << context_->description();
+  RecordProperty("egl", context->description());
+  EXPECT_NE(context->description().find("OpenGL ES 3"), std::string::npos)
+      << context->description();
 }
 
 // Ground points at known vehicle-frame positions: in the top view they must land where its
@@ -132,7 +138,7 @@ void expectGroundPointsLandOnTheirPixels(processing::MeshModel model,
       ++best;
     }
     drawn *= 1.0 / best;
-    const auto panoramaPixelsPerMetre = [&](cv::Vec3d step) {
+    const auto panoramaPixelsPerMetre = [&](const cv::Vec3d& step) {
       const cv::Vec3d at(ground.x, ground.y, 0);
       const cv::Point2d d =
           panorama.pixel(at + step - panorama.centre) - panorama.pixel(at - step - panorama.centre);
@@ -169,6 +175,7 @@ TEST_F(SurroundViewTest, TopViewPutsGroundPointsOnTheirPixelsOnTheFlatDisk) {
 void expectMatchesGolden(const cv::Mat& picture, const std::string& name) {
   const std::filesystem::path golden =
       std::filesystem::path(SURROUNDD_SOURCE_DIR) / "tests/render/golden" / (name + ".png");
+  // NOLINTNEXTLINE(concurrency-mt-unsafe): read once, before any thread of the test starts.
   if (std::getenv("SURROUNDD_UPDATE_GOLDEN") != nullptr) {
     cv::imwrite(golden.string(), picture);
     GTEST_SKIP() << "wrote " << golden;
@@ -212,6 +219,69 @@ TEST_F(SurroundViewTest, SwitchingTheViewChangesThePictureAndBack) {
   EXPECT_GT(cv::norm(top, orbit, cv::NORM_L1) / static_cast<double>(top.total()), 10.0);
   EXPECT_EQ(cv::norm(top, topAgain, cv::NORM_INF), 0.0);
   EXPECT_EQ(rendering.surround.collect().data, buffer) << "the picture was reallocated";
+}
+
+// A switch of view takes ViewSettings::transitionS of stream time from the first draw after it:
+// between top and orbit the eye moves (starting from the old picture, ending on the new), between
+// others the two pictures fade; the view moves while it lasts.
+TEST_F(SurroundViewTest, ASwitchMovesTheEyeOrFadesOverTheTransitionTime) {
+  Rendering cut(processing::MeshModel::kBowl, {320, 240}, ViewKind::kTop);
+  const auto cutTo = [&](ViewKind view, double timeS) {
+    cut.surround.setView(view);
+    return cut.draw(timeS);
+  };
+  SurroundView view(cut.scene, {320, 240}, ViewKind::kTop, ViewSettings{});  // 0.4 s
+  const auto draw = [&](double timeS) {
+    view.draw(timeS);
+    return view.collect().clone();
+  };
+  const auto apart = [](const cv::Mat& a, const cv::Mat& b) {
+    return cv::norm(a, b, cv::NORM_L1) / static_cast<double>(a.total());
+  };
+  EXPECT_FALSE(view.moves());
+  view.setView(ViewKind::kOrbit);
+  EXPECT_TRUE(view.moves());
+  EXPECT_EQ(cv::norm(draw(1.0), cutTo(ViewKind::kTop, 1.0), cv::NORM_INF), 0.0);
+  const cv::Mat midway = draw(1.2);
+  EXPECT_GT(apart(midway, cutTo(ViewKind::kTop, 1.2)), 10.0);
+  EXPECT_GT(apart(midway, cutTo(ViewKind::kOrbit, 1.2)), 10.0);
+  EXPECT_EQ(cv::norm(draw(1.4), cutTo(ViewKind::kOrbit, 1.4), cv::NORM_INF), 0.0);
+
+  // Orbit to 360: faded, half and half at half the time.
+  view.setView(ViewKind::kPanorama360);
+  EXPECT_TRUE(view.moves());
+  draw(2.0);
+  cv::Mat half;
+  cv::addWeighted(cutTo(ViewKind::kOrbit, 2.2), 0.5, cutTo(ViewKind::kPanorama360, 2.2), 0.5, 0,
+                  half);
+  EXPECT_GE(cv::PSNR(draw(2.2), half), 40.0);
+  EXPECT_EQ(cv::norm(draw(2.4), cutTo(ViewKind::kPanorama360, 2.4), cv::NORM_INF), 0.0);
+  EXPECT_FALSE(view.moves());
+}
+
+// The eye's path from the top view to the orbit's start, drawn at 30 pictures a second over the
+// default 0.4 s: it starts and stops gently and never jumps, at most 1.5 times the mean step
+// (smoothstep's peak speed).
+TEST(ViewTransition, TheEyeStartsAndStopsGentlyAndNeverJumps) {
+  const ViewSettings settings;
+  const cv::Size size(1280, 720);
+  const ViewPose top = topViewPose(settings, size);
+  const ViewPose orbit = orbitViewPose(settings, 0);
+  const int frames = static_cast<int>(std::lround(settings.transitionS * 30));
+  std::vector<double> steps;
+  for (int k = 1; k <= frames; ++k) {
+    const ViewPose a = poseBetween(top, orbit, (k - 1.0) / frames);
+    const ViewPose b = poseBetween(top, orbit, static_cast<double>(k) / frames);
+    steps.push_back(cv::norm(b.eye - a.eye));
+  }
+  const double path = std::accumulate(steps.begin(), steps.end(), 0.0);
+  const double mean = path / frames;
+  EXPECT_NEAR(cv::norm(poseBetween(top, orbit, 1).eye - orbit.eye), 0.0, 1e-9);
+  EXPECT_LE(*std::max_element(steps.begin(), steps.end()), 1.5 * mean + 1e-9);
+  EXPECT_LT(steps.front(), 0.3 * mean);
+  EXPECT_LT(steps.back(), 0.3 * mean);
+  RecordProperty("eye_path_m", std::to_string(path));
+  RecordProperty("largest_step_m", std::to_string(*std::max_element(steps.begin(), steps.end())));
 }
 
 TEST_F(SurroundViewTest, OrbitMovesWithTimeAndReadBackIsCollectedOnce) {

@@ -241,10 +241,12 @@ TEST_F(ViewLutTest, EachFixedViewMatchesTheRenderer) {
 // With orbit_period_s 0 the orbit's eye stays where it starts: the picture of the moving orbit
 // at that azimuth, at any stream time. Only the moving orbit and split views move.
 TEST_F(ViewLutTest, AStillOrbitHoldsItsStartingPose) {
-  ViewSettings still;
+  ViewSettings cutting;  // views switched at once, for what moves() says of each
+  cutting.transitionS = 0;
+  ViewSettings still = cutting;
   still.orbitPeriodS = 0;
   still.orbitStartDeg = 225;  // the moving orbit's eye 2.5 s into its 20 s turn
-  SurroundView moving(rig->scene, {640, 360}, ViewKind::kOrbit, ViewSettings{});
+  SurroundView moving(rig->scene, {640, 360}, ViewKind::kOrbit, cutting);
   SurroundView held(rig->scene, {640, 360}, ViewKind::kOrbit, still);
   rig->show(Correction::kNone);
   moving.draw(2.5);
