@@ -205,14 +205,22 @@ cv::Mat SurroundView::panoramaPositions(double timeS) const {
   gl::check("mapping a view onto the panorama");
 
   const cv::Size panorama = scene_.panoramaSize();
+  // A plain loop, not cv::Mat::forEach: OpenCV's TBB threads hand the picture back through
+  // synchronisation that ThreadSanitizer cannot see, and the view LUT reads it on the work pool.
+  // Once per view switch, so the single thread costs nothing that matters.
+  constexpr float kNone = std::numeric_limits<float>::quiet_NaN();
+  const auto scale =
+      cv::Vec2f(static_cast<float>(panorama.width), static_cast<float>(panorama.height));
   cv::Mat result(size_, CV_32FC2);
-  read.forEach<cv::Vec4f>([&](const cv::Vec4f& texel, const int* at) {
-    constexpr float kNone = std::numeric_limits<float>::quiet_NaN();
-    result.at<cv::Vec2f>(at[0], at[1]) =
-        texel[2] < 0.5F ? cv::Vec2f(kNone, kNone)
-                        : cv::Vec2f(texel[0] * static_cast<float>(panorama.width) - 0.5F,
-                                    texel[1] * static_cast<float>(panorama.height) - 0.5F);
-  });
+  for (int y = 0; y < size_.height; ++y) {
+    const auto* texel = read.ptr<cv::Vec4f>(y);
+    auto* position = result.ptr<cv::Vec2f>(y);
+    for (int x = 0; x < size_.width; ++x) {
+      position[x] = texel[x][2] < 0.5F
+                        ? cv::Vec2f(kNone, kNone)
+                        : cv::Vec2f(texel[x][0] * scale[0] - 0.5F, texel[x][1] * scale[1] - 0.5F);
+    }
+  }
   return result;
 }
 
