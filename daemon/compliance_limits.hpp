@@ -8,6 +8,8 @@
 // - The first picture: FMVSS 111 (49 CFR 571.111, rear visibility) wants the rear view shown within
 //   2.0 s of the start of a backing event; surroundd's own target is 1 s with a warm LUT cache, so
 //   that a daemon started with the vehicle (or restarted) is in time with room to spare.
+// - A switch of view (reverse gear's rule, `surroundctl view`): held to the same 2.0 s from the
+//   request to the new view settled on screen, transition included; surroundd's target is 0.5 s.
 
 #include <chrono>
 
@@ -20,6 +22,7 @@ inline constexpr std::chrono::milliseconds kMaxLatency{200};  // strictly less, 
 inline constexpr const char* kFirstPictureStandard = "FMVSS 111";
 inline constexpr std::chrono::milliseconds kMaxFirstPicture{2000};     // at most
 inline constexpr std::chrono::milliseconds kFirstPictureTarget{1000};  // surroundd's, warm cache
+inline constexpr std::chrono::milliseconds kViewSwitchTarget{500};     // surroundd's, settled
 
 constexpr bool frameRateMet(double framesPerSecond) {
   return framesPerSecond >= kMinFramesPerSecond;
@@ -30,6 +33,12 @@ constexpr bool firstPictureMet(std::chrono::nanoseconds startup) {
 }
 constexpr bool firstPictureTargetMet(std::chrono::nanoseconds startup) {
   return startup <= kFirstPictureTarget;
+}
+constexpr bool viewSwitchMet(std::chrono::nanoseconds settled) {
+  return settled <= kMaxFirstPicture;
+}
+constexpr bool viewSwitchTargetMet(std::chrono::nanoseconds settled) {
+  return settled <= kViewSwitchTarget;
 }
 
 }  // namespace surroundd::daemon::limits

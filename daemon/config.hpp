@@ -26,6 +26,8 @@
 #include "render/car_model.hpp"
 #include "render/egl_context.hpp"
 #include "render/view_camera.hpp"
+#include "vehicle/can_signal_reader.hpp"
+#include "vehicle/vehicle_signals.hpp"
 
 namespace surroundd::daemon {
 
@@ -220,6 +222,26 @@ struct ControlConfig {
   bool operator==(const ControlConfig&) const = default;
 };
 
+// A view the vehicle's signals bring up (vehicle_signals.view_rules): when every condition it
+// names holds. Conditions on a signal that is unknown (never set, or stale) do not hold.
+struct ViewRule {
+  std::optional<vehicle::Gear> gear;
+  std::optional<vehicle::Indicator> indicator;
+  std::optional<double> speedBelowKmh;
+  std::optional<double> speedAboveKmh;
+  ViewKind view = ViewKind::kTop;
+
+  bool operator==(const ViewRule&) const = default;
+};
+
+struct VehicleSignalsConfig {
+  double staleAfterS = 1.0;         // a signal not renewed for this long reads as its safe default
+  std::vector<ViewRule> viewRules;  // the first that holds wins
+  std::optional<vehicle::CanSignalMapping> can;  // none: signals from the control socket alone
+
+  bool operator==(const VehicleSignalsConfig&) const = default;
+};
+
 struct Config {
   std::filesystem::path file;
   spdlog::level::level_enum logLevel = spdlog::level::info;
@@ -234,6 +256,7 @@ struct Config {
   MeshConfig mesh;
   RenderConfig render;
   ControlConfig control;
+  VehicleSignalsConfig vehicleSignals;
   std::vector<OutputConfig> outputs;
   // What is worth saying about a valid config (surroundd logs them at start, --check-config prints
   // them).

@@ -11,6 +11,7 @@
 #include "daemon/logging.hpp"
 #include "daemon/output_files.hpp"
 #include "daemon/output_type.hpp"
+#include "daemon/view_rules.hpp"
 #include "processing/colour/correction_domain.hpp"
 
 namespace surroundd::daemon {
@@ -277,6 +278,8 @@ Config readConfig(const YAML::Node& document, const std::filesystem::path& file)
   readMeshSection(root, config);
   addWarnings(config);
   readSection(root, "control", [&](YamlObject& s) { readControl(s, config.control); });
+  readSection(root, "vehicle_signals",
+              [&](YamlObject& s) { vehicleSignalsKeys().read(s, config.vehicleSignals); });
   readOutputs(root, config);
   root.finish();
   diag.throwIfAny();

@@ -4,6 +4,7 @@
 #include <array>
 
 #include "daemon/logging.hpp"
+#include "daemon/view_rules.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -286,7 +287,8 @@ std::vector<SectionDocs> sectionDocs() {
           {"mesh", meshKeys().docs()},
           {"render", renderKeys().docs()},
           {"control", controlKeys().docs()},
-          {"vehicle", vehicleKeys().docs()}};
+          {"vehicle", vehicleKeys().docs()},
+          {"vehicle_signals", vehicleSignalsKeys().docs()}};
 }
 
 }  // namespace surroundd::daemon

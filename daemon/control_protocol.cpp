@@ -33,15 +33,17 @@ ParsedRequest parseControlRequest(std::string_view line) {
     Kind kind;
     bool takesArgument;
   };
-  constexpr std::array<Known, 5> kCommands{{{"status", Kind::kStatus, false},
+  constexpr std::array<Known, 6> kCommands{{{"status", Kind::kStatus, false},
                                             {"metrics", Kind::kMetrics, false},
                                             {"view", Kind::kView, true},
+                                            {"signal", Kind::kSignal, true},
                                             {"snapshot", Kind::kSnapshot, false},
                                             {"reload", Kind::kReload, false}}};
   const auto* known = std::ranges::find(kCommands, command, &Known::name);
   if (known == kCommands.end()) {
     return {{},
-            fmt::format("unknown request '{}' (status, metrics, view NAME, snapshot, reload)",
+            fmt::format("unknown request '{}' (status, metrics, view NAME, signal ITEMS, "
+                        "snapshot, reload)",
                         command)};
   }
   if (known->takesArgument && argument.empty()) {

@@ -7,6 +7,8 @@
 //   status            -> the status text (frame rate, stages p50/p99, latency, cameras)
 //   metrics           -> Prometheus text format
 //   view NAME         -> switches every surround output to NAME (top, 360, orbit, split)
+//   signal ITEMS      -> the vehicle's signals, e.g. "gear=R steering_deg=-12.5 speed_kmh=3
+//                        indicator=left" (vehicle/vehicle_signals.hpp)
 //   snapshot          -> the newest output picture as a PNG
 //   reload            -> reads the config file again; a bad one is rejected, the old one runs on
 // Reply: "ok <body bytes>\n" then the body, or "error <message>\n".
@@ -25,9 +27,9 @@ namespace surroundd::daemon {
 inline constexpr std::size_t kMaxRequestBytes = 256;
 
 struct ControlRequest {
-  enum class Kind { kStatus, kMetrics, kView, kSnapshot, kReload };
+  enum class Kind { kStatus, kMetrics, kView, kSignal, kSnapshot, kReload };
   Kind kind = Kind::kStatus;
-  std::string argument;  // view: the view's name
+  std::string argument;  // view: the view's name; signal: its items
 };
 
 struct ParsedRequest {

@@ -112,6 +112,7 @@ PipelineReport Pipeline::report() const {
   report.latency = outputs_.latency();
   if (const auto first = outputs_.firstPictureAt()) report.startup = *first - runStart_.at;
   report.startupFrom = runStart_.from;
+  report.viewSwitch = outputs_.viewSwitch();
   report.outputs = outputs_.count();
   report.failedOutputs = outputs_.failures();
   report.failedSets = failedSets_;

@@ -58,14 +58,50 @@ void PipelineOutputs::drop(PictureOutput& output, const std::exception& error) {
 }
 
 void PipelineOutputs::handOver(PictureOutput& output, const cv::Mat& picture,
-                               std::chrono::nanoseconds streamTime, Clock::time_point origin) {
+                               std::chrono::nanoseconds streamTime, Clock::time_point origin,
+                               std::optional<render::DrawnPicture> drawn) {
   guarded(output, [&] {
     output.sink->consume(picture, streamTime);
     output.latest = picture;
     const auto now = Clock::now();
     latency_.record(now - origin);
     if (!firstPictureAt_) firstPictureAt_ = now;
+    if (drawn) timeSwitch(output, *drawn, now);
   });
+}
+
+void PipelineOutputs::switchView(PictureOutput& output, ViewKind view) {
+  output.view->setView(view);
+  output.switchSettled = false;
+  output.handedSinceSwitch = false;
+  if (render::ViewPage* page = output.sink ? output.sink->page() : nullptr) {
+    page->setActiveView(toString(view));
+  }
+}
+
+void PipelineOutputs::timeSwitch(PictureOutput& output, const render::DrawnPicture& drawn,
+                                 Clock::time_point now) {
+  if (!viewSwitch_ || viewSwitch_->settled) return;
+  output.handedSinceSwitch = true;
+  // A picture drawn before the request (the renderer's, handed over one set later) shows none of
+  // it, but its output is one to wait for.
+  if (drawn.at < viewSwitch_->requestedAt) return;
+  if (!viewSwitch_->first) viewSwitch_->first = now - viewSwitch_->requestedAt;
+  if (!drawn.settled) return;
+  output.switchSettled = true;
+  const bool allSettled = std::ranges::all_of(pictures_, [](const PictureOutput& o) {
+    return !o.view || !o.sink || o.switchSettled || !o.handedSinceSwitch;
+  });
+  if (!allSettled) return;
+  viewSwitch_->settled = now - viewSwitch_->requestedAt;
+  spdlog::info("view switch: {}", viewSwitchWithLimits(*viewSwitch()));
+}
+
+std::optional<ViewSwitchTime> PipelineOutputs::viewSwitch() const {
+  if (!viewSwitch_ || !viewSwitch_->first) return std::nullopt;
+  ViewSwitchTime time{*viewSwitch_->first, std::nullopt};
+  if (viewSwitch_->settled) time.settled = *viewSwitch_->settled;
+  return time;
 }
 
 void PipelineOutputs::record(const capture::FrameSet& set) {
@@ -109,7 +145,11 @@ void PipelineOutputs::followPages(bool statusDue, const std::function<std::strin
     render::ViewPage* page = output.sink ? output.sink->page() : nullptr;
     if (page == nullptr) continue;
     if (const auto name = page->takeViewRequest(); name && output.view) {
-      if (const auto view = render::parseViewKind(*name)) output.view->setView(*view);
+      if (const auto view = render::parseViewKind(*name)) {
+        for (auto& other : pictures_) other.switchSettled = true;
+        viewSwitch_ = ViewSwitch{Clock::now(), std::nullopt, std::nullopt};
+        switchView(output, *view);
+      }
     }
     if (statusDue) {
       if (text.empty()) text = status();
@@ -119,12 +159,9 @@ void PipelineOutputs::followPages(bool statusDue, const std::function<std::strin
 }
 
 void PipelineOutputs::setView(ViewKind view) {
+  viewSwitch_ = ViewSwitch{Clock::now(), std::nullopt, std::nullopt};
   for (auto& output : pictures_) {
-    if (!output.view) continue;
-    output.view->setView(view);
-    if (render::ViewPage* page = output.sink ? output.sink->page() : nullptr) {
-      page->setActiveView(toString(view));
-    }
+    if (output.view) switchView(output, view);
   }
 }
 

@@ -23,6 +23,7 @@
 #include "daemon/camera_frames_sink.hpp"
 #include "daemon/config.hpp"
 #include "daemon/duration_histogram.hpp"
+#include "daemon/pipeline_report.hpp"
 #include "render/outputs/frame_sink.hpp"
 #include "render/surround_view.hpp"
 
@@ -46,6 +47,11 @@ class PipelineOutputs {
     std::chrono::nanoseconds pendingTime{0};  // stream time of the view's pending picture
     Clock::time_point pendingOrigin{};        // capture time of the pending picture's set
     cv::Mat latest;                           // header over the picture last handed over
+    // The current switch of view: whether the output shows it settled (or was spared it), and
+    // whether it has had any picture since (an output that takes none, a snapshot after its
+    // time, does not hold the switch's end back).
+    bool switchSettled = true;
+    bool handedSinceSwitch = false;
   };
 
   // `nominalFps`: the cameras' frame rate; `latestWins`: live, queues drop their oldest picture.
@@ -72,9 +78,10 @@ class PipelineOutputs {
       drop(output, e);
     }
   }
-  // Hands `picture` of the set captured at `origin` to the output (guarded), timing the latency.
+  // Hands `picture` of the set captured at `origin` to the output (guarded), timing the latency;
+  // a surround view's picture says when it was drawn, timing a switch of view.
   void handOver(PictureOutput& output, const cv::Mat& picture, std::chrono::nanoseconds streamTime,
-                Clock::time_point origin);
+                Clock::time_point origin, std::optional<render::DrawnPicture> drawn = std::nullopt);
   // Each recording's copy of the set.
   void record(const capture::FrameSet& set);
   // Opens again the failed outputs whose retry is due.
@@ -101,10 +108,21 @@ class PipelineOutputs {
   const DurationHistogram& latency() const { return latency_; }
   // When the first picture was handed to an output; empty before.
   std::optional<Clock::time_point> firstPictureAt() const { return firstPictureAt_; }
+  // The last switch of view's times; empty before its first picture.
+  std::optional<ViewSwitchTime> viewSwitch() const;
 
  private:
   void open(PictureOutput& output);
   void drop(PictureOutput& output, const std::exception& error);
+  // Switches `output`'s view as part of the switch requested now.
+  void switchView(PictureOutput& output, ViewKind view);
+  void timeSwitch(PictureOutput& output, const render::DrawnPicture& drawn, Clock::time_point now);
+
+  struct ViewSwitch {
+    Clock::time_point requestedAt;
+    std::optional<Clock::duration> first;
+    std::optional<Clock::duration> settled;
+  };
 
   double nominalFps_;
   bool latestWins_;
@@ -113,6 +131,7 @@ class PipelineOutputs {
   std::uint64_t failures_ = 0;
   DurationHistogram latency_;  // a set's capture to its picture handed to an output
   std::optional<Clock::time_point> firstPictureAt_;
+  std::optional<ViewSwitch> viewSwitch_;
 };
 
 }  // namespace surroundd::daemon

@@ -24,6 +24,13 @@ void family(std::string& out, std::string_view name, std::string_view type, std:
                  help, name, type);
 }
 
+// One sample with one label, in seconds: surroundd_NAME{LABEL="VALUE"} 0.620000
+void seconds(std::string& out, std::string_view name, std::string_view label,
+             std::string_view value, std::chrono::duration<double> time) {
+  fmt::format_to(std::back_inserter(out), "surroundd_{}{{{}=\"{}\"}} {:.6f}\n", name, label, value,
+                 time.count());
+}
+
 // A Prometheus summary: p50, p90 and p99 from the histogram, with its sum and count.
 void summary(std::string& out, std::string_view name, std::string_view labels,
              const DurationHistogram& histogram) {
@@ -73,6 +80,19 @@ std::string startupWithLimits(std::chrono::duration<double> startup, StartupFrom
                      verdict(limits::firstPictureTargetMet(exact)));
 }
 
+std::string viewSwitchWithLimits(const ViewSwitchTime& time) {
+  if (!time.settled) {
+    return fmt::format("under way, first picture {:.2f} s after the request", time.first.count());
+  }
+  const auto exact = std::chrono::duration_cast<std::chrono::nanoseconds>(*time.settled);
+  return fmt::format(
+      "first picture {:.2f} s, settled {:.2f} s after the request ({}: <= {:.1f} s, {}; target "
+      "<= {:.1f} s, {})",
+      time.first.count(), time.settled->count(), limits::kFirstPictureStandard,
+      seconds(limits::kMaxFirstPicture), verdict(limits::viewSwitchMet(exact)),
+      seconds(limits::kViewSwitchTarget), verdict(limits::viewSwitchTargetMet(exact)));
+}
+
 std::string statusLine(const PipelineReport& report) {
   std::string cameras;
   for (const auto& camera : report.cameras) {
@@ -112,6 +132,10 @@ std::string statusText(const PipelineReport& report) {
   fmt::format_to(std::back_inserter(out), "first picture: {}\n",
                  report.startup ? startupWithLimits(*report.startup, report.startupFrom)
                                 : std::string("none yet"));
+  if (report.viewSwitch) {
+    fmt::format_to(std::back_inserter(out), "view switch: {}\n",
+                   viewSwitchWithLimits(*report.viewSwitch));
+  }
   for (std::size_t c = 0; c < report.cameras.size(); ++c) {
     const auto& camera = report.cameras[c];
     fmt::format_to(std::back_inserter(out),
@@ -168,8 +192,19 @@ std::string prometheusText(const PipelineReport& report) {
                      limits::kFirstPictureStandard, seconds(limits::kMaxFirstPicture),
                      seconds(limits::kFirstPictureTarget)));
   if (report.startup) {
-    fmt::format_to(std::back_inserter(out), "surroundd_startup_seconds{{since=\"{}\"}} {:.6f}\n",
-                   toString(report.startupFrom), report.startup->count());
+    seconds(out, "startup_seconds", "since", toString(report.startupFrom), *report.startup);
+  }
+  family(out, "view_switch_seconds", "gauge",
+         fmt::format("The last switch of view, from its request to the first picture drawn after "
+                     "it (picture=\"first\") and to every switched output's new view settled "
+                     "(picture=\"settled\"); absent before ({}: at most {:g}; target {:g}).",
+                     limits::kFirstPictureStandard, seconds(limits::kMaxFirstPicture),
+                     seconds(limits::kViewSwitchTarget)));
+  if (report.viewSwitch) {
+    seconds(out, "view_switch_seconds", "picture", "first", report.viewSwitch->first);
+    if (const auto settled = report.viewSwitch->settled) {
+      seconds(out, "view_switch_seconds", "picture", "settled", *settled);
+    }
   }
 
   const auto perCamera = [&](std::string_view name, std::string_view type, std::string_view help,

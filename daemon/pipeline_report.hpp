@@ -41,6 +41,14 @@ struct CameraReport {
   std::size_t queued = 0;  // frames waiting between its capture thread and the synchronizer
 };
 
+// The last switch of view (Pipeline::setView, or an output's page): from its request to the first
+// picture drawn after it, and to the first picture of every switched output showing the new view
+// settled (its transition over); `settled` is empty while the switch is under way.
+struct ViewSwitchTime {
+  std::chrono::duration<double> first{0};
+  std::optional<std::chrono::duration<double>> settled;
+};
+
 struct PipelineReport {
   std::chrono::duration<double> elapsed{0};
   std::uint64_t frameSets = 0;
@@ -52,6 +60,7 @@ struct PipelineReport {
   // From the run's start to its first picture handed to an output; empty before.
   std::optional<std::chrono::duration<double>> startup;
   StartupFrom startupFrom = StartupFrom::kPipeline;
+  std::optional<ViewSwitchTime> viewSwitch;  // empty before the first switch's first picture
   std::size_t outputs = 0;
   std::uint64_t failedOutputs = 0;
   std::uint64_t failedSets = 0;     // frame sets a stage failed on (dropped)
@@ -78,6 +87,9 @@ std::string frameRateWithLimit(double framesPerSecond);
 std::string latencyWithLimit(const DurationHistogram& latency);
 // "0.62 s after the process started (FMVSS 111: <= 2.0 s, met; target <= 1.0 s, met)"
 std::string startupWithLimits(std::chrono::duration<double> startup, StartupFrom from);
+// "first picture 0.04 s, settled 0.45 s after the request (FMVSS 111: <= 2.0 s, met; target <=
+// 0.5 s, met)", or "under way, first picture 0.04 s after the request"
+std::string viewSwitchWithLimits(const ViewSwitchTime& time);
 
 // Prometheus text exposition format (version 0.0.4), metric names prefixed surroundd_.
 std::string prometheusText(const PipelineReport& report);

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
+#include "daemon/view_rules.hpp"
 #include "render/view_camera.hpp"
 
 namespace surroundd::daemon {
@@ -64,7 +65,10 @@ Service::Service(Config config, ServiceSignals& signals, ServiceNotifier notifie
     : config_(std::move(config)),
       nextStart_{processStart, StartupFrom::kProcess},
       signals_(signals),
-      notifier_(std::move(notifier)) {
+      notifier_(std::move(notifier)),
+      vehicle_(std::chrono::duration_cast<vehicle::VehicleSignalState::Clock::duration>(
+          std::chrono::duration<double>(config_.vehicleSignals.staleAfterS))),
+      chosenView_(config_.render.view) {
   const auto socket =
       config_.control.socket.empty() ? defaultControlSocket() : config_.control.socket;
   if (socket.empty()) {
@@ -93,6 +97,16 @@ int Service::run() {
       continue;
     }
     endRun_ = false;
+    ruledView_.reset();
+    ruleChecked_ = false;
+    vehicle_.setStaleAfter(std::chrono::duration_cast<vehicle::VehicleSignalState::Clock::duration>(
+        std::chrono::duration<double>(config_.vehicleSignals.staleAfterS)));
+    can_.reset();
+    if (config_.vehicleSignals.can) {
+      can_ = std::make_unique<vehicle::CanSignalReader>(*config_.vehicleSignals.can,
+                                                        vehicle::makeSocketCanBus(),
+                                                        std::chrono::steady_clock::now());
+    }
     const RunSummary summary = pipeline->run(endRun_, this);
     pipeline.reset();
     releaseFreedMemory();
@@ -129,6 +143,8 @@ void Service::onLoop(Pipeline& pipeline, std::chrono::steady_clock::time_point n
   if (control_) {
     control_->serve([&](const ControlRequest& request) { return answer(pipeline, request); });
   }
+  if (can_) can_->poll(vehicle_, now);
+  followViewRules(pipeline, now);
   // With every output failed nothing is recorded: the watchdog is no longer fed, so systemd
   // restarts the service if the outputs do not come back first.
   const bool outputsWork = pipeline.outputsWork();
@@ -138,6 +154,28 @@ void Service::onLoop(Pipeline& pipeline, std::chrono::steady_clock::time_point n
     notifier_.status(now,
                      outputsWork ? line : "degraded: every output has failed, retrying; " + line);
   }
+}
+
+void Service::followViewRules(Pipeline& pipeline, std::chrono::steady_clock::time_point now) {
+  const ViewRule* rule = ruleThatHolds(config_.vehicleSignals.viewRules, vehicle_.at(now));
+  const std::optional<ViewKind> ruled = rule != nullptr ? std::optional(rule->view) : std::nullopt;
+  if (ruleChecked_ && ruled == ruledView_) return;
+  // A run starts in its outputs' own views: only a rule that holds switches them then.
+  const bool first = !ruleChecked_;
+  ruleChecked_ = true;
+  ruledView_ = ruled;
+  if (first && !ruled) return;
+  const ViewKind view = ruled.value_or(chosenView_);
+  spdlog::info("view rules: {} ({})", toString(view),
+               rule != nullptr ? describe(*rule) : "no rule holds: the view chosen last");
+  pipeline.setView(view);
+}
+
+std::string Service::vehicleStatus(std::chrono::steady_clock::time_point now) const {
+  const ViewRule* rule = ruleThatHolds(config_.vehicleSignals.viewRules, vehicle_.at(now));
+  return fmt::format("vehicle: {}{}\nview rule: {}\n", vehicle_.describe(now),
+                     can_ ? "; " + can_->describe(now) : std::string(),
+                     rule != nullptr ? describe(*rule) : "none holds");
 }
 
 void Service::onStopping() {
@@ -174,7 +212,8 @@ ControlAnswer Service::answer(Pipeline& pipeline, const ControlRequest& request)
   using Kind = ControlRequest::Kind;
   switch (request.kind) {
     case Kind::kStatus:
-      return ControlReply::success(statusText(pipeline.report()));
+      return ControlReply::success(statusText(pipeline.report()) +
+                                   vehicleStatus(std::chrono::steady_clock::now()));
     case Kind::kMetrics:
       return ControlReply::success(prometheusText(pipeline.report()));
     case Kind::kView: {
@@ -183,8 +222,18 @@ ControlAnswer Service::answer(Pipeline& pipeline, const ControlRequest& request)
         return ControlReply::failure(
             fmt::format("unknown view '{}' (top, 360, orbit, split)", request.argument));
       }
+      chosenView_ = *view;
       pipeline.setView(*view);
       return ControlReply::success(fmt::format("view {}\n", request.argument));
+    }
+    case Kind::kSignal: {
+      const auto now = std::chrono::steady_clock::now();
+      if (const auto error = vehicle_.set(request.argument, now)) {
+        return ControlReply::failure("signal: " + *error);
+      }
+      // The view it brings up is switched to right away, before the next frame set.
+      followViewRules(pipeline, now);
+      return ControlReply::success(vehicle_.describe(now) + "\n");
     }
     case Kind::kSnapshot: {
       const cv::Mat picture = pipeline.latestPicture();

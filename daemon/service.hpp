@@ -10,6 +10,11 @@
 // new names where the files hold the last run's data (daemon/output_files.hpp). The control
 // socket stays where it was.
 //
+// The vehicle's signals (`surroundctl signal`, and the CAN bus of vehicle_signals.can, read on
+// every loop) outlive runs too: the view rules of
+// vehicle_signals are evaluated on every loop, and when the rule that holds changes, every
+// surround output switches to its view, or back to the view chosen last by hand when none holds.
+//
 // Threads: everything here runs on the pipeline thread, but for the signal flags (atomics set by
 // the signal handlers) and the control server's own thread (see ControlServer).
 
@@ -18,11 +23,14 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "daemon/config.hpp"
 #include "daemon/control_server.hpp"
 #include "daemon/pipeline.hpp"
 #include "daemon/service_notifier.hpp"
+#include "vehicle/can_signal_reader.hpp"
+#include "vehicle/vehicle_signals.hpp"
 
 namespace surroundd::daemon {
 
@@ -50,6 +58,9 @@ class Service final : public PipelineObserver {
   ControlAnswer answer(Pipeline& pipeline, const ControlRequest& request);
   // Reads the config file again; a good config becomes pending and ends the run.
   ControlReply reload();
+  // Switches the surround outputs when the view rule that holds has changed.
+  void followViewRules(Pipeline& pipeline, std::chrono::steady_clock::time_point now);
+  std::string vehicleStatus(std::chrono::steady_clock::time_point now) const;
 
   Config config_;
   std::optional<Config> pending_;  // a good new config, started when the current run has ended
@@ -62,6 +73,13 @@ class Service final : public PipelineObserver {
   ServiceNotifier notifier_;
   std::unique_ptr<ControlServer> control_;
   std::atomic<bool> endRun_{false};  // read by Pipeline::run; set on this same thread
+  vehicle::VehicleSignalState vehicle_;
+  std::unique_ptr<vehicle::CanSignalReader> can_;  // with vehicle_signals.can; opened per run
+  ViewKind chosenView_;                            // by hand (surroundctl view), else render.view
+  // The view of the rule that held at the last loop; none: no rule held. Unset at each run's
+  // start, so that a new pipeline gets the rule's view too.
+  std::optional<ViewKind> ruledView_;
+  bool ruleChecked_ = false;  // this run
 };
 
 }  // namespace surroundd::daemon

@@ -121,6 +121,7 @@ void SurroundView::draw(double timeS) {
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   constexpr auto kPicture = SurroundScene::Pass::kPicture;
   const double progress = transitionProgress(timeS);
+  drawn_ = {std::chrono::steady_clock::now(), progress >= 1};
   const auto perspective = [](ViewKind view) {
     return view == ViewKind::kTop || view == ViewKind::kOrbit;
   };

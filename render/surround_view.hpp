@@ -6,6 +6,7 @@
 // frame's stitch) while the GPU finishes; collect() then waits for the pixels. Nothing is
 // allocated per frame.
 
+#include <chrono>
 #include <optional>
 
 #include <opencv2/core.hpp>
@@ -15,6 +16,13 @@
 #include "render/view_camera.hpp"
 
 namespace surroundd::render {
+
+// When a view's picture was drawn, and whether it shows its view settled (no switch under way):
+// what the time from a switch's request to the new view on screen is measured by.
+struct DrawnPicture {
+  std::chrono::steady_clock::time_point at;
+  bool settled = true;
+};
 
 class SurroundView {
  public:
@@ -37,6 +45,8 @@ class SurroundView {
   // Renders the scene as it was last uploaded; `timeS` moves the orbiting eye.
   void draw(double timeS);
   bool pending() const { return pending_; }
+  // The last draw(): when, and whether the switch of view had ended by then.
+  DrawnPicture drawn() const { return drawn_; }
   // The picture of the last draw(), 8-bit BGR; valid until the next collect().
   const cv::Mat& collect();
 
@@ -68,6 +78,7 @@ class SurroundView {
   ViewKind from_;  // the view a switch under way started from
   bool transitioning_ = false;
   std::optional<double> transitionStartS_;
+  DrawnPicture drawn_;
   cv::Mat picture_;
 };
 

@@ -9,22 +9,11 @@ cd "$(dirname "$0")/.."
 input=${1:-480p}
 seconds=${2:-20}
 latest=${3:-auto}
-recording=$PWD/recordings/bench/$input
-[ -f "$recording/rig.yaml" ] || { echo "latency: no $recording; run scripts/bench.sh first" >&2; exit 2; }
-cmake --preset release >/dev/null
-cmake --build --preset release --target surroundd surroundctl >/dev/null
-panorama=$(sed -n 's/.*panorama_size=\([0-9]*\)x\([0-9]*\).*/\1 \2/p' "$recording/manifest.yaml")
-set -- $panorama
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-# The recording's rig with every source looping.
-escaped=$(printf '%s' "$recording" | sed 's/[\/&]/\\&/g')
-sed "s/source: {file: \(.*\)}/source: {file: $escaped\/\1, loop: true}/" "$recording/rig.yaml" \
-  > "$work/rig.yaml"
+. scripts/replay-rig.sh
 cat > "$work/config.yaml" <<CONFIG
 rig: {file: rig.yaml}
 capture: {pacing: realtime, latest_wins: $latest}
-panorama: {width_px: $1, height_px: $2}
+panorama: {width_px: $panorama_width, height_px: $panorama_height}
 render: {width_px: 1280, height_px: 720, view: orbit}
 control: {socket: $work/control.sock}
 outputs:
@@ -34,7 +23,7 @@ CONFIG
 build/release/daemon/surroundd --config "$work/config.yaml" > "$work/log.txt" 2>&1 &
 pid=$!
 sleep "$seconds"
-echo "4 x $input, panorama $1x$2, real time, latest_wins $latest, after $seconds s:"
+echo "4 x $input, panorama ${panorama_width}x$panorama_height, real time, latest_wins $latest, after $seconds s:"
 build/release/tools/surroundctl/surroundctl --socket "$work/control.sock" status
 kill -TERM "$pid"
 wait "$pid"

@@ -136,7 +136,9 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
     const auto fixed = fixedViews_.find({output.view.get(), output.view->view()});
     if (fixed == fixedViews_.end() || !fixed->second.handOver) continue;
     fixed->second.handOver = false;
-    work.outputs.handOver(output, fixed->second.picture, work.streamTime, work.origin);
+    // Gathered in this set, with the view settled: a fixed view does not move.
+    work.outputs.handOver(output, fixed->second.picture, work.streamTime, work.origin,
+                          render::DrawnPicture{PipelineOutputs::Clock::now(), true});
   }
   times.lap(Stage::kOutput);
 }
@@ -149,7 +151,8 @@ void SurroundStage::deliver(PipelineOutputs& outputs, StageTimes* times) {
     outputs.guarded(output, [&] { picture = output.view->collect(); });
     if (times != nullptr) times->lap(Stage::kReadBack);
     if (!picture.empty()) {
-      outputs.handOver(output, picture, output.pendingTime, output.pendingOrigin);
+      outputs.handOver(output, picture, output.pendingTime, output.pendingOrigin,
+                       output.view->drawn());
     }
     if (times != nullptr) times->lap(Stage::kOutput);
   }

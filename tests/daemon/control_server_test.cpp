@@ -37,6 +37,11 @@ TEST(ControlProtocol, ParsesTheRequestsAndSaysWhatIsWrongWithOthers) {
   EXPECT_EQ(view.request.kind, Kind::kView);
   EXPECT_EQ(view.request.argument, "top");
   EXPECT_THAT(parseControlRequest("view").error, HasSubstr("'view' needs an argument"));
+  const auto signal = parseControlRequest("signal gear=R steering_deg=-12.5");
+  EXPECT_TRUE(signal.error.empty());
+  EXPECT_EQ(signal.request.kind, Kind::kSignal);
+  EXPECT_EQ(signal.request.argument, "gear=R steering_deg=-12.5");
+  EXPECT_THAT(parseControlRequest("signal").error, HasSubstr("'signal' needs an argument"));
   EXPECT_THAT(parseControlRequest("status now").error, HasSubstr("'status' takes no argument"));
   EXPECT_THAT(parseControlRequest("shutdown").error, HasSubstr("unknown request 'shutdown'"));
   EXPECT_THAT(parseControlRequest("").error, HasSubstr("unknown request ''"));
@@ -137,7 +142,8 @@ TEST_F(ControlServerTest, RequestsRoundTripThroughThePipelineThread) {
 
 TEST_F(ControlServerTest, MisbehavingClientsGetAnErrorAndTheServerGoesOn) {
   EXPECT_EQ(exchange(path_, "shutdown\n", false),
-            "error unknown request 'shutdown' (status, metrics, view NAME, snapshot, reload)\n");
+            "error unknown request 'shutdown' (status, metrics, view NAME, signal ITEMS, snapshot, "
+            "reload)\n");
   EXPECT_EQ(exchange(path_, std::string(10000, 'x'), false),
             fmt::format("error request longer than {} bytes\n", kMaxRequestBytes));
   EXPECT_EQ(exchange(path_, "status", true), "error the request ended without a newline\n");

@@ -124,6 +124,36 @@ TEST(PipelineReport, FiguresAreJudgedAgainstTheirLimitsAtTheEdges) {
   EXPECT_THAT(prometheusText(starting), ::testing::Not(::testing::HasSubstr("startup_seconds{")));
 }
 
+// A switch of view: its first picture, then the new view settled, held to the first picture's
+// 2.0 s and surroundd's 0.5 s target; absent before any switch.
+TEST(PipelineReport, AViewSwitchIsTimedToItsFirstPictureAndToTheNewViewSettled) {
+  PipelineReport report = sampleReport();
+  EXPECT_THAT(statusText(report), ::testing::Not(::testing::HasSubstr("view switch")));
+  EXPECT_THAT(prometheusText(report), ::testing::Not(::testing::HasSubstr("view_switch_seconds{")));
+
+  report.viewSwitch = ViewSwitchTime{milliseconds(40), std::nullopt};
+  EXPECT_THAT(
+      statusText(report),
+      ::testing::HasSubstr("view switch: under way, first picture 0.04 s after the request\n"));
+  EXPECT_THAT(prometheusText(report),
+              ::testing::HasSubstr("surroundd_view_switch_seconds{picture=\"first\"} 0.040000\n"));
+  EXPECT_THAT(
+      prometheusText(report),
+      ::testing::Not(::testing::HasSubstr("surroundd_view_switch_seconds{picture=\"settled\"}")));
+
+  report.viewSwitch->settled = milliseconds(500);
+  EXPECT_THAT(statusText(report),
+              ::testing::HasSubstr("view switch: first picture 0.04 s, settled 0.50 s after the "
+                                   "request (FMVSS 111: <= 2.0 s, met; target <= 0.5 s, met)\n"));
+  EXPECT_THAT(
+      prometheusText(report),
+      ::testing::HasSubstr("surroundd_view_switch_seconds{picture=\"settled\"} 0.500000\n"));
+  EXPECT_THAT(viewSwitchWithLimits({milliseconds(40), milliseconds(510)}),
+              ::testing::EndsWith("target <= 0.5 s, not met)"));
+  EXPECT_THAT(viewSwitchWithLimits({milliseconds(40), milliseconds(2010)}),
+              ::testing::HasSubstr("<= 2.0 s, not met;"));
+}
+
 // The kernel's start time, not main's: it lies before this program's static initializers ran, and
 // not long before (the loader maps the libraries in well under a minute).
 const auto kStaticInitialization = std::chrono::steady_clock::now();

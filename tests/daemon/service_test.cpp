@@ -174,6 +174,12 @@ TEST_F(ServiceTest, ControlRequestsRoundTripAndSigtermLeavesPlayableFiles) {
       cv::imdecode(std::vector<uchar>(after.body.begin(), after.body.end()), cv::IMREAD_COLOR);
   ASSERT_EQ(top.size(), cv::Size(320, 240));
   EXPECT_GT(cv::norm(orbit, top, cv::NORM_L1) / static_cast<double>(orbit.total() * 3), 10.0);
+  // From the request to the top view settled in the outputs, beside its limits.
+  waitForLog(*surroundd, "view switch: first picture");
+  EXPECT_THAT(request("status").body, HasSubstr("settled"));
+  EXPECT_THAT(request("status").body, HasSubstr("after the request (FMVSS 111: <= 2.0 s"));
+  EXPECT_THAT(request("metrics").body,
+              HasSubstr("surroundd_view_switch_seconds{picture=\"settled\"}"));
   // The live page marks the view it was switched to.
   std::smatch port;
   const std::string log = surroundd->output();
@@ -201,6 +207,51 @@ TEST_F(ServiceTest, ControlRequestsRoundTripAndSigtermLeavesPlayableFiles) {
     EXPECT_EQ(video.last, capture::ReadStatus::kEndOfStream) << file;
     EXPECT_GE(video.images.size(), 10u) << file;
   }
+}
+
+// The vehicle's signals through surroundctl: reverse gear brings up the rule's view at once, and
+// once the gear is no longer renewed it goes back to the view the outputs had.
+TEST_F(ServiceTest, ViewRulesFollowTheVehicleSignalsAndLetGoWhenTheyGoStale) {
+  auto surroundd = start(writeConfig("  - {type: video, stream: surround, path: out/orbit.mp4}",
+                                     "vehicle_signals:\n  stale_after_s: 0.5\n  view_rules:\n"
+                                     "    - {gear: R, view: top}\n"));
+  waitForSets(*surroundd, 5);
+  const auto snapshot = [&] {
+    const auto reply = request("snapshot");
+    EXPECT_TRUE(reply.ok) << reply.body;
+    return cv::imdecode(std::vector<uchar>(reply.body.begin(), reply.body.end()), cv::IMREAD_COLOR);
+  };
+  const cv::Mat orbit = snapshot();
+  EXPECT_THAT(request("status").body, HasSubstr("vehicle: gear unknown (none)"));
+
+  testing::ChildProcess ctl(
+      {SURROUNDCTL_EXECUTABLE, "--socket", socket_.string(), "signal", "gear=R", "speed_kmh=2"},
+      dir_ / "ctl.txt");
+  ASSERT_EQ(ctl.wait(), 0) << ctl.output();
+  EXPECT_THAT(ctl.output(), HasSubstr("gear R, steering 0.0 deg (none), speed 2.0 km/h"));
+  // Switched in the loop that took the signal, before the next frame set.
+  EXPECT_THAT(surroundd->output(), HasSubstr("view rules: top (gear R -> top)"));
+  EXPECT_THAT(request("status").body, HasSubstr("view rule: gear R -> top"));
+  // Kept renewed past the 0.4 s transition, the pictures are the top view's.
+  for (int k = 0; k < 8; ++k) {
+    ASSERT_TRUE(request("signal gear=R").ok);
+    std::this_thread::sleep_for(100ms);
+  }
+  const auto sets = frameSets(*surroundd);
+  waitForSets(*surroundd, sets + 2);
+  const cv::Mat top = snapshot();
+  ASSERT_EQ(top.size(), orbit.size());
+  EXPECT_GT(cv::norm(orbit, top, cv::NORM_L1) / static_cast<double>(orbit.total() * 3), 10.0);
+
+  // Not renewed: stale after 0.5 s, and the orbit comes back.
+  waitForLog(*surroundd, "view rules: orbit (no rule holds: the view chosen last)");
+  EXPECT_THAT(request("status").body, HasSubstr("gear R (stale)"));
+  const auto refused = request("signal gear=X");
+  EXPECT_FALSE(refused.ok);
+  EXPECT_THAT(refused.body, HasSubstr("signal: gear: expected P, R, N or D, got 'X'"));
+
+  surroundd->signal(SIGTERM);
+  EXPECT_EQ(surroundd->wait(), 0) << surroundd->output();
 }
 
 TEST_F(ServiceTest, AReloadWithABadConfigIsRejectedAndAGoodOneRestartsTheOutputs) {

@@ -11,6 +11,7 @@ allowed() {
   case "$1" in
     common) echo "common" ;;
     capture) echo "common capture" ;;
+    vehicle) echo "common vehicle" ;;
     processing) echo "common processing" ;;
     processing/stitch) echo "common processing processing/stitch" ;;
     processing/colour) echo "common processing processing/stitch processing/colour" ;;
@@ -23,7 +24,7 @@ allowed() {
 
 report=$(mktemp)
 trap 'rm -f "$report"' EXIT
-for folder in common capture processing processing/stitch processing/colour \
+for folder in common capture vehicle processing processing/stitch processing/colour \
               processing/calibration render render/outputs; do
   permitted=$(allowed "$folder")
   # Each project include "a/b/c.hpp" belongs to folder "a/b".

@@ -23,6 +23,10 @@ commands:
                     picture (each beside its limit), each camera's health
   metrics           the same and more in Prometheus text format
   view NAME         switch the surround outputs to top, 360, orbit or split
+  signal NAME=VALUE...  the vehicle's signals, for vehicles whose signals come from other
+                    software: gear=P|R|N|D steering_deg=DEG (the wheel, + left) speed_kmh=KMH
+                    indicator=off|left|right|hazard; renew them more often than
+                    vehicle_signals.stale_after_s
   snapshot FILE     save the newest output picture as a PNG
   reload            read the config file again (a bad one is rejected; the old one keeps running)
 
@@ -60,6 +64,9 @@ int main(int argc, char** argv) {
   if (command == "view") {
     if (i + 2 != argc) return usage("view needs one NAME");
     request += fmt::format(" {}", argv[i + 1]);
+  } else if (command == "signal") {
+    if (i + 2 > argc) return usage("signal needs NAME=VALUE items");
+    for (int k = i + 1; k < argc; ++k) request += fmt::format(" {}", argv[k]);
   } else if (command == "snapshot") {
     if (i + 2 != argc) return usage("snapshot needs one FILE");
     snapshotFile = argv[i + 1];
