@@ -3,18 +3,20 @@
 # by scripts/bench.sh) in a loop at its own pace, with a 1280x720 video of the orbit view and the
 # view rule gear R -> top, then sends `surroundctl signal gear=R` and `gear=D` in turn, ROUNDS times
 # each, and prints each switch's time from the signal to its first picture and to the new view
-# settled (over render.transition_s, 0.4 s), as surroundd's status gives it, then their spread.
-#   scripts/view-switch.sh [480p|720p|1080p] [ROUNDS]
+# settled (over render.transition_s: 0.4 s unless TRANSITION_S says otherwise), as surroundd's
+# status gives it, then their spread.
+#   scripts/view-switch.sh [480p|720p|1080p] [ROUNDS] [TRANSITION_S]
 set -eu
 cd "$(dirname "$0")/.."
 input=${1:-720p}
 rounds=${2:-5}
+transition=${3:-0.4}
 . scripts/replay-rig.sh
 cat > "$work/config.yaml" <<CONFIG
 rig: {file: rig.yaml}
 capture: {pacing: realtime}
 panorama: {width_px: $panorama_width, height_px: $panorama_height}
-render: {width_px: 1280, height_px: 720, view: orbit}
+render: {width_px: 1280, height_px: 720, view: orbit, transition_s: $transition}
 control: {socket: $work/control.sock}
 vehicle_signals:
   stale_after_s: 30
@@ -26,7 +28,7 @@ ctl() { build/release/tools/surroundctl/surroundctl --socket "$work/control.sock
 build/release/daemon/surroundd --config "$work/config.yaml" > "$work/log.txt" 2>&1 &
 pid=$!
 sleep 3
-echo "4 x $input, panorama ${panorama_width}x$panorama_height, real time, 1280x720 video, orbit <-> top by gear R / D:"
+echo "4 x $input, panorama ${panorama_width}x$panorama_height, real time, 1280x720 video, orbit <-> top by gear R / D, transition $transition s:"
 round=1
 while [ "$round" -le "$rounds" ]; do
   for gear in R D; do
