@@ -25,6 +25,7 @@
 #include "processing/surround_mesh.hpp"
 #include "render/car_model.hpp"
 #include "render/egl_context.hpp"
+#include "render/guidelines.hpp"
 #include "render/view_camera.hpp"
 #include "vehicle/can_signal_reader.hpp"
 #include "vehicle/vehicle_signals.hpp"
@@ -103,6 +104,10 @@ struct MeshConfig {
 
 using render::ViewKind;
 
+// When the guidelines are drawn: in reverse gear (behind the car), also in the other gears (ahead
+// of it), or never.
+enum class GuidelineMode { kOff, kReverse, kAlways };
+
 struct RenderConfig {
   ViewKind view = ViewKind::kOrbit;  // of surround outputs that do not name their own
   int widthPx = 1280;                // the size of surround and mosaic outputs
@@ -112,6 +117,8 @@ struct RenderConfig {
   std::string splitCamera;    // the camera beside the 3D view in the split view; empty: the first
   render::CarDimensions car;  // from the vehicle
   bool viewLut = true;        // top and 360 views gathered from the frames through a view LUT
+  GuidelineMode guidelines = GuidelineMode::kReverse;
+  render::GuidelineSettings guide;
 
   bool operator==(const RenderConfig&) const = default;
 };

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
+#include <optional>
 
 #include "daemon/logging.hpp"
 #include "daemon/view_rules.hpp"
@@ -9,12 +11,69 @@
 namespace surroundd::daemon {
 namespace {
 
-constexpr std::array<std::pair<std::string_view, ViewKind>, 4> kViews{{
-    {"top", ViewKind::kTop},
-    {"360", ViewKind::kPanorama360},
-    {"orbit", ViewKind::kOrbit},
-    {"split", ViewKind::kSplit},
+constexpr const auto& kViews = render::kViewNames;
+
+constexpr std::array<std::pair<std::string_view, GuidelineMode>, 3> kGuidelineModes{{
+    {"reverse", GuidelineMode::kReverse},
+    {"always", GuidelineMode::kAlways},
+    {"off", GuidelineMode::kOff},
 }};
+
+// "#rrggbb" as RGB 0..1; none for anything else.
+std::optional<cv::Vec3f> hexColour(const std::string& text) {
+  if (text.size() != 7 || text[0] != '#') return std::nullopt;
+  cv::Vec3f colour;
+  for (std::size_t c = 0; c < 3; ++c) {
+    unsigned value = 0;
+    const char* first = text.data() + 1 + 2 * c;
+    const auto [end, error] = std::from_chars(first, first + 2, value, 16);
+    if (error != std::errc() || end != first + 2) return std::nullopt;
+    colour[static_cast<int>(c)] = static_cast<float>(value) / 255.0F;
+  }
+  return colour;
+}
+
+void readGuidelineMarkers(YamlObject& section, RenderConfig& c) {
+  const auto markers = section.numbers("guideline_markers_m", 0, 8);
+  if (!markers) return;
+  for (std::size_t m = 0; m < markers->size(); ++m) {
+    const double distance = (*markers)[m];
+    if (distance <= 0 || distance > 20 || (m > 0 && distance <= (*markers)[m - 1])) {
+      section.error("guideline_markers_m",
+                    fmt::format("expected up to 8 distances in 0..20 m, ascending, got {:g} at {}",
+                                distance, m));
+      return;
+    }
+  }
+  c.guide.markersM = *markers;
+}
+
+// The path's colour, then one for each marker (after guideline_markers_m, which the table reads
+// first).
+void readGuidelineColours(YamlObject& section, RenderConfig& c) {
+  const auto texts = section.strings("guideline_colours", 1, 9);
+  if (!texts) return;
+  if (texts->size() != c.guide.markersM.size() + 1) {
+    section.error("guideline_colours",
+                  fmt::format("expected {} colours (the paths', then one per marker of "
+                              "guideline_markers_m), got {}",
+                              c.guide.markersM.size() + 1, texts->size()));
+    return;
+  }
+  std::vector<cv::Vec3f> colours;
+  for (const std::string& text : *texts) {
+    const auto colour = hexColour(text);
+    // Black is where a gathered view shows no guideline (SurroundView::guidelineLayer).
+    if (!colour || *colour == cv::Vec3f()) {
+      section.error("guideline_colours",
+                    fmt::format("expected colours as \"#rrggbb\", not black, got '{}'", text));
+      return;
+    }
+    colours.push_back(*colour);
+  }
+  c.guide.pathColour = colours.front();
+  c.guide.markerColours.assign(colours.begin() + 1, colours.end());
+}
 
 // The message's words and the reference's: one rule.
 constexpr std::string_view kGainRangeRule = "0 < low <= 1 <= high <= 16";
@@ -250,6 +309,28 @@ const ConfigKeys<RenderConfig>& renderKeys() {
                 "views that do not move (top, 360, and orbit and split with orbit_period_s 0) "
                 "gathered from the camera frames through a look-up table of their own, not drawn "
                 "by OpenGL"),
+      Key::choice("guidelines", &RenderConfig::guidelines, kGuidelineModes,
+                  "the wheels' predicted paths and distance markers on the ground, from the "
+                  "steering angle (vehicle_signals): in reverse gear (behind the car), always "
+                  "(ahead of it in the other gears too) or off"),
+      Key::number("guideline_length_m",
+                  nested(&RenderConfig::guide, &render::GuidelineSettings::lengthM),
+                  {0.5, 20.0, false, "metres"}, "how far past the bumper the paths reach"),
+      Key::custom(
+          "guideline_markers_m", "distance markers across the paths, metres past the bumper",
+          readGuidelineMarkers,
+          [](const RenderConfig& a, const RenderConfig& b) {
+            return a.guide.markersM == b.guide.markersM;
+          },
+          {}, Shown::kDefault),
+      Key::custom(
+          "guideline_colours", "the paths' colour, then one per marker, as \"#rrggbb\" (not black)",
+          readGuidelineColours,
+          [](const RenderConfig& a, const RenderConfig& b) {
+            return a.guide.pathColour == b.guide.pathColour &&
+                   a.guide.markerColours == b.guide.markerColours;
+          },
+          {}, Shown::kDefault),
   };
   return kKeys;
 }

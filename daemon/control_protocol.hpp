@@ -6,7 +6,7 @@
 // its '\n', and reads one reply; then the server closes the connection.
 //   status            -> the status text (frame rate, stages p50/p99, latency, cameras)
 //   metrics           -> Prometheus text format
-//   view NAME         -> switches every surround output to NAME (top, 360, orbit, split)
+//   view NAME         -> switches every surround output to NAME (top, 360, orbit, split, rear)
 //   signal ITEMS      -> the vehicle's signals, e.g. "gear=R steering_deg=-12.5 speed_kmh=3
 //                        indicator=left" (vehicle/vehicle_signals.hpp)
 //   snapshot          -> the newest output picture as a PNG

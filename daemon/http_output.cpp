@@ -61,7 +61,7 @@ std::unique_ptr<render::FrameSink> openHttp(const OutputConfig& output,
   settings.jpegQuality = output.jpegQuality;
   settings.allowedHosts = output.allowedHosts;
   if (output.stream == OutputStream::kSurround) {
-    for (const ViewKind kind : render::kViewKinds) settings.views.emplace_back(toString(kind));
+    for (const auto& [name, kind] : render::kViewNames) settings.views.emplace_back(name);
     settings.initialView = toString(output.view.value_or(ViewKind::kOrbit));
   }
   auto sink = std::make_unique<render::HttpStreamSink>(std::move(settings));

@@ -98,6 +98,10 @@ void Pipeline::openOutputs(const Config& config, const MosaicStage& mosaic,
 
 Pipeline::~Pipeline() = default;
 
+void Pipeline::setVehicleSignals(const vehicle::VehicleSignals& signals) {
+  if (surround_ != nullptr) surround_->setVehicleSignals(signals);
+}
+
 PipelineReport Pipeline::report() const {
   PipelineReport report;
   report.elapsed = Clock::now() - start_;

@@ -100,6 +100,8 @@ class Pipeline {
   // From the pipeline thread (an observer), while it runs:
   // Switches every surround output to `view` (takes effect with the next frame set).
   void setView(ViewKind view) { outputs_.setView(view); }
+  // The vehicle's signals as they are now, for the guidelines the surround views draw.
+  void setVehicleSignals(const vehicle::VehicleSignals& signals);
   PipelineReport report() const;
   // Whether any output (or recording) works: with none, the run records nothing (a full disk),
   // and the service stops feeding the watchdog and says so in its status. A failed output is

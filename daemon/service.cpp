@@ -144,6 +144,7 @@ void Service::onLoop(Pipeline& pipeline, std::chrono::steady_clock::time_point n
     control_->serve([&](const ControlRequest& request) { return answer(pipeline, request); });
   }
   if (can_) can_->poll(vehicle_, now);
+  pipeline.setVehicleSignals(vehicle_.at(now));
   followViewRules(pipeline, now);
   // With every output failed nothing is recorded: the watchdog is no longer fed, so systemd
   // restarts the service if the outputs do not come back first.
@@ -220,7 +221,7 @@ ControlAnswer Service::answer(Pipeline& pipeline, const ControlRequest& request)
       const auto view = render::parseViewKind(request.argument);
       if (!view) {
         return ControlReply::failure(
-            fmt::format("unknown view '{}' (top, 360, orbit, split)", request.argument));
+            fmt::format("unknown view '{}' ({})", request.argument, render::viewNameList(", ")));
       }
       chosenView_ = *view;
       pipeline.setView(*view);
@@ -231,7 +232,8 @@ ControlAnswer Service::answer(Pipeline& pipeline, const ControlRequest& request)
       if (const auto error = vehicle_.set(request.argument, now)) {
         return ControlReply::failure("signal: " + *error);
       }
-      // The view it brings up is switched to right away, before the next frame set.
+      // The view it brings up, and the guidelines, right away: before the next frame set.
+      pipeline.setVehicleSignals(vehicle_.at(now));
       followViewRules(pipeline, now);
       return ControlReply::success(vehicle_.describe(now) + "\n");
     }

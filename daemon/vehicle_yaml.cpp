@@ -38,6 +38,8 @@ render::CarDimensions VehicleConfig::car() const {
   car.widthM = maxY - minY;
   car.centreXM = (minX + maxX) / 2;
   car.centreYM = (minY + maxY) / 2;
+  car.trackM = trackM > 0 ? trackM : std::max(0.1, car.widthM - 0.25);
+  car.steeringRatio = steeringRatio;
   return car;
 }
 
@@ -109,6 +111,10 @@ const ConfigKeys<VehicleConfig>& vehicleKeys() {
       Key::number("y_m", &VehicleConfig::yM, offset, "the body's centre, left of the origin"),
       Key::number("margin_m", &VehicleConfig::marginM, overhang,
                   "the dark ground patch drawn around the model reaches this far out"),
+      Key::number("track_m", &VehicleConfig::trackM, {0.0, 10.0, false, "metres"},
+                  "between the wheels' centres, for the guidelines; 0: width_m less 0.25 m"),
+      Key::number("steering_ratio", &VehicleConfig::steeringRatio, {3.0, 40.0, false, ""},
+                  "steering-wheel angle over road-wheel angle, for the guidelines"),
       Key::flag("body_masks", &VehicleConfig::bodyMasks,
                 "mask the body out of the cameras that see it"),
       Key::custom(
@@ -172,6 +178,8 @@ void emitVehicle(YAML::Emitter& out, const VehicleConfig& v) {
   out << YAML::Key << "front_overhang_m" << YAML::Value << v.frontOverhangM;
   out << YAML::Key << "rear_overhang_m" << YAML::Value << v.rearOverhangM;
   out << YAML::Key << "margin_m" << YAML::Value << v.marginM;
+  out << YAML::Key << "track_m" << YAML::Value << v.trackM;
+  out << YAML::Key << "steering_ratio" << YAML::Value << v.steeringRatio;
   out << YAML::Key << "body_masks" << YAML::Value << v.bodyMasks;
   if (!v.model.empty()) out << YAML::Key << "model" << YAML::Value << v.model.string();
   out << YAML::EndMap;

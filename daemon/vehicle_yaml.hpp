@@ -30,6 +30,8 @@ struct VehicleConfig {
   double xM = 0.0, yM = 0.0;
   std::vector<std::array<double, 2>> footprint;  // empty: the length x width box
   double marginM = 0.3;
+  double trackM = 0;  // between the wheels' centres; 0: width_m less 0.25 m
+  double steeringRatio = 15;
   bool bodyMasks = true;
   std::filesystem::path model;  // glTF 2.0; empty: the procedural car
 

@@ -39,13 +39,12 @@ ViewRule readRule(YamlObject& item) {
     item.errorHere("expected a condition: gear, indicator, speed_below_kmh and/or speed_above_kmh");
   }
   if (item.has("view")) {
-    rule.view = item.choice("view", ViewKind::kTop,
-                            {{"top", ViewKind::kTop},
-                             {"360", ViewKind::kPanorama360},
-                             {"orbit", ViewKind::kOrbit},
-                             {"split", ViewKind::kSplit}});
+    rule.view =
+        item.choice("view", ViewKind::kTop,
+                    std::span<const std::pair<std::string_view, ViewKind>>(render::kViewNames));
   } else {
-    item.errorHere("expected 'view': the view the rule brings up (top, 360, orbit, split)");
+    item.errorHere(fmt::format("expected 'view': the view the rule brings up ({})",
+                               render::viewNameList(", ")));
   }
   item.finish();
   return rule;
@@ -69,7 +68,7 @@ const ConfigKeys<VehicleSignalsConfig>& vehicleSignalsKeys() {
           "the views the signals bring up, the first that holds winning; none holding: the "
           "view chosen last by hand. Each: conditions (gear: P|R|N|D, indicator: "
           "off|left|right|hazard, speed_below_kmh, speed_above_kmh; all must hold, an unknown "
-          "signal holds none) and view: top|360|orbit|split",
+          "signal holds none) and view: top|360|orbit|split|rear",
           readRules,
           [](const VehicleSignalsConfig& a, const VehicleSignalsConfig& b) {
             return a.viewRules == b.viewRules;

@@ -20,6 +20,8 @@ struct CarDimensions {
   double frontOverhangM = 0.9;  // bumper to axle: where the wheels go
   double rearOverhangM = 1.0;
   double centreXM = 0, centreYM = 0;  // the body's centre in the vehicle frame
+  double trackM = 1.6;                // between the wheels' centres (guidelines)
+  double steeringRatio = 15;          // steering-wheel angle over road-wheel angle (guidelines)
   double marginM = 0.3;               // the dark footprint reaches this far past the body
   // A glTF 2.0 file (.glb, .gltf) drawn in the box instead of the procedural car; empty: none.
   std::filesystem::path model;

@@ -64,6 +64,23 @@ void main() {
 #endif
 })";
 
+// The guidelines: flat colours on the ground, unlit, so that they read the same in every view.
+constexpr const char* kGuidelineVertex = R"(#version 300 es
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_colour;
+uniform mat4 u_viewProjection;
+out vec3 v_colour;
+void main() {
+  v_colour = a_colour;
+  gl_Position = u_viewProjection * vec4(a_position, 1.0);
+})";
+
+constexpr const char* kGuidelineFragment = R"(#version 300 es
+precision mediump float;
+in vec3 v_colour;
+out vec4 o_colour;
+void main() { o_colour = vec4(v_colour, 1.0); })";
+
 // One triangle covering the viewport. v_picture: x -1 (left) .. 1 (right), y -1 (bottom) .. 1
 // (top) of the picture; framebuffer row 0 is the top (see view_camera.hpp).
 constexpr const char* kFullViewportVertex = R"(#version 300 es
@@ -224,6 +241,8 @@ SurroundScene::SurroundScene(const processing::SurroundMesh& mesh,
       picturePass_(panorama, false),
       positionsPass_(panorama, true),
       pictureProgram_("camera picture", kFullViewportVertex, kPictureFragment),
+      guidelineProgram_("guidelines", kGuidelineVertex, kGuidelineFragment),
+      guidelineViewProjection_(guidelineProgram_.uniform("u_viewProjection")),
       panoramaTexture_(panorama.size, GL_REPEAT),  // azimuth wraps around
       cameraTexture_(cameraSize, GL_CLAMP_TO_EDGE),
       meshIndexCount_(static_cast<GLsizei>(mesh.indices.size())) {
@@ -254,8 +273,73 @@ SurroundScene::SurroundScene(const processing::SurroundMesh& mesh,
   attribute(3, 2, kCarStride, offsetof(CarVertex, uv));
   for (const cv::Mat& texture : carModel.textures) carTextures_.push_back(carTexture(texture));
   carTextures_.push_back(carTexture(cv::Mat(1, 1, CV_8UC4, cv::Scalar::all(255))));
+
+  glBindVertexArray(guidelineArray_.name());
+  glBindBuffer(GL_ARRAY_BUFFER, guidelineVertices_.name());
+  constexpr auto kGuidelineStride = static_cast<GLsizei>(sizeof(GuidelineVertex));
+  attribute(0, 3, kGuidelineStride, offsetof(GuidelineVertex, position));
+  attribute(1, 3, kGuidelineStride, offsetof(GuidelineVertex, colour));
   glBindVertexArray(0);
   gl::check("setting up the surround scene");
+}
+
+void SurroundScene::setGuidelines(std::span<const GuidelineVertex> triangles) {
+  glBindBuffer(GL_ARRAY_BUFFER, guidelineVertices_.name());
+  const auto bytes = static_cast<GLsizeiptr>(triangles.size_bytes());
+  if (triangles.size() > guidelineCapacity_) {
+    // Once, when the first (largest) set comes: reserveGuidelines() makes it never happen later.
+    glBufferData(GL_ARRAY_BUFFER, bytes, triangles.data(), GL_DYNAMIC_DRAW);
+    guidelineCapacity_ = triangles.size();
+  } else if (bytes > 0) {
+    glBufferSubData(GL_ARRAY_BUFFER, 0, bytes, triangles.data());
+  }
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  guidelineCount_ = static_cast<GLsizei>(triangles.size());
+  gl::check("uploading the guidelines");
+}
+
+void SurroundScene::reserveGuidelines(std::size_t vertices) {
+  if (vertices <= guidelineCapacity_) return;
+  glBindBuffer(GL_ARRAY_BUFFER, guidelineVertices_.name());
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices * sizeof(GuidelineVertex)),
+               nullptr, GL_DYNAMIC_DRAW);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  guidelineCapacity_ = vertices;
+  guidelineCount_ = 0;
+  gl::check("reserving the guidelines' buffer");
+}
+
+void SurroundScene::drawGuidelineTriangles(const cv::Matx44f& viewProjection) const {
+  if (guidelineCount_ == 0) return;
+  glUseProgram(guidelineProgram_.name());
+  glUniformMatrix4fv(guidelineViewProjection_, 1, GL_TRUE, viewProjection.val);
+  glBindVertexArray(guidelineArray_.name());
+  glDrawArrays(GL_TRIANGLES, 0, guidelineCount_);
+}
+
+void SurroundScene::drawCar(const PassPrograms& programs, const cv::Matx44f& viewProjection) const {
+  glUseProgram(programs.car.name());
+  glUniformMatrix4fv(programs.carViewProjection, 1, GL_TRUE, viewProjection.val);
+  glBindVertexArray(carArray_.name());
+  for (const CarModel::Part& part : carParts_) {
+    glBindTexture(GL_TEXTURE_2D,
+                  carTextures_[part.texture < 0 ? carTextures_.size() - 1
+                                                : static_cast<std::size_t>(part.texture)]
+                      .name());
+    glDrawArrays(GL_TRIANGLES, static_cast<GLint>(part.first), static_cast<GLsizei>(part.count));
+  }
+}
+
+void SurroundScene::drawGuidelines(const cv::Matx44f& viewProjection) const {
+  if (guidelineCount_ == 0) return;
+  glEnable(GL_DEPTH_TEST);
+  // The car in depth alone: it hides the guidelines under it, as in the picture it is laid on.
+  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  drawCar(picturePass_, viewProjection);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  drawGuidelineTriangles(viewProjection);
+  glBindVertexArray(0);
+  glDisable(GL_DEPTH_TEST);
 }
 
 void SurroundScene::uploadPanorama(const cv::Mat& bgr) {
@@ -276,16 +360,9 @@ void SurroundScene::drawSurround(const cv::Matx44f& viewProjection, Pass pass) c
   glBindTexture(GL_TEXTURE_2D, panoramaTexture_.texture.name());
   glBindVertexArray(meshArray_.name());
   glDrawElements(GL_TRIANGLES, meshIndexCount_, GL_UNSIGNED_INT, nullptr);
-  glUseProgram(programs.car.name());
-  glUniformMatrix4fv(programs.carViewProjection, 1, GL_TRUE, viewProjection.val);
-  glBindVertexArray(carArray_.name());
-  for (const CarModel::Part& part : carParts_) {
-    glBindTexture(GL_TEXTURE_2D,
-                  carTextures_[part.texture < 0 ? carTextures_.size() - 1
-                                                : static_cast<std::size_t>(part.texture)]
-                      .name());
-    glDrawArrays(GL_TRIANGLES, static_cast<GLint>(part.first), static_cast<GLsizei>(part.count));
-  }
+  // Not where the view samples the panorama: they change with the steering, the view's LUT not.
+  if (pass == Pass::kPicture) drawGuidelineTriangles(viewProjection);
+  drawCar(programs, viewProjection);
   glBindVertexArray(0);
   glDisable(GL_DEPTH_TEST);
 }

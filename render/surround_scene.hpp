@@ -6,6 +6,7 @@
 
 #include <array>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -14,6 +15,7 @@
 #include "processing/surround_mesh.hpp"
 #include "render/car_model.hpp"
 #include "render/gl_objects.hpp"
+#include "render/guidelines.hpp"
 #include "render/shader_program.hpp"
 #include "render/view_camera.hpp"
 
@@ -28,6 +30,12 @@ class SurroundScene {
   // 8-bit BGR, of the panorama's size (resp. cameraSize); throws std::invalid_argument otherwise.
   void uploadPanorama(const cv::Mat& bgr);
   void uploadCamera(const cv::Mat& bgr);
+  // The guidelines' triangles, drawn on the ground by the picture pass from now on (none: empty).
+  // A buffer of reserveGuidelines() vertices is filled in place: nothing is allocated when they
+  // change with the steering.
+  void setGuidelines(std::span<const GuidelineVertex> triangles);
+  void reserveGuidelines(std::size_t vertices);
+  bool hasGuidelines() const { return guidelineCount_ > 0; }
 
   // What a draw writes: the picture, or where each pixel samples the panorama texture (texture
   // coordinates in red and green, 1 in blue; 0 in blue where the panorama is not shown: the car,
@@ -40,6 +48,9 @@ class SurroundScene {
   void drawStrips(const cv::Vec2f& stripTangents,  // the 360 view
                   Pass pass = Pass::kPicture) const;
   void drawCamera() const;  // the camera picture, filling it
+  // The guidelines alone, where the car does not stand over them (for a view drawn once, that
+  // lays them over its gathered picture).
+  void drawGuidelines(const cv::Matx44f& viewProjection) const;
 
   cv::Size cameraSize() const { return cameraSize_; }
   cv::Size panoramaSize() const { return panoramaTexture_.size; }
@@ -59,6 +70,8 @@ class SurroundScene {
   const PassPrograms& programs(Pass pass) const {
     return pass == Pass::kPicture ? picturePass_ : positionsPass_;
   }
+  void drawCar(const PassPrograms& programs, const cv::Matx44f& viewProjection) const;
+  void drawGuidelineTriangles(const cv::Matx44f& viewProjection) const;
 
   // A texture fed through two pixel buffers in turn, so that filling one does not wait for the
   // transfer of the other.
@@ -76,6 +89,8 @@ class SurroundScene {
   PassPrograms picturePass_;
   PassPrograms positionsPass_;
   ShaderProgram pictureProgram_;
+  ShaderProgram guidelineProgram_;
+  GLint guidelineViewProjection_;
   StreamedTexture panoramaTexture_;
   StreamedTexture cameraTexture_;
   gl::VertexArray meshArray_;
@@ -87,6 +102,10 @@ class SurroundScene {
   std::vector<CarModel::Part> carParts_;
   std::vector<gl::Texture> carTextures_;  // the model's, then one white texel for parts without
   gl::VertexArray emptyArray_;            // full-screen passes make their vertices from gl_VertexID
+  gl::VertexArray guidelineArray_;
+  gl::Buffer guidelineVertices_;
+  std::size_t guidelineCapacity_ = 0;
+  GLsizei guidelineCount_ = 0;
 };
 
 }  // namespace surroundd::render

@@ -91,13 +91,13 @@ void SurroundView::drawScene(ViewKind view, double timeS, SurroundScene::Pass pa
   glViewport(0, 0, size_.width, size_.height);
   switch (view) {
     case ViewKind::kTop:
-      scene_.drawSurround(topViewProjection(settings_, size_), pass);
+    case ViewKind::kOrbit:
+    case ViewKind::kRear:
+      scene_.drawSurround(viewProjection(*perspectivePose(view, settings_, size_, timeS), size_),
+                          pass);
       break;
     case ViewKind::kPanorama360:
       scene_.drawStrips(stripTangents(settings_, size_), pass);
-      break;
-    case ViewKind::kOrbit:
-      scene_.drawSurround(orbitViewProjection(settings_, size_, timeS), pass);
       break;
     case ViewKind::kSplit: {
       // Framebuffer row 0 is the picture's top, so viewport rectangles read top-down too.
@@ -122,19 +122,13 @@ void SurroundView::draw(double timeS) {
   constexpr auto kPicture = SurroundScene::Pass::kPicture;
   const double progress = transitionProgress(timeS);
   drawn_ = {std::chrono::steady_clock::now(), progress >= 1};
-  const auto perspective = [](ViewKind view) {
-    return view == ViewKind::kTop || view == ViewKind::kOrbit;
-  };
+  const auto fromPose = perspectivePose(from_, settings_, size_, timeS);
+  const auto toPose = perspectivePose(view_, settings_, size_, timeS);
   if (progress >= 1) {
     drawScene(view_, timeS, kPicture);
-  } else if (perspective(from_) && perspective(view_)) {
-    const auto pose = [&](ViewKind view) {
-      return view == ViewKind::kTop ? topViewPose(settings_, size_)
-                                    : orbitViewPose(settings_, timeS);
-    };
+  } else if (fromPose && toPose) {
     glViewport(0, 0, size_.width, size_.height);
-    scene_.drawSurround(viewProjection(poseBetween(pose(from_), pose(view_), progress), size_),
-                        kPicture);
+    scene_.drawSurround(viewProjection(poseBetween(*fromPose, *toPose, progress), size_), kPicture);
   } else {
     // The new view over the old, more of it as the switch goes on.
     drawScene(from_, timeS, kPicture);
@@ -223,6 +217,26 @@ cv::Mat SurroundView::panoramaPositions(double timeS) const {
     }
   }
   return result;
+}
+
+const cv::Mat& SurroundView::guidelineLayer(double timeS) {
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.name());
+  glClearColor(0, 0, 0, 1);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  // The 3D part of the view: all of it, or the split view's left half.
+  const bool split = view_ == ViewKind::kSplit;
+  const cv::Size area = split ? cv::Size(size_.width / 2, size_.height) : size_;
+  if (const auto pose = perspectivePose(split ? ViewKind::kOrbit : view_, settings_, area, timeS)) {
+    glViewport(0, 0, area.width, area.height);
+    scene_.drawGuidelines(viewProjection(*pose, area));
+  }
+  guidelineRgba_.create(size_, CV_8UC4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(0, 0, size_.width, size_.height, GL_RGBA, GL_UNSIGNED_BYTE, guidelineRgba_.data);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  gl::check("drawing a view's guidelines");
+  cv::cvtColor(guidelineRgba_, guidelineLayer_, cv::COLOR_RGBA2BGR);
+  return guidelineLayer_;
 }
 
 cv::Mat SurroundView::panoramaShown(const cv::Mat& panoramaPositions) {

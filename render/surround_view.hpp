@@ -57,6 +57,10 @@ class SurroundView {
   // (RenderError without it). For setting up a view that does not move; it allocates, and
   // waits for the GPU.
   cv::Mat panoramaPositions(double timeS) const;
+  // The scene's guidelines alone as this view shows them now (black elsewhere; none in the 360
+  // view), 8-bit BGR, read back at once: for a view whose picture is gathered rather than drawn.
+  // Valid until the next call; allocates the first time only.
+  const cv::Mat& guidelineLayer(double timeS);
   // Where such positions show the panorama: CV_8U, 255 there, 0 elsewhere.
   static cv::Mat panoramaShown(const cv::Mat& panoramaPositions);
 
@@ -80,6 +84,8 @@ class SurroundView {
   std::optional<double> transitionStartS_;
   DrawnPicture drawn_;
   cv::Mat picture_;
+  cv::Mat guidelineRgba_;  // guidelineLayer()'s read-back, and its picture
+  cv::Mat guidelineLayer_;
 };
 
 }  // namespace surroundd::render

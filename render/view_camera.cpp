@@ -48,23 +48,24 @@ double aspectOf(cv::Size viewport) { return static_cast<double>(viewport.width) 
 }  // namespace
 
 const char* toString(ViewKind view) {
-  switch (view) {
-    case ViewKind::kTop:
-      return "top";
-    case ViewKind::kPanorama360:
-      return "360";
-    case ViewKind::kOrbit:
-      return "orbit";
-    case ViewKind::kSplit:
-      return "split";
-  }
-  return "?";
+  const auto* named =
+      std::ranges::find(kViewNames, view, &std::pair<std::string_view, ViewKind>::second);
+  return named == kViewNames.end() ? "?" : named->first.data();
 }
 
 std::optional<ViewKind> parseViewKind(std::string_view name) {
-  const auto* kind =
-      std::ranges::find_if(kViewKinds, [&](ViewKind view) { return name == toString(view); });
-  return kind == kViewKinds.end() ? std::nullopt : std::optional(*kind);
+  const auto* named =
+      std::ranges::find(kViewNames, name, &std::pair<std::string_view, ViewKind>::first);
+  return named == kViewNames.end() ? std::nullopt : std::optional(named->second);
+}
+
+std::string viewNameList(std::string_view separator) {
+  std::string list;
+  for (const auto& [name, view] : kViewNames) {
+    if (!list.empty()) list += separator;
+    list += name;
+  }
+  return list;
 }
 
 ViewPose topViewPose(const ViewSettings& settings, cv::Size viewport) {
@@ -88,6 +89,32 @@ ViewPose orbitViewPose(const ViewSettings& settings, double timeS) {
           settings.orbitFovDeg * kDegToRad};
 }
 
+ViewPose rearViewPose(const ViewSettings& settings) {
+  // High above the car's back, looking about 57 degrees down: the rear half of the car at the
+  // bottom of the picture, and the ground from just past its bumper (the roof hides the first
+  // 0.3 m of a car's) to nearly 2 orbit radii behind it.
+  return {{-0.15 * settings.orbitRadiusM, 0, 1.5 * settings.orbitHeightM},
+          {-0.7 * settings.orbitRadiusM, 0, 0},
+          {0, 0, 1},
+          settings.orbitFovDeg * kDegToRad};
+}
+
+std::optional<ViewPose> perspectivePose(ViewKind view, const ViewSettings& settings,
+                                        cv::Size viewport, double timeS) {
+  switch (view) {
+    case ViewKind::kTop:
+      return topViewPose(settings, viewport);
+    case ViewKind::kOrbit:
+      return orbitViewPose(settings, timeS);
+    case ViewKind::kRear:
+      return rearViewPose(settings);
+    case ViewKind::kPanorama360:
+    case ViewKind::kSplit:
+      break;
+  }
+  return std::nullopt;
+}
+
 double transitionWeight(double t) {
   const double s = std::clamp(t, 0.0, 1.0);
   return s * s * (3 - 2 * s);
@@ -104,10 +131,6 @@ cv::Matx44f viewProjection(const ViewPose& pose, cv::Size viewport) {
   const auto vec = [](const cv::Vec3d& v) { return cv::Vec3f(v); };
   return perspective(pose.fovyRad, aspectOf(viewport)) *
          lookAt(vec(pose.eye), vec(pose.target), vec(pose.up));
-}
-
-cv::Matx44f topViewProjection(const ViewSettings& settings, cv::Size viewport) {
-  return viewProjection(topViewPose(settings, viewport), viewport);
 }
 
 cv::Matx44f orbitViewProjection(const ViewSettings& settings, cv::Size viewport, double timeS) {

@@ -7,22 +7,34 @@
 //           vertical lines straight (a cylinder seen from its axis).
 //   orbit   a camera circling the vehicle, looking at it.
 //   split   the orbit view on the left half, one camera's own picture on the right.
+//   rear    from high above the vehicle's back, looking back and down at the ground behind it:
+//           what reversing needs (a still eye; view rules bring it up with gear R).
 // Matrices take vehicle-frame points to OpenGL clip space, with rows of the picture top first.
 
 #include <array>
 #include <optional>
+#include <string>
 #include <string_view>
+#include <utility>
 
 #include <opencv2/core.hpp>
 
 namespace surroundd::render {
 
-enum class ViewKind { kTop, kPanorama360, kOrbit, kSplit };
-inline constexpr std::array<ViewKind, 4> kViewKinds{ViewKind::kTop, ViewKind::kPanorama360,
-                                                    ViewKind::kOrbit, ViewKind::kSplit};
+enum class ViewKind { kTop, kPanorama360, kOrbit, kSplit, kRear };
+// Each view by its name, as the config, the control socket and the live page name them.
+inline constexpr std::array<std::pair<std::string_view, ViewKind>, 5> kViewNames{{
+    {"top", ViewKind::kTop},
+    {"360", ViewKind::kPanorama360},
+    {"orbit", ViewKind::kOrbit},
+    {"split", ViewKind::kSplit},
+    {"rear", ViewKind::kRear},
+}};
 
-const char* toString(ViewKind view);  // "top", "360", "orbit", "split"
+const char* toString(ViewKind view);  // "top", "360", "orbit", "split", "rear"
 std::optional<ViewKind> parseViewKind(std::string_view name);
+// Every view's name, joined by `separator`: "top, 360, orbit, split, rear".
+std::string viewNameList(std::string_view separator);
 
 struct ViewSettings {
   double topRangeM = 8.0;
@@ -47,6 +59,10 @@ struct ViewPose {
 };
 ViewPose topViewPose(const ViewSettings& settings, cv::Size viewport);
 ViewPose orbitViewPose(const ViewSettings& settings, double timeS);
+ViewPose rearViewPose(const ViewSettings& settings);
+// The pose of a perspective view (top, orbit, rear) at `timeS`; none for the others.
+std::optional<ViewPose> perspectivePose(ViewKind view, const ViewSettings& settings,
+                                        cv::Size viewport, double timeS);
 // How far a view switch has come at `t` of its time (0..1): eased in and out (smoothstep), so that
 // the eye starts and stops gently.
 double transitionWeight(double t);
@@ -55,7 +71,6 @@ double transitionWeight(double t);
 ViewPose poseBetween(const ViewPose& from, const ViewPose& to, double t);
 cv::Matx44f viewProjection(const ViewPose& pose, cv::Size viewport);
 
-cv::Matx44f topViewProjection(const ViewSettings& settings, cv::Size viewport);
 cv::Matx44f orbitViewProjection(const ViewSettings& settings, cv::Size viewport, double timeS);
 // Whether the orbit view's eye moves with stream time.
 bool orbitMoves(const ViewSettings& settings);

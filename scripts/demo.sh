@@ -9,7 +9,27 @@ cmake --preset release
 cmake --build --preset release --target surroundd surroundctl surround-synth surround-calibrate \
   surround-bench
 build/release/tools/synth/surround-synth --rig config/rigs/paper.yaml --out recordings/demo
-build/release/daemon/surroundd --config config/demo.yaml "$@"
+build/release/daemon/surroundd --config config/demo.yaml "$@" &
+daemon=$!
+# The rear view with its guidelines (issue 21), after the snapshots at 5 s: the car in reverse
+# with the wheel turned a turn left, straight and a turn right, each snapshot once the 0.4 s
+# switch of view is over.
+ctl() { build/release/tools/surroundctl/surroundctl --socket out/demo/control.sock "$@"; }
+sets=0
+while kill -0 "$daemon" 2>/dev/null && [ "$sets" -lt 180 ]; do
+  sleep 0.2
+  sets=$(ctl status 2>/dev/null | sed -n '1s/^\([0-9]*\) frame sets.*/\1/p')
+  sets=${sets:-0}
+done
+for turn in left:360 straight:0 right:-360; do
+  name=${turn%%:*}
+  if ctl signal gear=R "steering_deg=${turn#*:}" >/dev/null 2>&1 && sleep 0.8 &&
+    ctl snapshot "out/demo/rear-$name.png" >/dev/null 2>&1; then :; else
+    echo "demo: no out/demo/rear-$name.png: the replay ended first"
+  fi
+done
+ctl signal gear=D >/dev/null 2>&1 || true
+wait "$daemon"
 echo
 echo "demo outputs:"
 for file in out/demo/*; do echo "  $(pwd)/$file"; done

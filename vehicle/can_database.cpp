@@ -93,9 +93,14 @@ std::optional<double> CanSignal::decode(std::span<const std::uint8_t> data) cons
 
 void CanSignal::encode(double physical, std::span<std::uint8_t> data) const {
   const double lowest = isSigned ? -std::ldexp(1.0, length - 1) : 0.0;
-  const double highest = isSigned ? std::ldexp(1.0, length - 1) - 1 : std::ldexp(1.0, length) - 1;
+  // One past the largest raw value, as a double (2^64 and 2^63 are exact; 2^64 - 1 is not).
+  const double end = std::ldexp(1.0, isSigned ? length - 1 : length);
+  const double highest = length >= 53 ? std::nextafter(end, 0.0) : end - 1;
   const double clamped = std::clamp(std::round((physical - offset) / factor), lowest, highest);
-  const auto raw = static_cast<std::uint64_t>(static_cast<std::int64_t>(clamped)) & rawMask(length);
+  const std::uint64_t raw =
+      (isSigned ? static_cast<std::uint64_t>(static_cast<std::int64_t>(clamped))
+                : static_cast<std::uint64_t>(clamped)) &
+      rawMask(length);
   forEachBit(*this, [&](int position, int weight) {
     auto& byte = data[static_cast<std::size_t>(position / 8)];
     const auto bit = static_cast<std::uint8_t>(1U << (position % 8));

@@ -17,7 +17,10 @@ SurroundStage::SurroundStage(const Config& config, PanoramaStage& panorama)
       gl_(config.render.platform),
       panoramaStage_(panorama),
       panorama_(panorama.picture()),
-      viewLut_(config.render.viewLut) {
+      viewLut_(config.render.viewLut),
+      guidelineMode_(config.render.guidelines),
+      guide_(config.render.guide),
+      car_(config.render.car) {
   spdlog::info("render: {}", gl_.description());
   const processing::PanoramaSettings settings = panoramaSettings(config);
   processing::SurroundMesh mesh;
@@ -31,6 +34,11 @@ SurroundStage::SurroundStage(const Config& config, PanoramaStage& panorama)
   splitCamera_ = split == names.end() ? 0 : static_cast<std::size_t>(split - names.begin());
   scene_ = std::make_unique<render::SurroundScene>(mesh, settings.geometry, config.render.car,
                                                    panorama.lut().cameraSizes.at(splitCamera_));
+  if (guidelineMode_ != GuidelineMode::kOff) {
+    const std::size_t vertices = render::maxGuidelineVertices(guide_);
+    guideVertices_.reserve(vertices);
+    scene_->reserveGuidelines(vertices);
+  }
   spdlog::info("render: {} mesh of {} triangles, split view shows '{}'",
                config.mesh.model == MeshModel::kBowl   ? "bowl"
                : config.mesh.model == MeshModel::kFlat ? "flat"
@@ -87,6 +95,39 @@ bool SurroundStage::needsPanorama(PipelineOutputs& outputs) {
   return false;
 }
 
+void SurroundStage::setVehicleSignals(const vehicle::VehicleSignals& signals) {
+  using vehicle::Gear;
+  std::optional<std::pair<render::Travel, long>> shown;
+  const bool reverse = signals.gear == Gear::kReverse;
+  const bool forward = signals.gear == Gear::kDrive || signals.gear == Gear::kNeutral;
+  if (guidelineMode_ != GuidelineMode::kOff &&
+      (reverse || (forward && guidelineMode_ == GuidelineMode::kAlways))) {
+    shown = std::pair{reverse ? render::Travel::kReverse : render::Travel::kForward,
+                      std::lround(signals.steeringDeg * 10)};
+  }
+  if (shown == guidesShown_) return;
+  guidesShown_ = shown;
+  guideVertices_.clear();
+  if (shown) {
+    render::guidelines(car_, guide_, shown->first, static_cast<double>(shown->second) / 10,
+                       guideVertices_);
+  }
+  scene_->setGuidelines(guideVertices_);
+  ++guidesVersion_;
+}
+
+void SurroundStage::layGuidelines(render::SurroundView& view, FixedView& fixed) {
+  if (!scene_->hasGuidelines()) return;
+  if (fixed.guidesVersion != guidesVersion_) {
+    // Drawn by OpenGL and read back once per change of steering, not per set.
+    view.guidelineLayer(0).copyTo(fixed.guides);
+    cv::cvtColor(fixed.guides, fixed.guidesGrey, cv::COLOR_BGR2GRAY);
+    cv::threshold(fixed.guidesGrey, fixed.guidesMask, 0, 255, cv::THRESH_BINARY);
+    fixed.guidesVersion = guidesVersion_;
+  }
+  fixed.guides.copyTo(fixed.picture, fixed.guidesMask);
+}
+
 void SurroundStage::process(FrameWork& work, StageTimes& times) {
   deliver(work.outputs, &times);
   lastStreamTime_ = work.streamTime;
@@ -104,6 +145,7 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
         if (!wanted && !panoramaSkipped_) return;
         panoramaStage_.draw(*fixed->view, work, fixed->picture);
         fixed->overlay.copyTo(fixed->picture, fixed->overlayMask);
+        layGuidelines(*output.view, *fixed);
         // As the renderer samples it (bilinear, pixel centres at halves); a missing frame leaves
         // the last one shown.
         if (const auto area = output.view->cameraArea(); area && camera != nullptr) {

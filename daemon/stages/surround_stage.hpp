@@ -17,8 +17,10 @@
 #include <chrono>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -28,6 +30,7 @@
 #include "render/egl_context.hpp"
 #include "render/surround_scene.hpp"
 #include "render/surround_view.hpp"
+#include "vehicle/vehicle_signals.hpp"
 
 namespace surroundd::daemon {
 
@@ -52,6 +55,10 @@ class SurroundStage final : public PipelineStage {
 
   std::string description() const { return gl_.description(); }
 
+  // The vehicle's signals as they are now: the guidelines follow its gear and steering (drawn
+  // again only when they change by a tenth of a degree or more).
+  void setVehicleSignals(const vehicle::VehicleSignals& signals);
+
  private:
   // Hands each view's pending picture (the previous set's) to its output.
   void deliver(PipelineOutputs& outputs, StageTimes* times);
@@ -64,7 +71,13 @@ class SurroundStage final : public PipelineStage {
     cv::Mat picture;                       // the last drawn
     std::chrono::nanoseconds drawnAt{-1};  // the stream time of its set
     bool handOver = false;                 // drawn this set for its output
+    cv::Mat guides;                        // the guidelines as the view shows them, on black
+    cv::Mat guidesGrey;
+    cv::Mat guidesMask;      // CV_8U: where they are
+    int guidesVersion = -1;  // of SurroundStage::guidesVersion_
   };
+  // Lays the guidelines over a fixed view's picture, drawing them again when they have changed.
+  void layGuidelines(render::SurroundView& view, FixedView& fixed);
   // The output's fixed view, built the first time it shows it; null for a view that moves, with
   // render.view_lut off, or where the renderer cannot map views (said once).
   FixedView* fixedView(render::SurroundView& view);
@@ -77,6 +90,13 @@ class SurroundStage final : public PipelineStage {
   PanoramaStage& panoramaStage_;
   const cv::Mat& panorama_;
   bool viewLut_;
+  GuidelineMode guidelineMode_;
+  render::GuidelineSettings guide_;
+  render::CarDimensions car_;
+  std::vector<render::GuidelineVertex> guideVertices_;  // reserved at start: filled in place
+  // What the guidelines show now (travel, steering in tenths of a degree); none: not shown.
+  std::optional<std::pair<render::Travel, long>> guidesShown_;
+  int guidesVersion_ = 0;
   bool panoramaSkipped_ = false;  // this set: needsPanorama() said no
   // Per output's view (its address; each lives as long as the pipeline) and the kind it shows.
   std::map<std::pair<const render::SurroundView*, ViewKind>, FixedView> fixedViews_;

@@ -127,7 +127,7 @@ TEST(BenchCli, BadCommandLinesAreUsageErrors) {
         std::pair{std::vector<std::string>{"stich", kRecording},
                   "expected 'stitch', 'colour' or 'pipeline'"},
         std::pair{std::vector<std::string>{"pipeline", "--view", "side", kRecording},
-                  "--view needs top, 360, orbit or split"},
+                  "--view needs one of top, 360, orbit, split, rear"},
         std::pair{std::vector<std::string>{"pipeline", "--size", "641x480", kRecording},
                   "--size needs an even WIDTHxHEIGHT"},
         std::pair{std::vector<std::string>{"pipeline", "--input", "h264", kRecording},

@@ -12,6 +12,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -250,6 +251,44 @@ TEST_F(ServiceTest, ViewRulesFollowTheVehicleSignalsAndLetGoWhenTheyGoStale) {
   EXPECT_FALSE(refused.ok);
   EXPECT_THAT(refused.body, HasSubstr("signal: gear: expected P, R, N or D, got 'X'"));
 
+  surroundd->signal(SIGTERM);
+  EXPECT_EQ(surroundd->wait(), 0) << surroundd->output();
+}
+
+// The guidelines (render.guidelines: reverse, amber paths): drawn in reverse gear as the steering
+// says, in a view gathered through its own LUT (top) and in one OpenGL draws (a moving orbit).
+TEST_F(ServiceTest, GuidelinesFollowTheGearAndTheSteering) {
+  auto surroundd =
+      start(writeConfig("  - {type: video, stream: surround, view: top, path: out/top.mp4}"));
+  waitForSets(*surroundd, 5);
+  cv::Mat last;
+  const auto amberPixels = [&] {
+    waitForSets(*surroundd, frameSets(*surroundd) + 3);
+    const auto reply = request("snapshot");
+    EXPECT_TRUE(reply.ok) << reply.body;
+    last = cv::imdecode(std::vector<uchar>(reply.body.begin(), reply.body.end()),
+                        cv::IMREAD_COLOR);
+    cv::Mat amber;
+    cv::inRange(last, cv::Scalar(0, 201, 247), cv::Scalar(8, 217, 255), amber);
+    return cv::countNonZero(amber);
+  };
+  EXPECT_EQ(amberPixels(), 0);
+  ASSERT_TRUE(request("signal gear=R steering_deg=300").ok);
+  EXPECT_GT(amberPixels(), 100);
+  const cv::Mat left = last.clone();
+  ASSERT_TRUE(request("signal gear=R steering_deg=-300").ok);
+  EXPECT_GT(amberPixels(), 100);
+  // The paths bend the other way: the pictures differ where they are (the ground stays).
+  EXPECT_GT(cv::norm(left, last, cv::NORM_L1) / 255, 100);
+  ASSERT_TRUE(request("signal gear=D").ok);
+  EXPECT_EQ(amberPixels(), 0);
+
+  ASSERT_TRUE(request("view orbit").ok);
+  for (int k = 0; k < 6; ++k) {  // past the 0.4 s switch, the gear kept fresh
+    ASSERT_TRUE(request("signal gear=R steering_deg=100").ok);
+    std::this_thread::sleep_for(100ms);
+  }
+  EXPECT_GT(amberPixels(), 20);
   surroundd->signal(SIGTERM);
   EXPECT_EQ(surroundd->wait(), 0) << surroundd->output();
 }

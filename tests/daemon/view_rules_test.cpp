@@ -33,8 +33,9 @@ TEST_F(ConfigTest, ViewRulesAreReadWithTheirMistakesNamed) {
                  {"vehicle_signals.view_rules[0]", "expected a condition"});
   expectOneError("capture:", "vehicle_signals:\n  view_rules: [{gear: R}]\ncapture:",
                  {"vehicle_signals.view_rules[0]", "expected 'view'"});
-  expectOneError("capture:", "vehicle_signals:\n  view_rules: [{gear: R, view: rear}]\ncapture:",
-                 {"vehicle_signals.view_rules[0].view", "got 'rear'"});
+  expectOneError(
+      "capture:", "vehicle_signals:\n  view_rules: [{gear: R, view: sideways}]\ncapture:",
+      {"vehicle_signals.view_rules[0].view", "got 'sideways'"});
   expectOneError(
       "capture:", "vehicle_signals:\n  view_rules: [{gear: R, view: top, wipers: on}]\ncapture:",
       {"vehicle_signals.view_rules[0].wipers", "unknown key"});

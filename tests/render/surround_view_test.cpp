@@ -11,11 +11,14 @@
 #include <memory>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <utility>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "render/egl_context.hpp"
 #include "render/render_error.hpp"
@@ -99,19 +102,39 @@ TEST_F(SurroundViewTest, MakesAHeadlessContext) {
       << context->description();
 }
 
-// Ground points at known vehicle-frame positions: in the top view they must land where its
-// geometry says (front up, left on the left, the shorter side spanning 2 x range), and the
-// panorama pixel seen there must be the one that looks at that ground point.
+// Where a ground point lands in a perspective view's picture (pixel centres at integers), by the
+// view's projection: clip space with the picture's rows top first.
+cv::Point2d projected(ViewKind view, cv::Size size, cv::Point2d ground) {
+  const cv::Matx44f m = viewProjection(*perspectivePose(view, ViewSettings{}, size, 0), size);
+  const cv::Vec4f clip =
+      m * cv::Vec4f(static_cast<float>(ground.x), static_cast<float>(ground.y), 0, 1);
+  return {(clip[0] / clip[3] + 1) / 2.0 * size.width - 0.5,
+          (clip[1] / clip[3] + 1) / 2.0 * size.height - 0.5};
+}
+
+// Where the top view's geometry puts a ground point: front up, left on the left, the shorter side
+// spanning 2 x range.
+cv::Point2d onTopView(cv::Size size, cv::Point2d ground) {
+  const double pixelsPerMetre = std::min(size.width, size.height) / (2 * ViewSettings{}.topRangeM);
+  return {size.width / 2.0 - ground.y * pixelsPerMetre - 0.5,
+          size.height / 2.0 - ground.x * pixelsPerMetre - 0.5};
+}
+
+// Ground points at known vehicle-frame positions: in the view they must land where its geometry
+// says (the top view's own, or the view's projection), and the panorama pixel seen there must be
+// the one that looks at that ground point.
 void expectGroundPointsLandOnTheirPixels(processing::MeshModel model,
-                                         std::initializer_list<cv::Point2d> groundPoints) {
+                                         std::initializer_list<cv::Point2d> groundPoints,
+                                         ViewKind view = ViewKind::kTop) {
   const cv::Size size(640, 480);
-  Rendering rendering(model, size, ViewKind::kTop);
+  Rendering rendering(model, size, view);
   const cv::Mat picture = rendering.draw();
   const processing::PanoramaGeometry panorama = testPanorama();
-  const double pixelsPerMetre = std::min(size.width, size.height) / (2 * ViewSettings{}.topRangeM);
+  const auto pictureOf = [&](cv::Point2d ground) {
+    return view == ViewKind::kTop ? onTopView(size, ground) : projected(view, size, ground);
+  };
   for (const cv::Point2d& ground : groundPoints) {
-    const cv::Point2d expected(size.width / 2.0 - ground.y * pixelsPerMetre - 0.5,
-                               size.height / 2.0 - ground.x * pixelsPerMetre - 0.5);
+    const cv::Point2d expected = pictureOf(ground);
     const cv::Point2d wanted = panorama.pixel(cv::Vec3d(ground.x, ground.y, 0) - panorama.centre);
     std::vector<std::pair<double, cv::Point>> seenFrom;  // panorama pixel error, picture pixel
     for (int y = static_cast<int>(expected.y) - 6; y <= static_cast<int>(expected.y) + 6; ++y) {
@@ -145,8 +168,12 @@ void expectGroundPointsLandOnTheirPixels(processing::MeshModel model,
       const double dc = std::abs(d.x);
       return std::hypot(std::min(dc, panorama.size.width - dc), d.y) / (2 * cv::norm(step));
     };
-    const double footprint = pixelsPerMetre / std::min(panoramaPixelsPerMetre({0.01, 0, 0}),
-                                                       panoramaPixelsPerMetre({0, 0.01, 0}));
+    const auto pictureStep = [&](cv::Point2d step) {
+      return cv::norm(pictureOf(ground + step) - pictureOf(ground - step)) / (2 * cv::norm(step));
+    };
+    const double footprint =
+        std::max(pictureStep({0.01, 0}) / panoramaPixelsPerMetre({0.01, 0, 0}),
+                 pictureStep({0, 0.01}) / panoramaPixelsPerMetre({0, 0.01, 0}));
     EXPECT_LE(cv::norm(drawn - expected), std::max(2.0, footprint))
         << "ground point " << ground << " drawn at " << drawn << " (" << best
         << " pixels), expected " << expected << "; a panorama pixel spans " << footprint;
@@ -163,6 +190,96 @@ TEST_F(SurroundViewTest, TopViewPutsGroundPointsOnTheirPixelsOnTheBowlFloor) {
                                                                      {3, -2.5},
                                                                      {4.5, 1.5},
                                                                      {-1, 4.5}});
+}
+
+// The rear view looks back from above the front: ground behind the car lands where its
+// projection says (on the bowl's floor; beyond it the wall rises), out to 10 m in the picture;
+// the projection itself agrees with the top view's own geometry.
+TEST_F(SurroundViewTest, RearViewPutsTheGroundBehindTheCarOnItsPixels) {
+  const cv::Size size(640, 480);
+  for (const cv::Point2d ground : {cv::Point2d(3.5, 0), cv::Point2d(-3, 2.5)}) {
+    EXPECT_LT(cv::norm(projected(ViewKind::kTop, size, ground) - onTopView(size, ground)), 1e-3);
+  }
+  for (const cv::Point2d ground : {cv::Point2d(-4, 0), cv::Point2d(-10, 0)}) {
+    const cv::Point2d at = projected(ViewKind::kRear, size, ground);
+    EXPECT_NEAR(at.x, size.width / 2.0 - 0.5, 1e-3);  // straight behind: the middle column
+    EXPECT_GT(at.y, 0);
+    EXPECT_LT(at.y, size.height);
+  }
+  EXPECT_LT(projected(ViewKind::kRear, size, {-10, 0}).y,
+            projected(ViewKind::kRear, size, {-4, 0}).y);
+  expectGroundPointsLandOnTheirPixels(processing::MeshModel::kBowl,
+                                      {{-3.5, 0}, {-4.5, 1.5}, {-4.5, -1.5}, {-4, -1}, {-3, 3}},
+                                      ViewKind::kRear);
+}
+
+// The guidelines in the top view: at each steering angle, points of both wheels' paths and the
+// markers' middles are drawn where the steering model puts them (render/guidelines.hpp), within
+// 2 pixels: the middle of the guideline's pixels near each point. Magenta paths and cyan markers:
+// colours the coded panorama never has (its blue stays below 220).
+TEST_F(SurroundViewTest, GuidelinesLandWhereTheSteeringModelPutsThem) {
+  const cv::Size size(640, 480);
+  Rendering rendering(processing::MeshModel::kBowl, size, ViewKind::kTop);
+  GuidelineSettings settings;
+  settings.pathColour = {1, 0, 1};
+  settings.markerColours.assign(settings.markersM.size(), {0, 1, 1});
+  const CarDimensions car;
+  std::vector<GuidelineVertex> vertices;
+  // The middle of the pixels of `colour` in a 9 x 9 window about `at`; none if there are none.
+  const auto middleOf = [](const cv::Mat& picture, cv::Point2d at, cv::Vec3b colour) {
+    cv::Point2d sum(0, 0);
+    int count = 0;
+    for (int y = static_cast<int>(std::lround(at.y)) - 4; y <= std::lround(at.y) + 4; ++y) {
+      for (int x = static_cast<int>(std::lround(at.x)) - 4; x <= std::lround(at.x) + 4; ++x) {
+        if (cv::norm(picture.at<cv::Vec3b>(y, x), colour, cv::NORM_INF) > 24) continue;
+        sum += cv::Point2d(x, y);
+        ++count;
+      }
+    }
+    return count == 0 ? std::optional<cv::Point2d>() : std::optional(sum * (1.0 / count));
+  };
+  for (const auto& [travel, steeringDeg] :
+       {std::pair{Travel::kReverse, 0.0}, std::pair{Travel::kReverse, 270.0},
+        std::pair{Travel::kReverse, -450.0}, std::pair{Travel::kForward, 360.0}}) {
+    SCOPED_TRACE(::testing::Message() << (travel == Travel::kReverse ? "reverse" : "forward")
+                                      << " at " << steeringDeg << " deg");
+    guidelines(car, settings, travel, steeringDeg, vertices);
+    rendering.scene.setGuidelines(vertices);
+    const cv::Mat picture = rendering.draw();
+    const double sign = travel == Travel::kReverse ? -1 : 1;
+    const double overhang = travel == Travel::kReverse ? car.rearOverhangM : car.frontOverhangM;
+    double worst = 0;
+    // Past the bumper and the car's dark patch, short of the path's end.
+    for (const double past : {0.6, 1.2, 1.8, 2.4}) {
+      for (const int side : {1, -1}) {
+        const cv::Point2d point =
+            wheelPathPoint(car, travel, steeringDeg, side, sign * (overhang + past));
+        const cv::Point2d expected = onTopView(size, point);
+        const auto drawn = middleOf(picture, expected, {255, 0, 255});
+        ASSERT_TRUE(drawn) << "no path drawn near " << expected << " (" << point << ")";
+        worst = std::max(worst, cv::norm(*drawn - expected));
+      }
+    }
+    for (const double marker : settings.markersM) {
+      const double distance = sign * (overhang + marker);
+      const cv::Point2d middle = (wheelPathPoint(car, travel, steeringDeg, 1, distance) +
+                                  wheelPathPoint(car, travel, steeringDeg, -1, distance)) *
+                                 0.5;
+      const auto drawn = middleOf(picture, onTopView(size, middle), {255, 255, 0});
+      ASSERT_TRUE(drawn) << "no marker at " << marker << " m";
+      worst = std::max(worst, cv::norm(*drawn - onTopView(size, middle)));
+    }
+    EXPECT_LE(worst, 2.0);
+    RecordProperty(fmt::format("worst_px_{}_{}", travel == Travel::kReverse ? "reverse" : "forward",
+                               steeringDeg),
+                   fmt::format("{:.2f}", worst));
+  }
+  // None: nothing of them is left.
+  rendering.scene.setGuidelines({});
+  const cv::Mat none = rendering.draw();
+  cv::Mat magenta;
+  cv::inRange(none, cv::Scalar(231, 0, 231), cv::Scalar(255, 24, 255), magenta);
+  EXPECT_EQ(cv::countNonZero(magenta), 0);
 }
 
 TEST_F(SurroundViewTest, TopViewPutsGroundPointsOnTheirPixelsOnTheFlatDisk) {

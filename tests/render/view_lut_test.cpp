@@ -193,7 +193,8 @@ TEST_F(ViewLutTest, EachFixedViewMatchesTheRenderer) {
   const std::vector<Case> cases{{ViewKind::kTop, 0},
                                 {ViewKind::kPanorama360, 0},
                                 {ViewKind::kOrbit, 0},
-                                {ViewKind::kOrbit, 2.5}};
+                                {ViewKind::kOrbit, 2.5},
+                                {ViewKind::kRear, 0}};
   struct Panorama {
     const char* name;
     RigScene* rig;

@@ -100,6 +100,23 @@ TEST(CanSignal, EncodingWritesOnlyTheSignalsBitsAndDecodesBack) {
   }
 }
 
+// Past the raw range: the nearest end, also for 64-bit signals (whose ends doubles cannot hold
+// exactly).
+TEST(CanSignal, EncodingClampsToTheRawRange) {
+  std::array<std::uint8_t, 8> frame{};
+  const CanSignal small = signal(0, 8, ByteOrder::kIntel, true);
+  small.encode(1000, frame);
+  EXPECT_EQ(small.decode(frame), 127);
+  small.encode(-1000, frame);
+  EXPECT_EQ(small.decode(frame), -128);
+  const CanSignal wide = signal(0, 64, ByteOrder::kIntel);
+  wide.encode(1e30, frame);
+  EXPECT_EQ(frame, (std::array<std::uint8_t, 8>{0, 0xF8, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF}));
+  const CanSignal wideSigned = signal(0, 64, ByteOrder::kIntel, true);
+  wideSigned.encode(-1e30, frame);
+  EXPECT_EQ(wideSigned.decode(frame), -std::ldexp(1.0, 63));
+}
+
 TEST(CanSignal, ALayoutPastTheFrameIsNamed) {
   EXPECT_THAT(signal(60, 8, ByteOrder::kIntel).problem(8).value_or(""),
               HasSubstr("8 bits from bit 60 (Intel) run past a 8-byte frame"));

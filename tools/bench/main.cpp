@@ -132,11 +132,8 @@ int main(int argc, char** argv) {
       pipeline.projection = *projection;
       ++i;
     } else if (command == "pipeline" && arg == "--view") {
-      const auto view = parseWord<ViewKind>(value, {{"top", ViewKind::kTop},
-                                                    {"360", ViewKind::kPanorama360},
-                                                    {"orbit", ViewKind::kOrbit},
-                                                    {"split", ViewKind::kSplit}});
-      if (!view) return usageError("--view needs top, 360, orbit or split");
+      const auto view = surroundd::render::parseViewKind(value);
+      if (!view) return usageError("--view needs one of " + surroundd::render::viewNameList(", "));
       pipeline.view = *view;
       ++i;
     } else if (command == "pipeline" && arg == "--input") {

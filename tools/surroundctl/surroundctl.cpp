@@ -22,7 +22,7 @@ commands:
   status            frame rate, per-stage p50/p99 milliseconds, latency, time to the first
                     picture (each beside its limit), each camera's health
   metrics           the same and more in Prometheus text format
-  view NAME         switch the surround outputs to top, 360, orbit or split
+  view NAME         switch the surround outputs to top, 360, orbit, split or rear
   signal NAME=VALUE...  the vehicle's signals, for vehicles whose signals come from other
                     software: gear=P|R|N|D steering_deg=DEG (the wheel, + left) speed_kmh=KMH
                     indicator=off|left|right|hazard; renew them more often than
