@@ -249,6 +249,15 @@ struct VehicleSignalsConfig {
   bool operator==(const VehicleSignalsConfig&) const = default;
 };
 
+// The calibration-drift watch: how often it compares the ground under each seam between the
+// seam's two cameras, and how far apart is too far.
+struct CalibrationWatchConfig {
+  double intervalS = 5;    // of stream time; 0: off
+  double thresholdCm = 5;  // a seam whose cameras put the ground further apart is misaligned
+
+  bool operator==(const CalibrationWatchConfig&) const = default;
+};
+
 struct Config {
   std::filesystem::path file;
   spdlog::level::level_enum logLevel = spdlog::level::info;
@@ -264,6 +273,7 @@ struct Config {
   RenderConfig render;
   ControlConfig control;
   VehicleSignalsConfig vehicleSignals;
+  CalibrationWatchConfig calibrationWatch;
   std::vector<OutputConfig> outputs;
   // What is worth saying about a valid config (surroundd logs them at start, --check-config prints
   // them).

@@ -280,6 +280,8 @@ Config readConfig(const YAML::Node& document, const std::filesystem::path& file)
   readSection(root, "control", [&](YamlObject& s) { readControl(s, config.control); });
   readSection(root, "vehicle_signals",
               [&](YamlObject& s) { vehicleSignalsKeys().read(s, config.vehicleSignals); });
+  readSection(root, "calibration_watch",
+              [&](YamlObject& s) { calibrationWatchKeys().read(s, config.calibrationWatch); });
   readOutputs(root, config);
   root.finish();
   diag.throwIfAny();

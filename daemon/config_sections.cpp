@@ -359,6 +359,20 @@ const ConfigKeys<OutputConfig>& outputKeys() {
   return kKeys;
 }
 
+const ConfigKeys<CalibrationWatchConfig>& calibrationWatchKeys() {
+  using Key = ConfigKey<CalibrationWatchConfig>;
+  static const ConfigKeys<CalibrationWatchConfig> kKeys{
+      Key::number("interval_s", &CalibrationWatchConfig::intervalS, {0.0, 3600.0, false, "seconds"},
+                  "how often (stream time) the ground under each seam is compared between its "
+                  "two cameras; 0: never"),
+      Key::number("threshold_cm", &CalibrationWatchConfig::thresholdCm,
+                  {0.5, 100.0, false, "centimetres"},
+                  "a seam whose cameras put the ground further apart is misaligned; a camera "
+                  "whose every measured seam is, is calibration drifting"),
+  };
+  return kKeys;
+}
+
 std::vector<SectionDocs> sectionDocs() {
   return {{"logging", loggingKeys().docs()},
           {"capture", captureKeys().docs()},
@@ -369,7 +383,8 @@ std::vector<SectionDocs> sectionDocs() {
           {"render", renderKeys().docs()},
           {"control", controlKeys().docs()},
           {"vehicle", vehicleKeys().docs()},
-          {"vehicle_signals", vehicleSignalsKeys().docs()}};
+          {"vehicle_signals", vehicleSignalsKeys().docs()},
+          {"calibration_watch", calibrationWatchKeys().docs()}};
 }
 
 }  // namespace surroundd::daemon

@@ -19,6 +19,7 @@ const ConfigKeys<ColourCorrectionConfig>& colourKeys();
 const ConfigKeys<MeshConfig>& meshKeys();
 const ConfigKeys<RenderConfig>& renderKeys();
 const ConfigKeys<ControlConfig>& controlKeys();
+const ConfigKeys<CalibrationWatchConfig>& calibrationWatchKeys();
 // The keys every entry of `outputs:` has besides `type` (which picks the type's own keys).
 const ConfigKeys<OutputConfig>& outputKeys();
 

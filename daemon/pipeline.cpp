@@ -7,6 +7,7 @@
 
 #include "daemon/output_type.hpp"
 #include "daemon/pipeline_ends.hpp"
+#include "daemon/stages/calibration_watch_stage.hpp"
 #include "daemon/stages/camera_health_stage.hpp"
 #include "daemon/stages/mosaic_stage.hpp"
 #include "daemon/stages/panorama_stage.hpp"
@@ -60,6 +61,9 @@ Pipeline::Pipeline(const Config& config, RunStart start)
     auto stage = std::make_unique<PanoramaStage>(config, pool_);
     panorama = stage.get();
     stages_.push_back(std::move(stage));
+    auto watch = std::make_unique<CalibrationWatchStage>(config, panorama->rig());
+    watch_ = watch.get();
+    stages_.push_back(std::move(watch));
   }
   if (configured(config, OutputStream::kSurround)) {
     auto stage = std::make_unique<SurroundStage>(config, *panorama);
@@ -109,9 +113,10 @@ PipelineReport Pipeline::report() const {
   report.staleDropped = staleDropped_;
   report.sync = synchronizer_.stats();
   for (std::size_t c = 0; c < cameras_.size(); ++c) {
-    report.cameras.push_back(
-        {cameras_[c]->name(), health_->health(c), cameras_[c]->stats(), cameras_[c]->queued()});
+    report.cameras.push_back({cameras_[c]->name(), health_->health(c), cameras_[c]->stats(),
+                              cameras_[c]->queued(), watch_ != nullptr && watch_->drifting(c)});
   }
+  if (watch_ != nullptr) report.seams = watch_->seams();
   report.stages = times_.histograms();
   report.latency = outputs_.latency();
   if (const auto first = outputs_.firstPictureAt()) report.startup = *first - runStart_.at;

@@ -40,6 +40,7 @@
 
 namespace surroundd::daemon {
 
+class CalibrationWatchStage;
 class CameraHealthStage;
 class MosaicStage;
 class PanoramaStage;
@@ -138,7 +139,8 @@ class Pipeline {
   // stage's GL context to the end. The named ones are in the list too (for the report).
   std::vector<std::unique_ptr<PipelineStage>> stages_;
   CameraHealthStage* health_ = nullptr;
-  SurroundStage* surround_ = nullptr;  // when an output shows a surround view
+  SurroundStage* surround_ = nullptr;       // when an output shows a surround view
+  CalibrationWatchStage* watch_ = nullptr;  // with the panorama stage
   PipelineOutputs outputs_;
   StageTimes times_;
   std::uint64_t frameSets_ = 0;

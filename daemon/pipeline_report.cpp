@@ -136,12 +136,21 @@ std::string statusText(const PipelineReport& report) {
     fmt::format_to(std::back_inserter(out), "view switch: {}\n",
                    viewSwitchWithLimits(*report.viewSwitch));
   }
+  for (const auto& seam : report.seams) {
+    fmt::format_to(std::back_inserter(out), "seam {}: {}\n", seam.name,
+                   seam.shiftCm ? fmt::format("ground {:.1f} cm apart at {:.1f} m (response "
+                                              "{:.2f}){}",
+                                              *seam.shiftCm, seam.distanceM, seam.response,
+                                              seam.misaligned ? ", misaligned" : "")
+                                : std::string("not measured yet"));
+  }
   for (std::size_t c = 0; c < report.cameras.size(); ++c) {
     const auto& camera = report.cameras[c];
     fmt::format_to(std::back_inserter(out),
-                   "camera {}: {}, {} frames, {} faults, {} queued, {} dropped by sync, {} sets "
+                   "camera {}: {}{}, {} frames, {} faults, {} queued, {} dropped by sync, {} sets "
                    "without it\n",
-                   camera.name, capture::toString(camera.health), camera.stats.frames,
+                   camera.name, capture::toString(camera.health),
+                   camera.calibrationDrifting ? ", calibration drifting" : "", camera.stats.frames,
                    camera.stats.faults, camera.queued,
                    report.sync.unmatchedDropped[c] + report.sync.outOfOrderDropped[c],
                    report.sync.lateMissing[c]);
@@ -240,6 +249,21 @@ std::string prometheusText(const PipelineReport& report) {
     fmt::format_to(std::back_inserter(out),
                    "surroundd_camera_health{{camera=\"{}\",state=\"{}\"}} 1\n", camera.name,
                    capture::toString(camera.health));
+  }
+  if (!report.seams.empty()) {
+    perCamera("camera_calibration_drifting", "gauge",
+              "1 while the drift watch finds the ground under every measured seam of the camera "
+              "misaligned (calibration_watch.threshold_cm), else 0.",
+              [&](std::size_t c) { return report.cameras[c].calibrationDrifting ? 1 : 0; });
+    family(out, "seam_misalignment_cm", "gauge",
+           "How far apart the seam's two cameras put the ground under it (phase correlation of "
+           "their pictures of a 1.6 m patch); absent before it is measured.");
+    for (const auto& seam : report.seams) {
+      if (!seam.shiftCm) continue;
+      fmt::format_to(std::back_inserter(out),
+                     "surroundd_seam_misalignment_cm{{seam=\"{}\"}} {:.2f}\n", seam.name,
+                     *seam.shiftCm);
+    }
   }
   family(out, "sync_skew_seconds", "gauge", "Mean newest-minus-oldest timestamp within a set.");
   fmt::format_to(std::back_inserter(out), "surroundd_sync_skew_seconds {:.6f}\n",

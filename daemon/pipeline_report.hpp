@@ -34,11 +34,21 @@ struct RunStart {
   StartupFrom from = StartupFrom::kPipeline;
 };
 
+// One seam of the calibration-drift watch: how far apart its two cameras put the ground under it.
+struct SeamReport {
+  std::string name;               // "front/left"
+  std::optional<double> shiftCm;  // none: not measured yet, or the ground could not be compared
+  double distanceM = 0;           // of the compared ground from the vehicle's centre
+  double response = 0;
+  bool misaligned = false;
+};
+
 struct CameraReport {
   std::string name;
   capture::CameraHealth health = capture::CameraHealth::kOk;
   capture::CameraStreamStats stats;
   std::size_t queued = 0;  // frames waiting between its capture thread and the synchronizer
+  bool calibrationDrifting = false;  // the drift watch's verdict
 };
 
 // The last switch of view (Pipeline::setView, or an output's page): from its request to the first
@@ -55,6 +65,7 @@ struct PipelineReport {
   std::uint64_t staleDropped = 0;  // live: complete sets skipped because a newer one was ready
   capture::SyncStats sync;
   std::vector<CameraReport> cameras;
+  std::vector<SeamReport> seams;                      // the drift watch's; empty when it is off
   std::array<DurationHistogram, kStageCount> stages;  // per frame set that went through the stage
   DurationHistogram latency;  // a frame's capture to its picture handed to an output
   // From the run's start to its first picture handed to an output; empty before.

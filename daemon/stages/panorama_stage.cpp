@@ -9,11 +9,9 @@
 namespace surroundd::daemon {
 
 PanoramaStage::PanoramaStage(const Config& config, WorkPool& pool)
-    : PanoramaStage(config, pool, rigOf(config, pool)) {}
-
-PanoramaStage::PanoramaStage(const Config& config, WorkPool& pool, const processing::Rig& rig)
     : pool_(pool),
-      lut_(obtainPanoramaLut(config, rig, pool)),
+      rig_(rigOf(config, pool)),
+      lut_(obtainPanoramaLut(config, rig_, pool)),
       stitcher_(lut_, pool),
       ownership_(lut_),
       corrected_(config.cameras.size()),
@@ -22,18 +20,17 @@ PanoramaStage::PanoramaStage(const Config& config, WorkPool& pool, const process
   for (const auto& size : lut_.cameraSizes) {
     blackFrames_.emplace_back(size, CV_8UC3, cv::Scalar::all(0));
   }
-  setUpColourCorrection(config, rig, pool);
+  setUpColourCorrection(config, pool);
 }
 
-void PanoramaStage::setUpColourCorrection(const Config& config, const processing::Rig& rig,
-                                          WorkPool& pool) {
+void PanoramaStage::setUpColourCorrection(const Config& config, WorkPool& pool) {
   const processing::ColourCorrectionSettings& settings = config.colour.poisson;
   if (config.colour.method == ColourMethod::kGain) {
     gains_ = std::make_unique<processing::GainCompensation>(lut_, pool, settings.minGain,
                                                             settings.maxGain, cameraNames(config));
     spdlog::info("colour correction: global gain compensation");
   } else if (config.colour.method == ColourMethod::kPoisson) {
-    poisson_ = std::make_unique<processing::PoissonColourCorrection>(rig, panoramaSettings(config),
+    poisson_ = std::make_unique<processing::PoissonColourCorrection>(rig_, panoramaSettings(config),
                                                                      lut_, settings, pool);
     for (const auto& note : poisson_->notes()) spdlog::warn("colour correction: {}", note);
     spdlog::info("colour correction: Poisson, {} region(s) at scale {:g}, solver {}",

@@ -39,6 +39,8 @@ class PanoramaStage final : public PipelineStage {
   // The corrected panorama of the last set, reused for every set; of lut().size.
   const cv::Mat& picture() const { return panorama_; }
   const processing::PanoramaLut& lut() const { return lut_; }
+  // The rig the LUT was built for (body masks included).
+  const processing::Rig& rig() const { return rig_; }
 
   // A view that does not move, made the way the panorama is made but through the view's own LUT
   // (processing/stitch/view_lut.hpp): gathered from the set's frames straight into the view's
@@ -60,10 +62,10 @@ class PanoramaStage final : public PipelineStage {
   void draw(ViewPicture& view, const FrameWork& work, cv::Mat& picture);
 
  private:
-  PanoramaStage(const Config& config, WorkPool& pool, const processing::Rig& rig);
-  void setUpColourCorrection(const Config& config, const processing::Rig& rig, WorkPool& pool);
+  void setUpColourCorrection(const Config& config, WorkPool& pool);
 
   WorkPool& pool_;
+  processing::Rig rig_;  // with its body masks
   processing::PanoramaLut lut_;
   processing::Stitcher stitcher_;  // borrows lut_
   processing::PanoramaOwnership ownership_;

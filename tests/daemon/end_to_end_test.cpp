@@ -44,6 +44,52 @@ outputs:
                                               kOutputSize.width, kOutputSize.height, extra));
 }
 
+// The calibration-drift watch: synth_seams replayed with the calibration that rendered it, then
+// with its front camera's turned by 2 degrees (as a knocked camera looks against the calibration
+// it had): the front camera alone is said to drift, with the ground under both its seams 13-14 cm
+// apart (4.1 m from the camera: 4.1 m x 2 degrees = 14 cm).
+TEST(EndToEnd, TheCalibrationWatchNamesTheCameraThatWasTurned) {
+  const auto seams = std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_seams";
+  std::string rig = testing::fileBytes(seams / "rig.yaml");
+  for (const std::string name : {"front", "right", "back", "left"}) {
+    const std::string source = "file: " + name + ".mkv";
+    rig.replace(rig.find(source), source.size(), "file: " + (seams / (name + ".mkv")).string());
+  }
+  for (const bool turned : {false, true}) {
+    SCOPED_TRACE(turned ? "front turned by 2 degrees" : "the true calibration");
+    const testing::TempDir dir;
+    std::string text = rig;
+    if (turned) {
+      const std::string yaw = "yaw_deg: 0,";  // the front camera's, the first
+      text.replace(text.find(yaw), yaw.size(), "yaw_deg: 2,");
+    }
+    dir.write("rig.yaml", text);
+    const auto config = dir.write("config.yaml", R"(rig: {file: rig.yaml}
+panorama: {width_px: 1024, height_px: 512, cache_dir: lut-cache}
+calibration_watch: {interval_s: 0.2, threshold_cm: 5}
+outputs:
+  - {type: snapshot, stream: panorama, path: out/panorama.png, at_s: 0.5}
+)");
+    testing::ChildProcess surroundd(
+        {SURROUNDD_EXECUTABLE, "--config", config.string(), "--pacing", "as_fast_as_possible"},
+        dir / "log.txt");
+    ASSERT_EQ(surroundd.wait(), 0) << surroundd.output();
+    const std::string log = surroundd.output();
+    if (!turned) {
+      EXPECT_THAT(log, ::testing::Not(::testing::HasSubstr("drifting"))) << log;
+      continue;
+    }
+    EXPECT_THAT(log, ::testing::ContainsRegex(
+                         "calibration watch: camera 'front' is drifting: the ground under its "
+                         "seams is 1[34]\\.[0-9] cm at front/right, 1[34]\\.[0-9] cm at "
+                         "left/front apart"))
+        << log;
+    for (const std::string other : {"right", "back", "left"}) {
+      EXPECT_THAT(log, ::testing::Not(::testing::HasSubstr("camera '" + other + "' is drifting")));
+    }
+  }
+}
+
 TEST(EndToEnd, MosaicVideoMatchesTheSourceFrames) {
   const testing::TempDir dir;
   testing::ChildProcess surroundd({SURROUNDD_EXECUTABLE, "--config", writeConfig(dir).string(),

@@ -124,6 +124,30 @@ TEST(PipelineReport, FiguresAreJudgedAgainstTheirLimitsAtTheEdges) {
   EXPECT_THAT(prometheusText(starting), ::testing::Not(::testing::HasSubstr("startup_seconds{")));
 }
 
+// The drift watch: each seam's figure, and the verdict on the camera whose every seam is off.
+TEST(PipelineReport, TheCalibrationWatchShowsEachSeamAndTheDriftingCamera) {
+  PipelineReport report = sampleReport();
+  EXPECT_THAT(prometheusText(report), ::testing::Not(::testing::HasSubstr("seam_misalignment")));
+  report.cameras[0].calibrationDrifting = true;
+  report.seams = {{"front/right", 13.4, 4.1, 0.71, true},
+                  {"back/front", std::nullopt, 4.1, 0, false}};
+  const std::string text = statusText(report);
+  EXPECT_THAT(
+      text, ::testing::HasSubstr("seam front/right: ground 13.4 cm apart at 4.1 m (response 0.71), "
+                                 "misaligned\n"));
+  EXPECT_THAT(text, ::testing::HasSubstr("seam back/front: not measured yet\n"));
+  EXPECT_THAT(text, ::testing::HasSubstr("camera front: ok, calibration drifting, 300 frames"));
+  EXPECT_THAT(text, ::testing::HasSubstr("camera right: frozen, 298 frames"));
+  const std::string metrics = prometheusText(report);
+  EXPECT_THAT(metrics,
+              ::testing::HasSubstr("surroundd_seam_misalignment_cm{seam=\"front/right\"} 13.40\n"));
+  EXPECT_THAT(metrics, ::testing::Not(::testing::HasSubstr("{seam=\"back/front\"}")));
+  EXPECT_THAT(metrics,
+              ::testing::HasSubstr("surroundd_camera_calibration_drifting{camera=\"front\"} 1\n"));
+  EXPECT_THAT(metrics,
+              ::testing::HasSubstr("surroundd_camera_calibration_drifting{camera=\"back\"} 0\n"));
+}
+
 // A switch of view: its first picture, then the new view settled, held to the first picture's
 // 2.0 s and surroundd's 0.5 s target; absent before any switch.
 TEST(PipelineReport, AViewSwitchIsTimedToItsFirstPictureAndToTheNewViewSettled) {

@@ -15,7 +15,7 @@ allowed() {
     processing) echo "common processing" ;;
     processing/stitch) echo "common processing processing/stitch" ;;
     processing/colour) echo "common processing processing/stitch processing/colour" ;;
-    processing/calibration) echo "common processing processing/calibration" ;;
+    processing/calibration) echo "common processing processing/stitch processing/calibration" ;;
     render) echo "common processing render" ;;
     render/outputs) echo "common render render/outputs" ;;
     *) return 1 ;;

@@ -48,7 +48,7 @@ constexpr std::string_view kUsage =
   --json        stitch, pipeline: one JSON object on stdout instead of the text table
   --solver S    pipeline: auto | cholmod | iterative (default auto)
   --projection P  pipeline: bowl | sphere (default bowl)
-  --view V      pipeline: top | 360 | orbit | split (default orbit)
+  --view V      pipeline: top | 360 | orbit | split | rear (default orbit)
   --size WxH    pipeline: output size (default 1280x720)
   --input I     pipeline: decode (each video decoded as it plays: replay figures; the default) |
                 raw (decoded once at start into memory as a camera's frames, converted to BGR per

@@ -92,7 +92,7 @@ void reportRigColour(const RigColourInput& input, WorkPool& pool,
   fmt::print("  {:<14} {:>24}   {:^23}   {:^23}\n", "seam", "misalignment",
              "step near: none gain PLCC", "step far: none gain PLCC");
   for (const auto& seam : seams) {
-    const auto alignment = seamAlignment(rig, frames, settings, seam);
+    const auto alignment = processing::seamMisalignment(rig, frames, settings, seam);
     fmt::print("  {:<14} {:>24}   {}\n", seam.name,
                alignment ? fmt::format("{:.1f} cm at {:.1f} m ({:.2f})", alignment->shiftCm,
                                        alignment->distanceM, alignment->response)

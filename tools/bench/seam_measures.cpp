@@ -4,22 +4,14 @@
 #include <array>
 #include <cmath>
 #include <numbers>
-#include <numeric>
 
 #include <opencv2/imgproc.hpp>
-
-#include "processing/calibration/ground_top_view.hpp"
 
 namespace surroundd::bench {
 namespace {
 
 constexpr double kDegree = std::numbers::pi / 180;
 constexpr double kStripRad = 1.5 * kDegree;
-constexpr double kPatchM = 1.6;
-constexpr double kPatchPixelM = 0.01;
-constexpr double kMinimumSeen = 0.8;
-
-double wrap(double angle) { return std::remainder(angle, 2 * std::numbers::pi); }
 
 constexpr std::array<double, 2> kNear{-15, -35};  // elevation ranges, degrees
 constexpr std::array<double, 2> kFar{-2, -12};
@@ -117,55 +109,7 @@ std::optional<cv::Vec3d> stripMedian(const cv::Mat& panorama, const processing::
   return cv::Vec3d(median(values[0]), median(values[1]), median(values[2]));
 }
 
-std::optional<SeamAlignment> alignmentAt(const processing::Rig& rig,
-                                         std::span<const cv::Mat> frames, const SeamLine& seam,
-                                         double distance) {
-  const cv::Point2d centre(distance * std::cos(seam.azimuthRad),
-                           distance * std::sin(seam.azimuthRad));
-  const int side = static_cast<int>(kPatchM / kPatchPixelM);
-  std::array<cv::Mat, 2> patches;
-  for (int k = 0; k < 2; ++k) {
-    const std::size_t camera = k == 0 ? seam.left : seam.right;
-    // Patch rows run along -x of the vehicle, columns along -y: a top view, front up.
-    const auto sampling =
-        processing::groundSampling(rig.cameras[camera], {centre, kPatchPixelM, {side, side}});
-    if (sampling.seen < kMinimumSeen * side * side) return std::nullopt;
-    cv::Mat grey;
-    cv::cvtColor(frames[camera], grey, cv::COLOR_BGR2GRAY);
-    cv::Mat patch;
-    cv::remap(grey, patch, sampling.mapX, sampling.mapY, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-              cv::Scalar(0));
-    patch.convertTo(patches[static_cast<std::size_t>(k)], CV_32F);
-  }
-  cv::Mat window;
-  cv::createHanningWindow(window, patches[0].size(), CV_32F);
-  SeamAlignment alignment;
-  alignment.distanceM = distance;
-  const cv::Point2d shift = cv::phaseCorrelate(patches[0], patches[1], window, &alignment.response);
-  alignment.shiftCm = std::hypot(shift.x, shift.y) * kPatchPixelM * 100;
-  return alignment;
-}
-
 }  // namespace
-
-std::vector<SeamLine> seamLines(const processing::Rig& rig,
-                                const processing::PanoramaSettings& settings) {
-  const processing::PanoramaProjector projector(rig, settings);
-  std::vector<std::size_t> order(rig.cameras.size());
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  std::ranges::sort(order, {}, [&](std::size_t c) { return projector.axisAzimuth(c); });
-  std::vector<SeamLine> seams;
-  for (std::size_t k = 0; k < order.size() && order.size() > 1; ++k) {
-    const std::size_t right = order[k];
-    const std::size_t left = order[(k + 1) % order.size()];
-    const double a = projector.axisAzimuth(right);
-    double gap = std::fmod(projector.axisAzimuth(left) - a, 2 * std::numbers::pi);
-    if (gap <= 0) gap += 2 * std::numbers::pi;
-    seams.push_back(
-        {left, right, wrap(a + gap / 2), rig.cameras[left].name + "/" + rig.cameras[right].name});
-  }
-  return seams;
-}
 
 SeamColourStep seamColourStep(const cv::Mat& panorama, const processing::PanoramaLut& lut,
                               const processing::PanoramaSettings& settings, const SeamLine& seam) {
@@ -261,19 +205,6 @@ SeamColourStep seamViewStep(const cv::Mat& raw, const cv::Mat& corrected,
     return measured == 0 ? std::nullopt : std::optional<double>(sum / measured);
   };
   return {step(kNear[0], kNear[1]), step(kFar[0], kFar[1])};
-}
-
-std::optional<SeamAlignment> seamAlignment(const processing::Rig& rig,
-                                           std::span<const cv::Mat> frames,
-                                           const processing::PanoramaSettings& settings,
-                                           const SeamLine& seam) {
-  // The nearest ground under the seam that both cameras see past the vehicle's body: at
-  // elevations -25, -18, -12, -8 and -5 degrees from the panorama's centre.
-  for (const double elevationDeg : {25.0, 18.0, 12.0, 8.0, 5.0}) {
-    const double distance = settings.geometry.centre[2] / std::tan(elevationDeg * kDegree);
-    if (auto alignment = alignmentAt(rig, frames, seam, distance)) return alignment;
-  }
-  return std::nullopt;
 }
 
 double meanLevel(const cv::Mat& panorama, const processing::PanoramaLut& lut) {

@@ -157,7 +157,7 @@ TEST_F(RobustColourTest, ASeamThatCorrectionWouldMakeWorseKeepsGainOne) {
   stitcher.stitch(frames_, raw);
   cv::Mat corrected = raw.clone();
   poisson.apply(corrected);
-  for (const auto& seam : bench::seamLines(truth_.rig, settings_)) {
+  for (const auto& seam : processing::seamLines(truth_.rig, settings_)) {
     if (seam.left != 1 && seam.right != 1) continue;
     const auto before = bench::seamColourStep(raw, lut_, settings_, seam).nearLevels;
     const auto after = bench::seamColourStep(corrected, lut_, settings_, seam).nearLevels;
@@ -220,7 +220,7 @@ TEST_F(ViewStepTest, MeasuresTheCamerasNotTheContent) {
   cv::Mat raw;
   stitcher.stitch(darker, raw);
   int measured = 0;
-  for (const auto& seam : bench::seamLines(truth_.rig, settings_)) {
+  for (const auto& seam : processing::seamLines(truth_.rig, settings_)) {
     if (seam.left != 1 && seam.right != 1) continue;
     const auto before = bench::seamViewStep(matched, matched, projector, lut_, frames_, seam);
     const auto dark = bench::seamViewStep(raw, raw, projector, lut_, darker, seam);
@@ -302,7 +302,7 @@ TEST_P(RealRigTest, PoissonNeverMakesANearGroundSeamWorseAndKeepsTheLevel) {
   poisson.update(input.frames);
   cv::Mat corrected = raw.clone();
   poisson.apply(corrected);
-  for (const auto& seam : bench::seamLines(input.rig, input.panorama)) {
+  for (const auto& seam : processing::seamLines(input.rig, input.panorama)) {
     const auto before = bench::seamColourStep(raw, lut, input.panorama, seam).nearLevels;
     const auto after = bench::seamColourStep(corrected, lut, input.panorama, seam).nearLevels;
     if (!before || !after) continue;
@@ -311,7 +311,7 @@ TEST_P(RealRigTest, PoissonNeverMakesANearGroundSeamWorseAndKeepsTheLevel) {
   }
   // On the seam itself, both cameras' views of one piece of ground, near and far: never worse.
   const PanoramaProjector projector(input.rig, input.panorama);
-  for (const auto& seam : bench::seamLines(input.rig, input.panorama)) {
+  for (const auto& seam : processing::seamLines(input.rig, input.panorama)) {
     const auto before = bench::seamViewStep(raw, raw, projector, lut, input.frames, seam);
     const auto after = bench::seamViewStep(raw, corrected, projector, lut, input.frames, seam);
     for (const auto& [b, a] : {std::pair{before.nearLevels, after.nearLevels},

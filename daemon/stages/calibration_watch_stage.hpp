@@ -1,0 +1,54 @@
+#pragma once
+// The calibration-drift watch: every calibration_watch.interval_s of stream time, how far apart
+// each seam's two cameras put the ground under the seam (processing/calibration/
+// seam_misalignment.hpp), measured on that set's frames. A seam past threshold_cm, with a
+// correlation peak that means something, is misaligned; a camera whose every measured seam is
+// misaligned is "calibration drifting" — a knocked mirror camera moves the ground under both its
+// seams while its neighbours' other seams stay put. Changes are logged; the pipeline's report
+// carries each seam's figure and each camera's verdict.
+//
+// Its probes (where each camera sees each seam's ground patch) are made once at start-up; a
+// measurement resamples only the patches (about 3 ms for four seams).
+
+#include <chrono>
+#include <optional>
+#include <vector>
+
+#include "daemon/config.hpp"
+#include "daemon/pipeline_report.hpp"
+#include "daemon/pipeline_stage.hpp"
+#include "processing/calibration/seam_misalignment.hpp"
+#include "processing/rig.hpp"
+
+namespace surroundd::daemon {
+
+class CalibrationWatchStage final : public PipelineStage {
+ public:
+  // Correlation peaks below this say the ground has too little texture to be compared.
+  static constexpr double kMinResponse = 0.1;
+
+  CalibrationWatchStage(const Config& config, const processing::Rig& rig);
+
+  void process(FrameWork& work, StageTimes& times) override;
+
+  // Each seam's last measurement (none before the first, or where the ground could not be
+  // compared).
+  std::vector<SeamReport> seams() const;
+  bool drifting(std::size_t camera) const { return drifting_.at(camera); }
+
+ private:
+  struct Seam {
+    processing::SeamMisalignmentProbe probe;
+    std::optional<processing::SeamMisalignment> last;  // with a response of kMinResponse or more
+  };
+  void judge();
+
+  std::vector<std::string> cameraNames_;
+  std::vector<Seam> seams_;
+  std::chrono::nanoseconds interval_;
+  std::optional<std::chrono::nanoseconds> next_;  // stream time of the next measurement
+  double thresholdCm_;
+  std::vector<bool> drifting_;  // per camera
+};
+
+}  // namespace surroundd::daemon
