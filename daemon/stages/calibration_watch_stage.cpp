@@ -53,33 +53,48 @@ void CalibrationWatchStage::process(FrameWork& work, StageTimes& /*times*/) {
   judge();
 }
 
-void CalibrationWatchStage::judge() {
-  for (std::size_t camera = 0; camera < drifting_.size(); ++camera) {
-    std::vector<std::string> evidence;
-    bool measured = false;
-    bool allOff = true;
-    for (const Seam& seam : seams_) {
-      const auto& line = seam.probe.seam();
-      if ((line.left != camera && line.right != camera) || !seam.last) continue;
-      measured = true;
-      if (seam.last->shiftCm > thresholdCm_) {
-        evidence.push_back(fmt::format("{:.1f} cm at {}", seam.last->shiftCm, line.name));
-      } else {
-        allOff = false;
-      }
+std::vector<bool> driftingCameras(std::size_t cameras, std::span<const SeamShift> seams,
+                                  double thresholdCm) {
+  std::vector<bool> drifting(cameras, false);
+  for (std::size_t camera = 0; camera < cameras; ++camera) {
+    bool any = false;
+    bool all = true;
+    for (const SeamShift& seam : seams) {
+      if (seam.left != camera && seam.right != camera) continue;
+      any = true;
+      all = all && seam.shiftCm && *seam.shiftCm > thresholdCm;
     }
-    const bool drifting = measured && allOff;
-    if (drifting == drifting_[camera]) continue;
-    drifting_[camera] = drifting;
-    if (drifting) {
-      spdlog::warn(
-          "calibration watch: camera '{}' is drifting: the ground under its seams is "
-          "{} apart (more than {:g} cm); check its mount, then calibrate it again",
-          cameraNames_[camera], fmt::join(evidence, ", "), thresholdCm_);
-    } else {
+    drifting[camera] = any && all;
+  }
+  return drifting;
+}
+
+void CalibrationWatchStage::judge() {
+  std::vector<SeamShift> shifts;
+  for (const Seam& seam : seams_) {
+    shifts.push_back({seam.probe.seam().left, seam.probe.seam().right,
+                      seam.last ? std::optional(seam.last->shiftCm) : std::nullopt});
+  }
+  const std::vector<bool> verdicts = driftingCameras(drifting_.size(), shifts, thresholdCm_);
+  for (std::size_t camera = 0; camera < drifting_.size(); ++camera) {
+    if (verdicts[camera] == drifting_[camera]) continue;
+    drifting_[camera] = verdicts[camera];
+    if (!verdicts[camera]) {
       spdlog::info("calibration watch: camera '{}' agrees with its neighbours again",
                    cameraNames_[camera]);
+      continue;
     }
+    std::vector<std::string> evidence;
+    for (const Seam& seam : seams_) {
+      const auto& line = seam.probe.seam();
+      if (line.left == camera || line.right == camera) {
+        evidence.push_back(fmt::format("{:.1f} cm at {}", seam.last->shiftCm, line.name));
+      }
+    }
+    spdlog::warn(
+        "calibration watch: camera '{}' is drifting: the ground under its seams is {} "
+        "apart (more than {:g} cm); check its mount, then calibrate it again",
+        cameraNames_[camera], fmt::join(evidence, ", "), thresholdCm_);
   }
 }
 

@@ -2,16 +2,18 @@
 // The calibration-drift watch: every calibration_watch.interval_s of stream time, how far apart
 // each seam's two cameras put the ground under the seam (processing/calibration/
 // seam_misalignment.hpp), measured on that set's frames. A seam past threshold_cm, with a
-// correlation peak that means something, is misaligned; a camera whose every measured seam is
-// misaligned is "calibration drifting" — a knocked mirror camera moves the ground under both its
-// seams while its neighbours' other seams stay put. Changes are logged; the pipeline's report
-// carries each seam's figure and each camera's verdict.
+// correlation peak that means something, is misaligned; a camera whose seams are all measured and
+// all misaligned is "calibration drifting" — a knocked mirror camera moves the ground under both
+// its seams while its neighbours' other seams stay put. One misaligned seam alone cannot say which
+// of its cameras moved: it is reported, no camera is named. Changes are logged; the pipeline's
+// report carries each seam's figure and each camera's verdict.
 //
 // Its probes (where each camera sees each seam's ground patch) are made once at start-up; a
 // measurement resamples only the patches (about 3 ms for four seams).
 
 #include <chrono>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "daemon/config.hpp"
@@ -21,6 +23,15 @@
 #include "processing/rig.hpp"
 
 namespace surroundd::daemon {
+
+// One seam as the verdict sees it: its cameras, and its last shift where it was measured.
+struct SeamShift {
+  std::size_t left = 0, right = 0;
+  std::optional<double> shiftCm;
+};
+// Per camera of `cameras`: whether its seams are all measured and all past `thresholdCm`.
+std::vector<bool> driftingCameras(std::size_t cameras, std::span<const SeamShift> seams,
+                                  double thresholdCm);
 
 class CalibrationWatchStage final : public PipelineStage {
  public:
