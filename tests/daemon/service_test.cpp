@@ -266,8 +266,7 @@ TEST_F(ServiceTest, GuidelinesFollowTheGearAndTheSteering) {
     waitForSets(*surroundd, frameSets(*surroundd) + 3);
     const auto reply = request("snapshot");
     EXPECT_TRUE(reply.ok) << reply.body;
-    last = cv::imdecode(std::vector<uchar>(reply.body.begin(), reply.body.end()),
-                        cv::IMREAD_COLOR);
+    last = cv::imdecode(std::vector<uchar>(reply.body.begin(), reply.body.end()), cv::IMREAD_COLOR);
     cv::Mat amber;
     cv::inRange(last, cv::Scalar(0, 201, 247), cv::Scalar(8, 217, 255), amber);
     return cv::countNonZero(amber);
