@@ -34,9 +34,6 @@ constexpr bool firstPictureMet(std::chrono::nanoseconds startup) {
 constexpr bool firstPictureTargetMet(std::chrono::nanoseconds startup) {
   return startup <= kFirstPictureTarget;
 }
-constexpr bool viewSwitchMet(std::chrono::nanoseconds settled) {
-  return settled <= kMaxFirstPicture;
-}
 constexpr bool viewSwitchTargetMet(std::chrono::nanoseconds settled) {
   return settled <= kViewSwitchTarget;
 }

@@ -89,7 +89,7 @@ std::string viewSwitchWithLimits(const ViewSwitchTime& time) {
       "first picture {:.2f} s, settled {:.2f} s after the request ({}: <= {:.1f} s, {}; target "
       "<= {:.1f} s, {})",
       time.first.count(), time.settled->count(), limits::kFirstPictureStandard,
-      seconds(limits::kMaxFirstPicture), verdict(limits::viewSwitchMet(exact)),
+      seconds(limits::kMaxFirstPicture), verdict(limits::firstPictureMet(exact)),
       seconds(limits::kViewSwitchTarget), verdict(limits::viewSwitchTargetMet(exact)));
 }
 

@@ -58,6 +58,12 @@ void releaseFreedMemory() {
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
 }
 
+// vehicle_signals.stale_after_s as the signal state's clock counts.
+vehicle::VehicleSignalState::Clock::duration staleAfter(const Config& config) {
+  return std::chrono::duration_cast<vehicle::VehicleSignalState::Clock::duration>(
+      std::chrono::duration<double>(config.vehicleSignals.staleAfterS));
+}
+
 }  // namespace
 
 Service::Service(Config config, ServiceSignals& signals, ServiceNotifier notifier,
@@ -66,8 +72,7 @@ Service::Service(Config config, ServiceSignals& signals, ServiceNotifier notifie
       nextStart_{processStart, StartupFrom::kProcess},
       signals_(signals),
       notifier_(std::move(notifier)),
-      vehicle_(std::chrono::duration_cast<vehicle::VehicleSignalState::Clock::duration>(
-          std::chrono::duration<double>(config_.vehicleSignals.staleAfterS))),
+      vehicle_(staleAfter(config_)),
       chosenView_(config_.render.view) {
   const auto socket =
       config_.control.socket.empty() ? defaultControlSocket() : config_.control.socket;
@@ -99,8 +104,7 @@ int Service::run() {
     endRun_ = false;
     ruledView_.reset();
     ruleChecked_ = false;
-    vehicle_.setStaleAfter(std::chrono::duration_cast<vehicle::VehicleSignalState::Clock::duration>(
-        std::chrono::duration<double>(config_.vehicleSignals.staleAfterS)));
+    vehicle_.setStaleAfter(staleAfter(config_));
     can_.reset();
     if (config_.vehicleSignals.can) {
       can_ = std::make_unique<vehicle::CanSignalReader>(*config_.vehicleSignals.can,
