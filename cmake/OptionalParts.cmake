@@ -32,6 +32,8 @@ surroundd_optional_part(DRM "DRM/KMS display output"
   PACKAGES libdrm-dev libgbm-dev MODULES libdrm gbm)
 surroundd_optional_part(HTTP "MJPEG over HTTP output and its live page, surround-calibrate guide"
   PACKAGES libmicrohttpd-dev libturbojpeg0-dev MODULES libmicrohttpd libturbojpeg)
+surroundd_optional_part(RTSP "RTSP server output"
+  PACKAGES libgstrtspserver-1.0-dev MODULES gstreamer-rtsp-server-1.0 gstreamer-app-1.0)
 surroundd_optional_part(LIBCAMERA "libcamera cameras"
   PACKAGES libcamera-dev MODULES libcamera)
 

@@ -2,9 +2,11 @@
 // surroundd's own output types, one source file each (daemon/<type>_output.cpp), listed in
 // builtInOutputTypes() (output_types.cpp), which the registry (output_type.hpp) starts with.
 
+#include <optional>
 #include <vector>
 
 #include "daemon/output_type.hpp"
+#include "render/outputs/video_encoder.hpp"
 
 namespace surroundd::daemon {
 
@@ -15,12 +17,27 @@ std::vector<OutputType> builtInOutputTypes();
 OutputType videoOutputType();      // H.264 files, segmented or not (video_output.cpp)
 OutputType networkOutputType();    // H.264 in MPEG-TS over UDP (video_output.cpp)
 OutputType httpOutputType();       // MJPEG over HTTP and a live page (http_output.cpp)
+OutputType rtspOutputType();       // H.264 served over RTSP (rtsp_output.cpp)
 OutputType windowOutputType();     // an X11 window (window_output.cpp)
 OutputType displayOutputType();    // a DRM/KMS screen (display_output.cpp)
 OutputType snapshotOutputType();   // a PNG snapshot (snapshot_output.cpp)
 OutputType recordingOutputType();  // the cameras' own streams and a rig file (recording_output.cpp)
 
-// The encoder's quality, one rule for every type that encodes (video_output.cpp).
+// The H.264 encoder's keys, one rule for every type that encodes (video_output.cpp): which
+// encoder, its quality, x264's preset, the pixel format; checkEncoder() tells one this FFmpeg
+// lacks.
+ConfigKey<OutputConfig> encoderKey();
 ConfigKey<OutputConfig> crfKey();
+ConfigKey<OutputConfig> presetKey();
+ConfigKey<OutputConfig> pixelFormatKey();
+void checkEncoder(YamlObject& item, OutputConfig& output);
+// The encoder's settings from those keys and the stream's size and rate (no path or URL).
+render::VideoEncoderSettings encoderSettings(const OutputConfig& output,
+                                             const OutputContext& context);
+
+// `listen: ADDRESS:PORT` of the types that serve (http, rtsp), `defaultPort` when absent; and the
+// rule that two of a type cannot listen on one port (listen_key.cpp).
+ConfigKey<OutputConfig> listenKey(int defaultPort);
+std::optional<OutputConflict> sharesPort(const OutputConfig& earlier, const OutputConfig& output);
 
 }  // namespace surroundd::daemon

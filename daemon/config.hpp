@@ -136,7 +136,7 @@ class OutputKind {
   constexpr std::string_view name() const { return name_; }
   bool operator==(const OutputKind& other) const { return name_ == other.name_; }
 
-  static const OutputKind kVideo, kNetwork, kHttp, kWindow, kDisplay, kSnapshot;
+  static const OutputKind kVideo, kNetwork, kHttp, kRtsp, kWindow, kDisplay, kSnapshot;
   // Not a picture of the pipeline but the cameras' own streams (RigRecorder).
   static const OutputKind kRecording;
 
@@ -146,6 +146,7 @@ class OutputKind {
 inline constexpr OutputKind OutputKind::kVideo{"video"};
 inline constexpr OutputKind OutputKind::kNetwork{"network"};
 inline constexpr OutputKind OutputKind::kHttp{"http"};
+inline constexpr OutputKind OutputKind::kRtsp{"rtsp"};
 inline constexpr OutputKind OutputKind::kWindow{"window"};
 inline constexpr OutputKind OutputKind::kDisplay{"display"};
 inline constexpr OutputKind OutputKind::kSnapshot{"snapshot"};
@@ -203,11 +204,13 @@ struct OutputConfig {
   std::string encoder = "auto";  // H.264: auto | libx264 | an FFmpeg encoder's name
   double segmentS = 0.0;  // video: a new file every this many seconds of stream time; 0 = one file
   std::string url;        // network: udp://HOST:PORT (MPEG-TS)
-  // http: MJPEG and the live page
+  // http and rtsp: the server
   std::string listenAddress = "127.0.0.1";  // only this machine, unless configured otherwise
   int listenPort = 8080;
   int jpegQuality = 80;
   std::vector<std::string> allowedHosts;  // host names it answers to besides IPs and localhost
+  // rtsp: H.264 served at rtsp://<listen>/<rtspName> (listen's default port there: 8554)
+  std::string rtspName;  // empty: what it shows (surround, panorama, mosaic)
   // window (X11)
   std::string display;  // empty: $DISPLAY
   std::string title = "surroundd";

@@ -1,6 +1,6 @@
 // The list of surroundd's own output types. The optional ones are compiled in by CMake options
-// (SURROUNDD_WITH_HTTP, _X11, _DRM), which only this file and those types' sources see: every
-// other object is the same in every build (and ccache hits).
+// (SURROUNDD_WITH_HTTP, _RTSP, _X11, _DRM), which only this file and those types' sources see:
+// every other object is the same in every build (and ccache hits).
 #include <string>
 
 #include "daemon/built_in_outputs.hpp"
@@ -28,6 +28,12 @@ std::vector<OutputType> builtInOutputTypes() {
   types.push_back(leftOut("http",
                           "configure with -DSURROUNDD_WITH_HTTP=ON (needs libmicrohttpd-dev and "
                           "libturbojpeg0-dev)"));
+#endif
+#if SURROUNDD_WITH_RTSP
+  types.push_back(rtspOutputType());
+#else
+  types.push_back(
+      leftOut("rtsp", "configure with -DSURROUNDD_WITH_RTSP=ON (needs libgstrtspserver-1.0-dev)"));
 #endif
 #if SURROUNDD_WITH_X11
   types.push_back(windowOutputType());

@@ -61,7 +61,11 @@ void PipelineOutputs::handOver(PictureOutput& output, const cv::Mat& picture,
                                std::chrono::nanoseconds streamTime, Clock::time_point origin,
                                std::optional<render::DrawnPicture> drawn) {
   guarded(output, [&] {
-    output.sink->consume(picture, streamTime);
+    // The wall clock of the capture, for viewers that measure how late they show it.
+    const auto captured =
+        std::chrono::system_clock::now() -
+        std::chrono::duration_cast<std::chrono::system_clock::duration>(Clock::now() - origin);
+    output.sink->consume(picture, {streamTime, captured});
     output.latest = picture;
     const auto now = Clock::now();
     latency_.record(now - origin);

@@ -17,34 +17,6 @@ constexpr std::size_t kEncoderQueue = 3;
 
 using Key = ConfigKey<OutputConfig>;
 
-Key presetKey() {
-  return Key::choice("preset", &OutputConfig::preset,
-                     {{"ultrafast", "ultrafast"},
-                      {"superfast", "superfast"},
-                      {"veryfast", "veryfast"},
-                      {"faster", "faster"},
-                      {"fast", "fast"},
-                      {"medium", "medium"}},
-                     "x264 speed preset");
-}
-
-Key encoderKey() {
-  return Key::text("encoder", &OutputConfig::encoder,
-                   "the H.264 encoder: auto (the first of h264_nvenc, h264_vaapi, h264_v4l2m2m "
-                   "that opens here, else libx264; the log says which) | libx264 | an FFmpeg "
-                   "encoder's name");
-}
-
-// An encoder this FFmpeg has, and H.264 (whether its device is there shows only when it opens).
-void checkEncoder(YamlObject& item, OutputConfig& o) {
-  if (const auto problem = render::h264EncoderProblem(o.encoder)) item.error("encoder", *problem);
-}
-
-Key pixelFormatKey() {
-  return Key::choice("pixel_format", &OutputConfig::pixelFormat,
-                     {{"yuv420p", "yuv420p"}, {"yuv444p", "yuv444p"}}, "the encoded pixel format");
-}
-
 // The container is chosen by the file's extension.
 void checkVideo(YamlObject& item, OutputConfig& o) {
   checkEncoder(item, o);
@@ -65,15 +37,11 @@ void checkNetwork(YamlObject& item, OutputConfig& o) {
 std::unique_ptr<render::FrameSink> openVideo(const OutputConfig& output,
                                              const OutputContext& context) {
   if (output.path.has_parent_path()) createOutputFolder(output.path.parent_path(), output.path);
-  render::VideoEncoderSettings settings;
+  render::VideoEncoderSettings settings = encoderSettings(output, context);
   settings.path = output.path;
-  settings.size = context.pictureSize;
-  settings.nominalFps = context.nominalFps;
-  settings.crf = output.crf;
-  settings.preset = output.preset;
-  settings.pixelFormat = output.pixelFormat;
   settings.url = output.url;
-  settings.encoder = output.encoder;
+  // A viewer of the stream can tell how late it shows each picture.
+  settings.stampCaptureTime = !output.url.empty();
   auto video = std::make_unique<render::VideoSink>(
       std::move(settings), std::chrono::duration_cast<std::chrono::nanoseconds>(
                                std::chrono::duration<double>(output.segmentS)));
@@ -82,6 +50,46 @@ std::unique_ptr<render::FrameSink> openVideo(const OutputConfig& output,
 }
 
 }  // namespace
+
+ConfigKey<OutputConfig> presetKey() {
+  return Key::choice("preset", &OutputConfig::preset,
+                     {{"ultrafast", "ultrafast"},
+                      {"superfast", "superfast"},
+                      {"veryfast", "veryfast"},
+                      {"faster", "faster"},
+                      {"fast", "fast"},
+                      {"medium", "medium"}},
+                     "x264 speed preset");
+}
+
+ConfigKey<OutputConfig> encoderKey() {
+  return Key::text("encoder", &OutputConfig::encoder,
+                   "the H.264 encoder: auto (the first of h264_nvenc, h264_vaapi, h264_v4l2m2m "
+                   "that opens here, else libx264; the log says which) | libx264 | an FFmpeg "
+                   "encoder's name");
+}
+
+// An encoder this FFmpeg has, and H.264 (whether its device is there shows only when it opens).
+void checkEncoder(YamlObject& item, OutputConfig& o) {
+  if (const auto problem = render::h264EncoderProblem(o.encoder)) item.error("encoder", *problem);
+}
+
+ConfigKey<OutputConfig> pixelFormatKey() {
+  return Key::choice("pixel_format", &OutputConfig::pixelFormat,
+                     {{"yuv420p", "yuv420p"}, {"yuv444p", "yuv444p"}}, "the encoded pixel format");
+}
+
+render::VideoEncoderSettings encoderSettings(const OutputConfig& output,
+                                             const OutputContext& context) {
+  render::VideoEncoderSettings settings;
+  settings.size = context.pictureSize;
+  settings.nominalFps = context.nominalFps;
+  settings.crf = output.crf;
+  settings.preset = output.preset;
+  settings.pixelFormat = output.pixelFormat;
+  settings.encoder = output.encoder;
+  return settings;
+}
 
 ConfigKey<OutputConfig> crfKey() {
   return Key::integer("crf", &OutputConfig::crf, 0, 51, "x264 constant rate factor");

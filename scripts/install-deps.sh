@@ -17,6 +17,7 @@ PACKAGES="
   libturbojpeg0-dev libcamera-dev libsystemd-dev
   libgtest-dev libgmock-dev opencv-doc help2man lintian python3
   libmicrohttpd-dev chromium
+  libgstrtspserver-1.0-dev gstreamer1.0-plugins-base gstreamer1.0-plugins-good
 "
 
 for argument in "$@"; do

@@ -6,8 +6,8 @@
 # the pipeline, its outputs' queues and servers, the control server, the service) built with
 # ThreadSanitizer (the `tsan` preset).
 # --minimal: then also builds the `minimal` preset (every optional part left out: X11, DRM, HTTP,
-# libcamera) and runs the tests that apply to it and may differ there; those of left-out parts are
-# not run (configure lists them).
+# RTSP, libcamera) and runs the tests that apply to it and may differ there; those of left-out parts
+# are not run (configure lists them).
 # Each phase's time is printed at the end.
 set -eu
 cd "$(dirname "$0")/.."

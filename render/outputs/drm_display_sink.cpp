@@ -232,7 +232,7 @@ DrmDisplaySink::DrmDisplaySink(const DrmDisplaySettings& settings) {
 
 DrmDisplaySink::~DrmDisplaySink() = default;
 
-void DrmDisplaySink::consume(const cv::Mat& bgr, std::chrono::nanoseconds /*streamTime*/) {
+void DrmDisplaySink::consume(const cv::Mat& bgr, const PictureTime& /*time*/) {
   auto& card = *card_;
   if (bgr.type() != CV_8UC3) card.fail("expected an 8-bit BGR picture");
   card.finishFlip();  // the back buffer is free once the previous flip has shown the other one

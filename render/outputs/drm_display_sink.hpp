@@ -34,7 +34,7 @@ class DrmDisplaySink final : public FrameSink {
   explicit DrmDisplaySink(const DrmDisplaySettings& settings);
   ~DrmDisplaySink() override;
 
-  void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) override;
+  void consume(const cv::Mat& bgr, const PictureTime& time) override;
   void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) override;
   // "display HDMI-A-1 1920x1080@60 on /dev/dri/card0 (123 frames)"
   std::string describe() const override;

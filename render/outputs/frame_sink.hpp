@@ -12,6 +12,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -20,6 +21,20 @@
 
 namespace surroundd::render {
 
+// When a picture's frame set was taken. A stream time alone converts: its capture time is then
+// unknown (a test's picture, a replay's last frame).
+struct PictureTime {
+  template <class Rep, class Period>
+  PictureTime(std::chrono::duration<Rep, Period> streamTime,  // NOLINT(google-explicit-constructor)
+              std::optional<std::chrono::system_clock::time_point> capturedAt = std::nullopt)
+      : stream(streamTime), captured(capturedAt) {}
+
+  std::chrono::nanoseconds stream;  // counts from the first frame of the run
+  // The wall clock when the cameras took it; a live stream carries it to its viewers (see
+  // VideoEncoderSettings::stampCaptureTime).
+  std::optional<std::chrono::system_clock::time_point> captured;
+};
+
 class FrameSink {
  public:
   virtual ~FrameSink() = default;
@@ -27,8 +42,8 @@ class FrameSink {
   FrameSink(const FrameSink&) = delete;
   FrameSink& operator=(const FrameSink&) = delete;
 
-  // `bgr` is 8-bit BGR; `streamTime` counts from the first frame of the run.
-  virtual void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) = 0;
+  // `bgr` is 8-bit BGR.
+  virtual void consume(const cv::Mat& bgr, const PictureTime& time) = 0;
   // Whether the frame at `streamTime` is needed: the pipeline skips making pictures (renders) that
   // no sink wants.
   virtual bool wantsFrame(std::chrono::nanoseconds /*streamTime*/) const { return true; }

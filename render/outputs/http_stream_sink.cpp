@@ -305,8 +305,8 @@ HttpStreamSink::HttpStreamSink(HttpStreamSettings settings)
 
 HttpStreamSink::~HttpStreamSink() = default;
 
-void HttpStreamSink::consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) {
-  if (!wantsFrame(streamTime)) return;
+void HttpStreamSink::consume(const cv::Mat& bgr, const PictureTime& time) {
+  if (!wantsFrame(time.stream)) return;
   Impl& s = *impl_;
   const std::size_t size = s.encoder.encode(bgr, s.spare);
   {

@@ -60,7 +60,7 @@ class HttpStreamSink final : public FrameSink, public ViewPage {
   ~HttpStreamSink() override;                            // stops the server if finish() did not
 
   // Encodes `bgr` (8-bit BGR) to JPEG when wantsFrame(); otherwise does nothing.
-  void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) override;
+  void consume(const cv::Mat& bgr, const PictureTime& time) override;
   // True while a stream client is connected, before the first JPEG, and after a snapshot request
   // until the next picture.
   bool wantsFrame(std::chrono::nanoseconds streamTime) const override;

@@ -38,7 +38,7 @@ void QueuedSink::work() {
     --size_;
     lock.unlock();
     try {
-      sink_->consume(slots_[item.slot], item.streamTime);
+      sink_->consume(slots_[item.slot], item.time);
     } catch (...) {
       lock.lock();
       failure_ = std::current_exception();
@@ -52,7 +52,7 @@ void QueuedSink::work() {
   }
 }
 
-void QueuedSink::consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) {
+void QueuedSink::consume(const cv::Mat& bgr, const PictureTime& time) {
   std::size_t slot = 0;
   {
     std::unique_lock lock(mutex_);
@@ -73,7 +73,7 @@ void QueuedSink::consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime
   bgr.copyTo(slots_[slot]);
   {
     const std::lock_guard lock(mutex_);
-    queue_[(head_ + size_) % queue_.size()] = {slot, streamTime};
+    queue_[(head_ + size_) % queue_.size()] = {slot, time};
     ++size_;
   }
   changed_.notify_all();

@@ -33,7 +33,7 @@ class QueuedSink final : public FrameSink {
   QueuedSink(std::unique_ptr<FrameSink> sink, cv::Size size, std::size_t depth, WhenFull whenFull);
   ~QueuedSink() override;  // without finish(): stops the worker; the sink finalizes itself
 
-  void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) override;
+  void consume(const cv::Mat& bgr, const PictureTime& time) override;
   void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) override;
   std::string describe() const override;
   // The wrapped sink's: a picture nobody wants is neither made nor queued.
@@ -45,7 +45,7 @@ class QueuedSink final : public FrameSink {
  private:
   struct Item {
     std::size_t slot = 0;
-    std::chrono::nanoseconds streamTime{0};
+    PictureTime time{std::chrono::nanoseconds(0)};
   };
   void work();
   void stopWorker();

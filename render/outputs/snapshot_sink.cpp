@@ -9,10 +9,10 @@ namespace surroundd::render {
 SnapshotSink::SnapshotSink(std::filesystem::path path, std::chrono::nanoseconds at)
     : path_(std::move(path)), at_(at) {}
 
-void SnapshotSink::consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) {
-  if (!wantsFrame(streamTime)) return;
+void SnapshotSink::consume(const cv::Mat& bgr, const PictureTime& time) {
+  if (!wantsFrame(time.stream)) return;
   writeImageFile(path_, bgr);
-  writtenAt_ = streamTime;
+  writtenAt_ = time.stream;
 }
 
 void SnapshotSink::finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) {

@@ -15,7 +15,7 @@ namespace surroundd::render {
 class SnapshotSink final : public FrameSink {
  public:
   SnapshotSink(std::filesystem::path path, std::chrono::nanoseconds at);
-  void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) override;
+  void consume(const cv::Mat& bgr, const PictureTime& time) override;
   bool wantsFrame(std::chrono::nanoseconds streamTime) const override {
     return !writtenAt_ && streamTime >= at_;
   }

@@ -1,6 +1,7 @@
 #include "render/outputs/video_encoder.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <optional>
 #include <vector>
@@ -10,6 +11,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/ffmpeg_util.hpp"
+#include "render/outputs/capture_time_sei.hpp"
 
 extern "C" {
 #include <libavutil/hwcontext.h>
@@ -58,15 +60,20 @@ struct VideoEncoder::Impl {
   ffmpeg::BufferPtr hwDevice;  // a VA-API encoder's device and frame pool; null for the others
   ffmpeg::BufferPtr hwFrames;
   ffmpeg::FramePtr hwFrame;
-  AVStream* stream = nullptr;  // owned by `format`
+  AVStream* stream = nullptr;     // owned by `format`; null when pictures are handed over
+  EncodedPictureHandler handler;  // where the pictures go instead of a container, if set
+  // Set by any thread (a viewer joining), taken by the one that writes.
+  std::atomic<bool> keyframeWanted{false};
   std::uint64_t framesWritten = 0;
   std::optional<std::int64_t> lastPts;
   bool closed = false;
 
-  bool network() const { return !settings.url.empty(); }
-  std::string target() const { return network() ? settings.url : settings.path.string(); }
+  bool handedOver() const { return static_cast<bool>(handler); }
+  // A stream a viewer watches live (MPEG-TS over UDP, or handed to a server), not a file.
+  bool live() const { return !settings.url.empty() || handedOver(); }
+  std::string target() const { return live() ? settings.url : settings.path.string(); }
 
-  const char* kind() const { return network() ? "stream" : "video"; }
+  const char* kind() const { return live() ? "stream" : "video"; }
 
   [[noreturn]] void fail(std::string_view what, int error = 0) const {
     throw EncoderError(error == 0 ? fmt::format("{} '{}': {}", kind(), target(), what)
@@ -75,24 +82,16 @@ struct VideoEncoder::Impl {
   }
 
   void open();
+  void openContainer();
   void openCodec(AVPixelFormat pixelFormat);
   // Empty when `encoder` opened; else why not (and nothing of it kept).
   std::string tryCodec(const AVCodec* encoder, AVPixelFormat pixelFormat);
   std::string useHardwareFrames();
   void drain(bool flushing);
+  void handOver(const AVPacket& encoded) const;
 };
 
 void VideoEncoder::Impl::open() {
-  const auto extension = settings.path.extension().string();
-  const char* muxer = network()             ? "mpegts"
-                      : extension == ".mp4" ? "mp4"
-                      : extension == ".mkv" ? "matroska"
-                                            : nullptr;
-  if (muxer == nullptr)
-    fail(fmt::format("expected a file ending in .mp4 or .mkv, got '{}'", extension));
-  if (network() && !settings.url.starts_with("udp://")) {
-    fail("expected a udp://HOST:PORT address");
-  }
   if (settings.size.width <= 0 || settings.size.height <= 0 || settings.size.width % 2 != 0 ||
       settings.size.height % 2 != 0) {
     fail(fmt::format("frame size must be even and positive, got {}x{}", settings.size.width,
@@ -110,44 +109,33 @@ void VideoEncoder::Impl::open() {
   if (settings.crf < 0 || settings.crf > 51) {
     fail(fmt::format("crf must be in 0..51 (0 = lossless), got {}", settings.crf));
   }
-  // A file is written under a temporary name until it is finalized; a stream has no name to keep.
-  std::string destination = settings.url;
-  if (!network()) {
-    partPath = settings.path;
-    partPath += ".part";
-    destination = partPath.string();
-  } else if (destination.find("pkt_size=") == std::string::npos) {
-    // Seven 188-byte TS packets per datagram: below every Ethernet MTU, so nothing is fragmented.
-    destination += destination.find('?') == std::string::npos ? "?pkt_size=1316" : "&pkt_size=1316";
-  }
-  AVFormatContext* rawFormat = nullptr;
-  if (const int error =
-          avformat_alloc_output_context2(&rawFormat, nullptr, muxer, destination.c_str());
-      error < 0) {
-    fail("cannot set up the container", error);
-  }
-  format.reset(rawFormat);
-
+  if (!handedOver()) openContainer();
   openCodec(pixelFormat);
-
-  stream = avformat_new_stream(format.get(), nullptr);
-  if (stream == nullptr) fail("cannot add a video stream");
-  stream->time_base = kMicroseconds;
-  stream->avg_frame_rate = codec->framerate;
-  stream->r_frame_rate = codec->framerate;
-  if (const int error = avcodec_parameters_from_context(stream->codecpar, codec.get()); error < 0) {
-    fail("cannot describe the video stream", error);
+  if (!handedOver()) {
+    stream = avformat_new_stream(format.get(), nullptr);
+    if (stream == nullptr) fail("cannot add a video stream");
+    stream->time_base = kMicroseconds;
+    stream->avg_frame_rate = codec->framerate;
+    stream->r_frame_rate = codec->framerate;
+    if (const int error = avcodec_parameters_from_context(stream->codecpar, codec.get());
+        error < 0) {
+      fail("cannot describe the video stream", error);
+    }
+    AVDictionary* muxerOptions = nullptr;
+    if (settings.path.extension() == ".mp4" && settings.url.empty()) {
+      av_dict_set(&muxerOptions, "movie_timescale", kMp4MovieTimescale, 0);
+    }
+    if (!settings.url.empty()) {
+      // Each picture leaves whole as soon as it is encoded: its last datagram is not held for the
+      // next picture's, and its PES says how long it is, so that a receiver need not wait for
+      // the next one to know it has it all.
+      av_dict_set(&muxerOptions, "flush_packets", "1", 0);
+      av_dict_set(&muxerOptions, "omit_video_pes_length", "0", 0);
+    }
+    const int headerError = avformat_write_header(format.get(), &muxerOptions);
+    av_dict_free(&muxerOptions);
+    if (headerError < 0) fail("cannot write the container header", headerError);
   }
-  if (settings.bitExact) format->flags |= AVFMT_FLAG_BITEXACT;
-  if (const int error = avio_open(&format->pb, destination.c_str(), AVIO_FLAG_WRITE); error < 0) {
-    fail(network() ? std::string("cannot open") : fmt::format("cannot create '{}'", destination),
-         error);
-  }
-  AVDictionary* muxerOptions = nullptr;
-  if (extension == ".mp4") av_dict_set(&muxerOptions, "movie_timescale", kMp4MovieTimescale, 0);
-  const int headerError = avformat_write_header(format.get(), &muxerOptions);
-  av_dict_free(&muxerOptions);
-  if (headerError < 0) fail("cannot write the container header", headerError);
 
   frame.reset(av_frame_alloc());
   packet.reset(av_packet_alloc());
@@ -169,6 +157,40 @@ void VideoEncoder::Impl::open() {
   if (pixelFormat != AV_PIX_FMT_BGR24) {
     const int* bt601 = sws_getCoefficients(SWS_CS_ITU601);
     sws_setColorspaceDetails(sws.get(), bt601, 1, bt601, 0, 0, 1 << 16, 1 << 16);
+  }
+}
+
+void VideoEncoder::Impl::openContainer() {
+  const auto extension = settings.path.extension().string();
+  const bool network = !settings.url.empty();
+  const char* muxer = network               ? "mpegts"
+                      : extension == ".mp4" ? "mp4"
+                      : extension == ".mkv" ? "matroska"
+                                            : nullptr;
+  if (muxer == nullptr)
+    fail(fmt::format("expected a file ending in .mp4 or .mkv, got '{}'", extension));
+  if (network && !settings.url.starts_with("udp://")) fail("expected a udp://HOST:PORT address");
+  // A file is written under a temporary name until it is finalized; a stream has no name to keep.
+  std::string destination = settings.url;
+  if (!network) {
+    partPath = settings.path;
+    partPath += ".part";
+    destination = partPath.string();
+  } else if (destination.find("pkt_size=") == std::string::npos) {
+    // Seven 188-byte TS packets per datagram: below every Ethernet MTU, so nothing is fragmented.
+    destination += destination.find('?') == std::string::npos ? "?pkt_size=1316" : "&pkt_size=1316";
+  }
+  AVFormatContext* rawFormat = nullptr;
+  if (const int error =
+          avformat_alloc_output_context2(&rawFormat, nullptr, muxer, destination.c_str());
+      error < 0) {
+    fail("cannot set up the container", error);
+  }
+  format.reset(rawFormat);
+  if (settings.bitExact) format->flags |= AVFMT_FLAG_BITEXACT;
+  if (const int error = avio_open(&format->pb, destination.c_str(), AVIO_FLAG_WRITE); error < 0) {
+    fail(network ? std::string("cannot open") : fmt::format("cannot create '{}'", destination),
+         error);
   }
 }
 
@@ -231,10 +253,11 @@ std::string VideoEncoder::Impl::tryCodec(const AVCodec* encoder, AVPixelFormat p
   codec->color_trc = AVCOL_TRC_SMPTE170M;
   codec->color_range = rgb ? AVCOL_RANGE_JPEG : AVCOL_RANGE_MPEG;
   if (settings.bitExact) codec->flags |= AV_CODEC_FLAG_BITEXACT;
-  if ((format->oformat->flags & AVFMT_GLOBALHEADER) != 0)
+  // Handed-over pictures carry their parameter sets in the stream, before each keyframe.
+  if (format && (format->oformat->flags & AVFMT_GLOBALHEADER) != 0)
     codec->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
   const std::string crf = std::to_string(settings.crf);
-  if (network()) {
+  if (live()) {
     // A viewer sees each picture as soon as it is encoded (no look-ahead, no B-frames), and one
     // that joins late waits at most a second for a keyframe.
     codec->gop_size = std::max(1, static_cast<int>(std::lround(settings.nominalFps)));
@@ -249,7 +272,9 @@ std::string VideoEncoder::Impl::tryCodec(const AVCodec* encoder, AVPixelFormat p
     // (seen with x264 164 r3095); without mbtree the same input gives the same bytes on every CPU.
     if (settings.bitExact) av_opt_set(codec->priv_data, "x264-params", "mbtree=0", 0);
     if (pixelFormat == AV_PIX_FMT_YUV444P) av_opt_set(codec->priv_data, "profile", "high444", 0);
-    if (network()) av_opt_set(codec->priv_data, "tune", "zerolatency", 0);
+    if (live()) av_opt_set(codec->priv_data, "tune", "zerolatency", 0);
+    // A forced keyframe is an IDR picture, where a viewer that joins can start.
+    av_opt_set(codec->priv_data, "forced-idr", "1", 0);
   } else {
     if (takes(encoder, pixelFormat)) {
       codec->pix_fmt = pixelFormat;
@@ -271,8 +296,11 @@ std::string VideoEncoder::Impl::tryCodec(const AVCodec* encoder, AVPixelFormat p
     av_opt_set(codec->priv_data, "rc_mode", "CQP", 0);  // vaapi
     av_opt_set(codec->priv_data, "qp", crf.c_str(), 0);
     codec->bit_rate = static_cast<std::int64_t>(0.1 * settings.size.area() * settings.nominalFps);
-    if (network()) av_opt_set(codec->priv_data, "zerolatency", "1", 0);  // nvenc
+    if (live()) av_opt_set(codec->priv_data, "zerolatency", "1", 0);  // nvenc
+    av_opt_set(codec->priv_data, "forced-idr", "1", 0);               // nvenc
   }
+  // Capture times go into SEI messages only when asked for (libx264, nvenc).
+  if (settings.stampCaptureTime) av_opt_set(codec->priv_data, "udu_sei", "1", 0);
   // x264 checks the preset only here; a hardware encoder finds its device here.
   if (const int error = avcodec_open2(codec.get(), encoder, nullptr); error < 0) {
     codec.reset();
@@ -318,16 +346,34 @@ void VideoEncoder::Impl::drain(bool flushing) {
     const int status = avcodec_receive_packet(codec.get(), packet.get());
     if (status == AVERROR(EAGAIN) || (flushing && status == AVERROR_EOF)) return;
     if (status < 0) fail("encoding failed", status);
+    if (handedOver()) {
+      handOver(*packet);
+      av_packet_unref(packet.get());
+      continue;
+    }
     av_packet_rescale_ts(packet.get(), codec->time_base, stream->time_base);
     packet->stream_index = stream->index;
     if (const int error = av_interleaved_write_frame(format.get(), packet.get()); error < 0) {
-      fail(network() ? "cannot send" : "cannot write to the file", error);
+      fail(live() ? "cannot send" : "cannot write to the file", error);
     }
   }
 }
 
-VideoEncoder::VideoEncoder(VideoEncoderSettings settings) : impl_(std::make_unique<Impl>()) {
+void VideoEncoder::Impl::handOver(const AVPacket& encoded) const {
+  EncodedPicture picture;
+  picture.bytes = {encoded.data, static_cast<std::size_t>(encoded.size)};
+  picture.timestamp = std::chrono::microseconds(encoded.pts);  // the codec's time base
+  picture.keyframe = (encoded.flags & AV_PKT_FLAG_KEY) != 0;
+  handler(picture);
+}
+
+VideoEncoder::VideoEncoder(VideoEncoderSettings settings)
+    : VideoEncoder(std::move(settings), nullptr) {}
+
+VideoEncoder::VideoEncoder(VideoEncoderSettings settings, EncodedPictureHandler handler)
+    : impl_(std::make_unique<Impl>()) {
   impl_->settings = std::move(settings);
+  impl_->handler = std::move(handler);
   try {
     impl_->open();
   } catch (...) {
@@ -349,7 +395,8 @@ VideoEncoder::~VideoEncoder() {
   }
 }
 
-void VideoEncoder::write(const cv::Mat& bgr, std::chrono::nanoseconds timestamp) {
+void VideoEncoder::write(const cv::Mat& bgr, std::chrono::nanoseconds timestamp,
+                         std::optional<std::chrono::system_clock::time_point> captured) {
   auto& s = *impl_;
   if (s.closed) s.fail("write after close");
   if (bgr.type() != CV_8UC3 || bgr.size() != s.settings.size) {
@@ -359,8 +406,9 @@ void VideoEncoder::write(const cv::Mat& bgr, std::chrono::nanoseconds timestamp)
   }
   const std::int64_t pts = std::chrono::duration_cast<std::chrono::microseconds>(timestamp).count();
   // The container keeps its own precision (ms in MKV): two frames must not fall on one tick there.
-  const std::int64_t containerPts = av_rescale_q(pts, kMicroseconds, s.stream->time_base);
-  if (s.lastPts && containerPts <= av_rescale_q(*s.lastPts, kMicroseconds, s.stream->time_base)) {
+  const AVRational precision = s.stream != nullptr ? s.stream->time_base : kMicroseconds;
+  const std::int64_t containerPts = av_rescale_q(pts, kMicroseconds, precision);
+  if (s.lastPts && containerPts <= av_rescale_q(*s.lastPts, kMicroseconds, precision)) {
     s.fail(fmt::format("timestamps must increase (at the file's precision): {} us after {} us", pts,
                        *s.lastPts));
   }
@@ -380,7 +428,17 @@ void VideoEncoder::write(const cv::Mat& bgr, std::chrono::nanoseconds timestamp)
     s.hwFrame->pts = pts;
     picture = s.hwFrame.get();
   }
+  picture->pict_type = s.keyframeWanted.exchange(false) ? AV_PICTURE_TYPE_I : AV_PICTURE_TYPE_NONE;
+  if (s.settings.stampCaptureTime && captured) {
+    const CaptureTimeSei payload = captureTimeSei(*captured);
+    AVFrameSideData* sei =
+        av_frame_new_side_data(picture, AV_FRAME_DATA_SEI_UNREGISTERED, payload.size());
+    if (sei == nullptr) s.fail("out of memory");
+    std::copy(payload.begin(), payload.end(), sei->data);
+  }
   const int sent = avcodec_send_frame(s.codec.get(), picture);
+  // The frame is used again for the next picture: its capture time must not stay with it.
+  av_frame_remove_side_data(picture, AV_FRAME_DATA_SEI_UNREGISTERED);
   if (s.hwFrames) av_frame_unref(s.hwFrame.get());
   if (sent < 0) s.fail("encoding failed", sent);
   s.drain(false);
@@ -390,7 +448,7 @@ void VideoEncoder::write(const cv::Mat& bgr, std::chrono::nanoseconds timestamp)
 
 void VideoEncoder::close() {
   auto& s = *impl_;
-  if (s.closed || !s.format) return;
+  if (s.closed || (!s.format && !s.handedOver())) return;
   s.closed = true;
   const auto discard = [&s] {
     s.format.reset();
@@ -399,13 +457,14 @@ void VideoEncoder::close() {
   };
   if (s.framesWritten == 0) {
     discard();
-    if (s.network()) return;  // nothing was sent; nothing is lost
+    if (s.live()) return;  // nothing was sent; nothing is lost
     s.fail("no frames written; no file made");
   }
   try {
     if (const int error = avcodec_send_frame(s.codec.get(), nullptr); error < 0)
       s.fail("flushing failed", error);
     s.drain(true);
+    if (s.handedOver()) return;
     if (const int error = av_write_trailer(s.format.get()); error < 0)
       s.fail("cannot finalize the file", error);
     s.format.reset();  // closes the file
@@ -413,7 +472,7 @@ void VideoEncoder::close() {
     discard();
     throw;
   }
-  if (s.network()) return;
+  if (s.live()) return;
   std::error_code renamed;
   std::filesystem::rename(s.partPath, s.settings.path, renamed);
   // The finished file is kept under its .part name rather than lost.
@@ -428,6 +487,8 @@ const std::filesystem::path& VideoEncoder::path() const { return impl_->settings
 std::string VideoEncoder::target() const { return impl_->target(); }
 
 std::uint64_t VideoEncoder::framesWritten() const { return impl_->framesWritten; }
+
+void VideoEncoder::requestKeyframe() { impl_->keyframeWanted = true; }
 
 std::string VideoEncoder::encoderName() const { return impl_->codec->codec->name; }
 

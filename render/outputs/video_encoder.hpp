@@ -1,8 +1,10 @@
 #pragma once
 // H.264 (libx264, or a hardware encoder, through FFmpeg's libavcodec) into MP4 or MKV (chosen by
-// the file extension), or as MPEG-TS to a network address (`url`, e.g. udp://239.0.0.1:5600: tuned
-// for latency, no B-frames, a keyframe with its parameter sets every second so that a receiver can
-// join any time).
+// the file extension), as MPEG-TS to a network address (`url`, e.g. udp://239.0.0.1:5600), or as
+// encoded pictures handed to the caller (Annex B, for a server that sends them on: RTSP). The two
+// streams are tuned for latency: no B-frames, a keyframe with its parameter sets every second so
+// that a receiver can join any time, sooner on request (requestKeyframe()), and, with
+// stampCaptureTime, each picture's capture time in it (capture_time_sei.hpp).
 //
 // The file is written as "<path>.part" and renamed to <path> only when it has been finalized
 // (trailer written), so a finished name always plays and nothing half-written carries it. close()
@@ -29,8 +31,10 @@
 #include <array>
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -55,8 +59,11 @@ struct VideoEncoderSettings {
   std::string pixelFormat = "yuv420p";
   int threads = 0;        // encoder threads; 0 = codec's choice. Fix it for identical bytes.
   bool bitExact = false;  // leave out version strings so the same input gives the same bytes
-  std::string url;        // udp://HOST:PORT: MPEG-TS over UDP instead of a file
+  std::string url;        // udp://HOST:PORT: MPEG-TS over UDP instead of a file; for messages
+                          // only when the pictures are handed over (the server's address)
   std::string encoder = "libx264";  // libx264 | auto | an FFmpeg H.264 encoder's name
+  // Streams: each picture given a capture time carries it in an SEI message (libx264, nvenc).
+  bool stampCaptureTime = false;
 
   bool operator==(const VideoEncoderSettings&) const = default;
 };
@@ -68,16 +75,31 @@ inline constexpr std::array<const char*, 3> kHardwareH264Encoders{"h264_nvenc", 
 // has); none if it can.
 std::optional<std::string> h264EncoderProblem(std::string_view name);
 
+// One encoded picture: H.264 Annex B, a keyframe's parameter sets in front of it.
+struct EncodedPicture {
+  std::span<const std::uint8_t> bytes;  // valid during the call it is handed to
+  std::chrono::nanoseconds timestamp;
+  bool keyframe = false;
+};
+using EncodedPictureHandler = std::function<void(const EncodedPicture&)>;
+
 class VideoEncoder {
  public:
+  // Into settings.path or settings.url.
   explicit VideoEncoder(VideoEncoderSettings settings);
+  // Each encoded picture to `handler`, on the thread that writes (no file; settings.url names it).
+  VideoEncoder(VideoEncoderSettings settings, EncodedPictureHandler handler);
   ~VideoEncoder();
   VideoEncoder(const VideoEncoder&) = delete;
   VideoEncoder& operator=(const VideoEncoder&) = delete;
 
   // `bgr` is 8-bit BGR of settings.size. Timestamps must increase at the file's precision (see
   // above); converted as BT.601 limited range, and tagged so, so that decoders convert back alike.
-  void write(const cv::Mat& bgr, std::chrono::nanoseconds timestamp);
+  // `captured` goes into the stream with settings.stampCaptureTime.
+  void write(const cv::Mat& bgr, std::chrono::nanoseconds timestamp,
+             std::optional<std::chrono::system_clock::time_point> captured = std::nullopt);
+  // The next picture written is a keyframe (a viewer has joined). Safe from any thread.
+  void requestKeyframe();
   // Flushes, finalizes and renames the file. Idempotent; the destructor calls it and logs errors.
   void close();
 

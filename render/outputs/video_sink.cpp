@@ -71,7 +71,8 @@ void VideoSink::openSegment() {
   }
 }
 
-void VideoSink::consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) {
+void VideoSink::consume(const cv::Mat& bgr, const PictureTime& time) {
+  const std::chrono::nanoseconds streamTime = time.stream;
   if (segmentLength_.count() > 0) {
     // Segments cover whole multiples of their length in stream time: [0, L), [L, 2L), ...
     const auto window = streamTime.count() / segmentLength_.count();
@@ -81,7 +82,7 @@ void VideoSink::consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime)
     }
     window_ = window;
   }
-  encoder_->write(bgr, streamTime);
+  encoder_->write(bgr, streamTime, time.captured);
   ++frames_;
 }
 

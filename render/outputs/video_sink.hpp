@@ -24,7 +24,7 @@ class VideoSink final : public FrameSink {
   // Opens the file (the first segment) or the stream; throws EncoderError naming it.
   explicit VideoSink(VideoEncoderSettings settings,
                      std::chrono::nanoseconds segmentLength = std::chrono::nanoseconds(0));
-  void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) override;
+  void consume(const cv::Mat& bgr, const PictureTime& time) override;
   void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) override;
   std::string describe() const override;
 

@@ -228,7 +228,7 @@ X11WindowSink::X11WindowSink(X11WindowSettings settings) : settings_(std::move(s
 
 X11WindowSink::~X11WindowSink() = default;
 
-void X11WindowSink::consume(const cv::Mat& bgr, std::chrono::nanoseconds /*streamTime*/) {
+void X11WindowSink::consume(const cv::Mat& bgr, const PictureTime& /*time*/) {
   if (bgr.type() != CV_8UC3) {
     throw RenderError(fmt::format("X11 window on {}: frames must be 8-bit BGR, got {}",
                                   window_->displayName(), cv::typeToString(bgr.type())));

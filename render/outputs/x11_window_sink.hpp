@@ -45,7 +45,7 @@ class X11WindowSink final : public FrameSink {
   explicit X11WindowSink(X11WindowSettings settings);
   ~X11WindowSink() override;
 
-  void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) override;
+  void consume(const cv::Mat& bgr, const PictureTime& time) override;
   // False once the window was closed or the display went away.
   bool wantsFrame(std::chrono::nanoseconds streamTime) const override;
   // The window keeps showing the last frame until the sink is destroyed.

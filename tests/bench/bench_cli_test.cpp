@@ -1,13 +1,22 @@
 // surround-bench stitch on a small recording: it measures what it says (timings against the
 // cv::remap baseline, accuracy for both projections) and prints it as JSON for machines; bad
-// command lines are usage errors.
+// command lines are usage errors. surround-bench receive reads a stream as a player would.
 
+#include <chrono>
+#include <regex>
+#include <thread>
+
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include "render/outputs/video_sink.hpp"
 #include "tests/support/child_process.hpp"
+#include "tests/support/stream_receiver.hpp"
 #include "tests/support/temp_dir.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace surroundd {
 namespace {
@@ -125,7 +134,12 @@ TEST(BenchCli, BadCommandLinesAreUsageErrors) {
   for (const auto& [arguments, message] :
        {std::pair{std::vector<std::string>{"stitch"}, "no recording given"},
         std::pair{std::vector<std::string>{"stich", kRecording},
-                  "expected 'stitch', 'colour' or 'pipeline'"},
+                  "expected 'stitch', 'colour', 'pipeline' or 'receive'"},
+        std::pair{std::vector<std::string>{"receive"}, "no URL given"},
+        std::pair{std::vector<std::string>{"receive", "--transport", "sctp", "rtsp://h/s"},
+                  "--transport needs udp or tcp"},
+        std::pair{std::vector<std::string>{"receive", "--seconds", "0", "rtsp://h/s"},
+                  "--seconds needs a number from 1 to 86400"},
         std::pair{std::vector<std::string>{"pipeline", "--view", "side", kRecording},
                   "--view needs one of top, 360, orbit, split, rear"},
         std::pair{std::vector<std::string>{"pipeline", "--size", "641x480", kRecording},
@@ -151,6 +165,55 @@ TEST(BenchCli, BadCommandLinesAreUsageErrors) {
                                 dir / "out.txt");
   EXPECT_EQ(missing.wait(), 1);
   EXPECT_THAT(missing.output(), HasSubstr("rig.yaml"));
+  testing::ChildProcess http({SURROUND_BENCH, "receive", "http://127.0.0.1:9/"}, dir / "out.txt");
+  EXPECT_EQ(http.wait(), 1);
+  EXPECT_THAT(
+      http.output(),
+      HasSubstr("expected rtsp://HOST:PORT/NAME or udp://HOST:PORT, got 'http://127.0.0.1:9/'"));
+}
+
+// surround-bench receive watching a network stream as a player: every picture counted, and the
+// capture times the stream carries (set here 40 ms before each picture is sent) read back as
+// latency.
+TEST(BenchCli, ReceiveReportsPicturesAndCaptureToPictureOfAStream) {
+  const testing::TempDir dir;
+  const int port = testing::freeUdpPort();
+  testing::ChildProcess receive(
+      {SURROUND_BENCH, "receive", "--seconds", "20", "--save", (dir / "last.png").string(),
+       fmt::format("udp://127.0.0.1:{}", port)},
+      dir / "out.txt");
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!testing::udpPortBound(port) && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_TRUE(testing::udpPortBound(port)) << receive.output();
+  const cv::Size size(320, 240);
+  render::VideoEncoderSettings settings;
+  settings.url = fmt::format("udp://127.0.0.1:{}", port);
+  settings.size = size;
+  settings.stampCaptureTime = true;
+  {
+    render::VideoSink sink(settings);
+    for (int i = 0; i < 45; ++i) {
+      sink.consume(testing::syntheticPicture(size, i),
+                   {std::chrono::milliseconds(33 * i),
+                    std::chrono::system_clock::now() - std::chrono::milliseconds(40)});
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    sink.finish({}, {});
+  }
+  // It ends when nothing has come for its 5 s.
+  EXPECT_EQ(receive.wait(), 0) << receive.output();
+  EXPECT_THAT(receive.output(),
+              AllOf(HasSubstr("pictures           45 (320x240)"),
+                    HasSubstr("(45 stamped; ISO 16505 / IEC 63033-3: p99 < 200 ms")));
+  // At least the 40 ms the stamps say, plus what sending and decoding took.
+  std::smatch p50;
+  const std::string output = receive.output();
+  ASSERT_TRUE(std::regex_search(output, p50, std::regex("capture to picture p50 ([0-9.]+) ms")));
+  EXPECT_GE(std::stod(p50[1]), 40.0);
+  EXPECT_LT(std::stod(p50[1]), 1000.0);
+  EXPECT_EQ(cv::imread((dir / "last.png").string()).size(), size);
 }
 
 }  // namespace

@@ -177,8 +177,11 @@ TEST_F(ConfigTest, SegmentedVideoNetworkStreamAndTheControlSocket) {
                  "  - {type: window, display: \":3\", title: rig}\n"
                  "  - {type: http, stream: mosaic}\n"
                  "  - {type: display, stream: surround, device: /dev/dri/card1, "
-                 "connector: HDMI-A-1}"));
-  ASSERT_EQ(pages.outputs.size(), 5u);
+                 "connector: HDMI-A-1}\n"
+                 "  - {type: rtsp, stream: surround}\n"
+                 "  - {type: rtsp, stream: mosaic, listen: \"0.0.0.0:9554\", name: cameras, "
+                 "crf: 30}"));
+  ASSERT_EQ(pages.outputs.size(), 7u);
   EXPECT_EQ(pages.outputs[1].kind, OutputKind::kHttp);
   EXPECT_EQ(pages.outputs[1].listenAddress, "0.0.0.0");
   EXPECT_EQ(pages.outputs[1].listenPort, 9000);
@@ -191,12 +194,23 @@ TEST_F(ConfigTest, SegmentedVideoNetworkStreamAndTheControlSocket) {
   EXPECT_EQ(pages.outputs[4].kind, OutputKind::kDisplay);
   EXPECT_EQ(pages.outputs[4].device, "/dev/dri/card1");
   EXPECT_EQ(pages.outputs[4].connector, "HDMI-A-1");
+  EXPECT_EQ(pages.outputs[5].kind, OutputKind::kRtsp);
+  EXPECT_EQ(pages.outputs[5].listenAddress, "127.0.0.1");
+  EXPECT_EQ(pages.outputs[5].listenPort, 8554);  // RTSP's own port by default
+  EXPECT_EQ(pages.outputs[5].rtspName, "");      // named by what it shows
+  EXPECT_EQ(pages.outputs[6].listenAddress, "0.0.0.0");
+  EXPECT_EQ(pages.outputs[6].listenPort, 9554);
+  EXPECT_EQ(pages.outputs[6].rtspName, "cameras");
+  EXPECT_EQ(pages.outputs[6].crf, 30);
   expectOneError(
       "  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
       "  - {type: http, listen: \"localhost\"}",
       {"outputs[1].listen: expected IPv4-ADDRESS:PORT (e.g. 127.0.0.1:8080), got 'localhost'"});
   expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
                  "  - {type: http, listen: \"localhost:8080\"}", {"got 'localhost:8080'"});
+  expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "  - {type: rtsp, listen: \"127.0.0.1:8554\", name: \"rear view\"}",
+                 {"outputs[1].name: expected letters, digits, '-', '_' and '.', got 'rear view'"});
   expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
                  "  - {type: network, url: \"http://example.com\"}",
                  {"outputs[1].url: expected udp://HOST:PORT, got 'http://example.com'"});

@@ -61,6 +61,13 @@ TEST_F(ConfigTest, AVideoInsideARecordingAndTwoHttpOutputsOnOnePortAreRefused) {
   EXPECT_THAT(messages[0], HasSubstr("control.socket: expected a path of at most 107 bytes"));
 }
 
+TEST_F(ConfigTest, TwoRtspOutputsOnOnePortAreRefused) {
+  expectOneError("{type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "{type: rtsp, stream: surround}\n"
+                 "  - {type: rtsp, stream: mosaic, listen: \"127.0.0.1:8554\"}",
+                 {"outputs[2].listen: outputs[1] listens on port 8554 already"});
+}
+
 TEST(OutputFiles, AnEarlierRunsFilesAreKeptAndTheNextFreeNameTaken) {
   const testing::TempDir dir;
   OutputConfig video;

@@ -36,7 +36,7 @@ FlakyState& flaky() {
 
 class FlakySink final : public render::FrameSink {
  public:
-  void consume(const cv::Mat& /*bgr*/, std::chrono::nanoseconds /*streamTime*/) override {
+  void consume(const cv::Mat& /*bgr*/, const render::PictureTime& /*time*/) override {
     if (flaky().consumeFails) throw std::runtime_error("flaky: the picture was refused");
   }
   void finish(const cv::Mat& /*lastFrame*/, std::chrono::nanoseconds /*lastTime*/) override {}

@@ -48,11 +48,11 @@ class TallySink final : public render::FrameSink {
  public:
   explicit TallySink(TallySettings settings) : settings_(settings) {}
 
-  void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) override {
+  void consume(const cv::Mat& bgr, const render::PictureTime& time) override {
     if (count_++ % settings_.every != 0) return;
     const std::lock_guard lock(tally().mutex);
     tally().sizes.push_back(bgr.size());
-    tally().times.push_back(streamTime);
+    tally().times.push_back(time.stream);
   }
   void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds /*lastTime*/) override {
     const std::lock_guard lock(tally().mutex);

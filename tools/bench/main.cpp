@@ -6,6 +6,7 @@
 //   surround-bench pipeline [--threads N] [--repeats N] [--json] [--solver S] [--projection P]
 //                           [--view V] [--size WxH] [--input decode|raw] [--raw-format F]
 //                           RECORDING...
+//   surround-bench receive [--transport udp|tcp] [--seconds N] [--save PICTURE] URL
 //
 // Exit codes: 0 done, 1 failed while measuring, 2 bad command line.
 
@@ -21,6 +22,7 @@
 #include "common/work_pool.hpp"
 #include "tools/bench/colour_benchmark.hpp"
 #include "tools/bench/pipeline_benchmark.hpp"
+#include "tools/bench/receive_benchmark.hpp"
 #include "tools/bench/rig_colour_report.hpp"
 #include "tools/bench/stitch_benchmark.hpp"
 
@@ -32,6 +34,7 @@ constexpr std::string_view kUsage =
        surround-bench pipeline [--threads N] [--repeats N] [--json] [--solver S]
                                [--projection P] [--view V] [--size WxH] [--input I]
                                [--raw-format F] RECORDING...
+       surround-bench receive [--transport T] [--seconds N] [--save PICTURE] URL
   stitch        LUT build, stitch against cv::remap, accuracy against the ground truth
   colour        Poisson colour correction: solvers, per-frame cost, seam colour error; for a
                 CONFIG (a surroundd .yaml: any rig, the shared real ones, your own car): per
@@ -41,6 +44,8 @@ constexpr std::string_view kUsage =
                 milliseconds per stage, CPU and peak memory, against a decode-only replay
                 (--input raw: convert-only); frame rate, latency and time to the first picture
                 (cold and warm LUT cache) beside their limits
+  receive       a surroundd stream watched as a viewer would (FFmpeg): pictures per second and
+                capture to decoded picture, from the capture times the stream carries
   RECORDING     a surround-synth recording folder (with ground truth); scripts/bench.sh makes
                 4x480p, 720p and 1080p ones
   --threads N   worker threads (default 2); stitch measures 1 thread too
@@ -55,6 +60,11 @@ constexpr std::string_view kUsage =
                 frame as a V4L2 camera's are: live-rig figures)
   --raw-format F  pipeline, --input raw: yuyv | nv12 (default yuyv)
   --pictures DIR  colour, CONFIG: also write the panoramas (none, gain, Poisson) and body masks
+  URL           receive: rtsp://HOST:PORT/NAME (an rtsp output) or udp://HOST:PORT (a network
+                output's address, bound here)
+  --transport T receive, RTSP: udp (RTP over UDP; the default) | tcp (in the RTSP connection)
+  --seconds N   receive: watch for at most N seconds (default 10; the stream may end first)
+  --save PICTURE  receive: write the last picture there (.png, .jpg)
 )";
 
 int usageError(std::string_view message) {
@@ -83,6 +93,43 @@ std::optional<E> parseWord(std::string_view text,
   return std::nullopt;
 }
 
+int receive(int argc, char** argv) {
+  surroundd::bench::ReceiveBenchmarkOptions options;
+  for (int i = 2; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    const std::string_view value = i + 1 < argc ? argv[i + 1] : "";
+    if (arg == "--transport") {
+      if (value != "udp" && value != "tcp") return usageError("--transport needs udp or tcp");
+      options.viewer.transport = value;
+      ++i;
+    } else if (arg == "--seconds") {
+      int seconds = 0;
+      if (!parseNumber(value, seconds, 1, 86400)) {
+        return usageError("--seconds needs a number from 1 to 86400");
+      }
+      options.duration = std::chrono::seconds(seconds);
+      ++i;
+    } else if (arg == "--save") {
+      if (value.empty()) return usageError("--save needs a file");
+      options.lastPicture = value;
+      ++i;
+    } else if (arg.starts_with("--")) {
+      return usageError(fmt::format("unknown option '{}'", arg));
+    } else if (!options.viewer.url.empty()) {
+      return usageError("receive takes one URL");
+    } else {
+      options.viewer.url = arg;
+    }
+  }
+  if (options.viewer.url.empty()) return usageError("no URL given");
+  try {
+    return surroundd::bench::runReceiveBenchmark(options);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "surround-bench: {}\n", e.what());
+    return 1;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -96,8 +143,9 @@ int main(int argc, char** argv) {
     return 0;
   }
   const std::string_view command = argc >= 2 ? argv[1] : "";
+  if (command == "receive") return receive(argc, argv);
   if (command != "stitch" && command != "colour" && command != "pipeline") {
-    return usageError("expected 'stitch', 'colour' or 'pipeline'");
+    return usageError("expected 'stitch', 'colour', 'pipeline' or 'receive'");
   }
   bench::StitchBenchmarkOptions options;
   bench::PipelineBenchmarkOptions pipeline;

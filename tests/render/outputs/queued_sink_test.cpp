@@ -40,7 +40,7 @@ class KeepingSink final : public FrameSink {
     bool finished = false;
   };
   explicit KeepingSink(Shared& shared) : shared_(shared) {}
-  void consume(const cv::Mat& bgr, std::chrono::nanoseconds streamTime) override {
+  void consume(const cv::Mat& bgr, const PictureTime& time) override {
     if (shared_.hold) {
       if (!std::exchange(shared_.holdingSet, true)) shared_.holding.set_value();
       shared_.release.wait();
@@ -49,7 +49,7 @@ class KeepingSink final : public FrameSink {
     if (static_cast<int>(shared_.consumed.size()) == shared_.failAt) {
       throw std::runtime_error("disk full");
     }
-    shared_.consumed.emplace_back(bgr.clone(), streamTime);
+    shared_.consumed.emplace_back(bgr.clone(), time.stream);
   }
   void finish(const cv::Mat& /*lastFrame*/, std::chrono::nanoseconds /*lastTime*/) override {
     shared_.finished = true;
