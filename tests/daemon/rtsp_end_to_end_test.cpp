@@ -1,6 +1,6 @@
 // surroundd's rtsp output as a player sees it: FFmpeg connects to a running daemon and gets the
-// rendered frames from there to the end. A test program of its own: GStreamer's allocations need
-// LeakSanitizer's full stacks (tests/CMakeLists.txt, GLIB).
+// rendered frames from there to the end. A test program of its own: under ASan, LeakSanitizer
+// cannot judge GStreamer's allocations (tests/CMakeLists.txt, GLIB).
 
 #include <csignal>
 #include <thread>
@@ -62,6 +62,7 @@ outputs:
   ASSERT_THAT(url, ::testing::MatchesRegex("rtsp://127\\.0\\.0\\.1:[0-9]+/surround"))
       << surroundd.output();
   testing::StreamReceiver player(bench::StreamViewerSettings{url, "tcp", std::chrono::seconds(10)});
+  // It has connected, or failed (its own 10 s timeout at most).
   while (!player.started()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
   std::this_thread::sleep_for(std::chrono::seconds(2));
   surroundd.signal(SIGTERM);
