@@ -92,7 +92,7 @@ struct RtspStreamSink::Impl {
   std::optional<VideoEncoder> encoder;
   std::unique_ptr<GMainContext, MainContextUnref> context{g_main_context_new()};
   std::unique_ptr<GMainLoop, MainLoopUnref> loop{g_main_loop_new(context.get(), FALSE)};
-  GObjectPtr<GstRTSPServer> server{gst_rtsp_server_new()};
+  GObjectPtr<GstRTSPServer> server;  // made once GStreamer is started
   std::unique_ptr<GSource, SourceUnref> listening;
   std::thread thread;  // runs `loop`: every callback below but consume()'s
   int port = 0;
@@ -103,7 +103,9 @@ struct RtspStreamSink::Impl {
   GstAppSrc* pictures = nullptr;  // the shared pipeline's way in (a reference), while it exists
   GstRTSPMedia* media = nullptr;  // whose pipeline that is (no reference: `connected` holds one)
   std::optional<std::chrono::nanoseconds> firstTimestamp;  // of the pictures pushed into it
-  std::vector<GObjectPtr<GObject>> connected;              // media and clients that call us back
+  // The media and clients that call us back, while they do (a reference each, dropped when the
+  // client leaves or the media ends), so that stop() can tell them to stop.
+  std::vector<GObjectPtr<GObject>> connected;
   std::atomic<bool> watched{false};
   std::atomic<int> viewers{0};
   std::atomic<std::uint64_t> viewersServed{0};
@@ -115,6 +117,13 @@ struct RtspStreamSink::Impl {
   void send(const EncodedPicture& picture);
   void stop();
   void follow(gpointer object) { connected.emplace_back(G_OBJECT(g_object_ref(object))); }
+  void unfollow(gpointer object) {
+    std::erase_if(connected, [this, object](const GObjectPtr<GObject>& followed) {
+      if (followed.get() != object) return false;
+      g_signal_handlers_disconnect_by_data(object, this);
+      return true;
+    });
+  }
 
   static void onMediaConfigure(GstRTSPMediaFactory* factory, GstRTSPMedia* media, gpointer self);
   static void onMediaPrepared(GstRTSPMedia* media, gpointer self);
@@ -133,6 +142,7 @@ void RtspStreamSink::Impl::listen() {
   if (const std::string problem = gstreamerProblem(); !problem.empty()) {
     throw std::runtime_error(fmt::format("RTSP stream on {}: {}", where, problem));
   }
+  server.reset(gst_rtsp_server_new());
   GstRTSPServer* s = server.get();
   gst_rtsp_server_set_address(s, settings.address.c_str());
   gst_rtsp_server_set_service(s, std::to_string(settings.port).c_str());
@@ -206,6 +216,7 @@ void RtspStreamSink::Impl::onMediaPrepared(GstRTSPMedia* media, gpointer /*self*
 void RtspStreamSink::Impl::onMediaUnprepared(GstRTSPMedia* media, gpointer self) {
   auto& s = *static_cast<Impl*>(self);
   const std::lock_guard lock(s.mutex);
+  s.unfollow(media);
   if (media != s.media) return;  // one that a newer pipeline has replaced already
   s.watched = false;
   s.media = nullptr;
@@ -223,8 +234,11 @@ void RtspStreamSink::Impl::onClientConnected(GstRTSPServer* /*server*/, GstRTSPC
   g_signal_connect(client, "play-request", G_CALLBACK(onPlay), self);
 }
 
-void RtspStreamSink::Impl::onClientClosed(GstRTSPClient* /*client*/, gpointer self) {
-  --static_cast<Impl*>(self)->viewers;
+void RtspStreamSink::Impl::onClientClosed(GstRTSPClient* client, gpointer self) {
+  auto& s = *static_cast<Impl*>(self);
+  --s.viewers;
+  const std::lock_guard lock(s.mutex);
+  s.unfollow(client);
 }
 
 void RtspStreamSink::Impl::onPlay(GstRTSPClient* /*client*/, GstRTSPContext* /*request*/,

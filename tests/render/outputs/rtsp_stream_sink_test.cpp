@@ -1,5 +1,6 @@
 #include "render/outputs/rtsp_stream_sink.hpp"
 
+#include <atomic>
 #include <chrono>
 #include <thread>
 
@@ -114,6 +115,53 @@ TEST(RtspStreamSink, ServesOneStreamToViewersOverUdpAndTcpEachFromTheNextPicture
   EXPECT_THAT(sink.describe(), HasSubstr(fmt::format("RTSP stream {} ({} frames, 2 viewers)",
                                                      sink.url(), last - indexOf(onUdp[0]) + 1)));
   EXPECT_EQ(sink.viewers(), 0);
+}
+
+// A player that leaves ends the encoding once it was the last; the next one gets a new pipeline
+// and pictures again, from its own start.
+TEST(RtspStreamSink, APlayerAfterTheLastOneLeftIsServedAfresh) {
+  RtspStreamSink sink(settingsOnAnyPort());
+  std::atomic<bool> feeding{true};
+  std::atomic<int> sent{0};
+  std::thread feeder([&] {
+    for (int index = 0; feeding; ++index) {
+      sink.consume(testPicture(index), {milliseconds(10 * index), capturedAt(index)});
+      sent = index;
+      std::this_thread::sleep_for(milliseconds(10));
+    }
+  });
+  const auto watch = [&](int pictures) {
+    bench::StreamViewer viewer({sink.url(), "tcp", std::chrono::seconds(5)});
+    std::vector<int> indices;
+    while (static_cast<int>(indices.size()) < pictures) {
+      const auto picture = viewer.next();
+      if (!picture || !picture->captured) break;
+      indices.push_back(indexOf(*picture));
+    }
+    return indices;
+  };
+  const std::vector<int> first = watch(10);
+  // Gone: nobody watches, nothing is wanted.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while ((sink.viewers() > 0 || sink.wantsFrame(milliseconds(0))) &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(milliseconds(10));
+  }
+  EXPECT_EQ(sink.viewers(), 0);
+  EXPECT_FALSE(sink.wantsFrame(milliseconds(0)));
+  const int before = sent;
+  const std::vector<int> second = watch(10);
+  feeding = false;
+  feeder.join();
+  sink.finish({}, {});
+  ASSERT_EQ(first.size(), 10u);
+  ASSERT_EQ(second.size(), 10u);
+  for (std::size_t k = 1; k < 10; ++k) {
+    EXPECT_EQ(first[k], first[k - 1] + 1);
+    EXPECT_EQ(second[k], second[k - 1] + 1);
+  }
+  EXPECT_GT(second.front(), before);  // its own pictures, none left over from the first pipeline
+  EXPECT_THAT(sink.describe(), HasSubstr("2 viewers"));
 }
 
 TEST(RtspStreamSink, APortInUseIsRefusedWithTheAddress) {
