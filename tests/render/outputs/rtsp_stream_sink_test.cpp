@@ -19,13 +19,14 @@ using std::chrono::milliseconds;
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
+// NOLINTNEXTLINE(cert-err58-cpp): cv::Size stores two ints; its constructor throws nothing.
 const cv::Size kSize(320, 240);
 
 cv::Mat testPicture(int index) { return testing::syntheticPicture(kSize, index); }
 
 // Picture `index`'s capture time: the index in seconds after an arbitrary start, so that a
 // viewer's picture says which one it is.
-const auto kStart = std::chrono::system_clock::time_point(std::chrono::hours(24 * 365 * 56));
+constexpr auto kStart = std::chrono::system_clock::time_point(std::chrono::hours(24 * 365 * 56));
 std::chrono::system_clock::time_point capturedAt(int index) {
   return kStart + std::chrono::seconds(index);
 }
