@@ -8,7 +8,9 @@ scripts/install-deps.sh
 cmake --preset release
 cmake --build --preset release --target surroundd surroundctl surround-synth surround-calibrate \
   surround-bench
-build/release/tools/synth/surround-synth --rig config/rigs/paper.yaml --out recordings/demo
+# recordings/demo is the demo's own: made again (--force) only when the generator or its arguments
+# changed since (a recording of the same key is kept, "up to date").
+build/release/tools/synth/surround-synth --rig config/rigs/paper.yaml --out recordings/demo --force
 build/release/daemon/surroundd --config config/demo.yaml "$@" &
 daemon=$!
 # The rear view with its guidelines (issue 21), after the snapshots at 5 s: the car in reverse
