@@ -66,19 +66,19 @@ CameraHealth CameraHealthMonitor::judge(Camera& camera, const Frame* frame, Time
   }
   camera.lastFrame = now;
 
-  const cv::Mat& image = frame->image;
+  const cv::Size size = pictureSize(frame->format, frame->image);
   std::array<std::uint8_t, static_cast<std::size_t>(kSamplesAcross) * kSamplesDown * 3> samples{};
   std::uint64_t sum = 0;
   std::size_t index = 0;
   for (int j = 0; j < kSamplesDown; ++j) {
-    const auto* row = image.ptr<std::uint8_t>((2 * j + 1) * image.rows / (2 * kSamplesDown));
+    const int row = (2 * j + 1) * size.height / (2 * kSamplesDown);
     for (int i = 0; i < kSamplesAcross; ++i) {
-      const std::size_t column = static_cast<std::size_t>((2 * i + 1) * image.cols) /
-                                 (2 * static_cast<std::size_t>(kSamplesAcross));
-      const std::uint8_t* pixel = row + 3 * column;
+      const int column = (2 * i + 1) * size.width / (2 * kSamplesAcross);
+      const std::uint32_t pixel = bgrAt(frame->image, frame->format, column, row);
       for (int k = 0; k < 3; ++k) {
-        samples[index++] = pixel[k];
-        sum += pixel[k];
+        const auto level = static_cast<std::uint8_t>(pixel >> (8 * k));
+        samples[index++] = level;
+        sum += level;
       }
     }
   }

@@ -14,7 +14,7 @@ CameraStream::CameraStream(std::string name, std::unique_ptr<FrameSource> source
                            std::size_t poolFrames, RecoverySettings recovery)
     : name_(std::move(name)),
       source_(std::move(source)),
-      pool_(poolFrames, source_->frameSize()),
+      pool_(poolFrames, source_->frameSize(), source_->pixelFormat()),
       nominalPeriod_(source_->nominalPeriod()),
       repeatsOnePicture_(source_->repeatsOnePicture()),
       recovery_(recovery),

@@ -15,6 +15,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "common/pixel_format.hpp"
+
 namespace surroundd::capture {
 
 // Timestamps are on the source's monotonic clock (the driver's, or the file's presentation time),
@@ -22,7 +24,10 @@ namespace surroundd::capture {
 using Timestamp = std::chrono::nanoseconds;
 
 struct Frame {
-  cv::Mat image;               // 8-bit BGR, allocated once by the pool; never reallocated per frame
+  // The picture as `format` holds it (common/pixel_format.hpp: BGR, or the camera's own YUYV or
+  // NV12), allocated once by the pool; never reallocated per frame.
+  cv::Mat image;
+  PixelFormat format = PixelFormat::kBgr;
   Timestamp timestamp{0};      // presentation (capture) time of the first pixel row
   std::uint64_t sequence = 0;  // per-source frame counter; gaps mean the source skipped frames
   // Decoded with errors that the decoder concealed (the source's lastError() says which): shown,
@@ -44,11 +49,11 @@ struct FrameReturner {
 
 using FrameRef = std::unique_ptr<Frame, detail::FrameReturner>;
 
-// A fixed set of preallocated frames of one size. acquire() blocks while all are in use, which is
-// how a consumer that falls behind applies back-pressure to a replay source.
+// A fixed set of preallocated frames of one size and format. acquire() blocks while all are in
+// use, which is how a consumer that falls behind applies back-pressure to a replay source.
 class FramePool {
  public:
-  FramePool(std::size_t count, cv::Size size);
+  FramePool(std::size_t count, cv::Size size, PixelFormat format = PixelFormat::kBgr);
 
   // Blocks until a frame is free or `timeout` passes; returns an empty FrameRef on timeout.
   FrameRef acquire(std::chrono::milliseconds timeout);

@@ -19,13 +19,14 @@ void FrameReturner::operator()(Frame* frame) const noexcept {
 }
 }  // namespace detail
 
-FramePool::FramePool(std::size_t count, cv::Size size)
+FramePool::FramePool(std::size_t count, cv::Size size, PixelFormat format)
     : state_(std::make_shared<detail::FramePoolState>()), size_(size) {
   state_->storage.reserve(count);
   state_->free.reserve(count);
   for (std::size_t i = 0; i < count; ++i) {
     auto frame = std::make_unique<Frame>();
-    frame->image.create(size, CV_8UC3);
+    frame->image.create(heldSize(format, size), heldType(format));
+    frame->format = format;
     state_->free.push_back(frame.get());
     state_->storage.push_back(std::move(frame));
   }

@@ -35,11 +35,15 @@ class FrameSource {
   FrameSource(const FrameSource&) = delete;
   FrameSource& operator=(const FrameSource&) = delete;
 
-  // Size of the BGR frames this source delivers; known once the source is constructed.
+  // Size of the pictures this source delivers; known once the source is constructed.
   virtual cv::Size frameSize() const = 0;
+  // How it holds them (common/pixel_format.hpp); known once the source is constructed, and kept
+  // by reopen(). BGR unless a source says otherwise.
+  virtual PixelFormat pixelFormat() const { return PixelFormat::kBgr; }
   // Nominal frame period, used for pacing and health deadlines.
   virtual Timestamp nominalPeriod() const = 0;
-  // Blocks until the next frame is decoded or captured into `out` (whose image has frameSize()).
+  // Blocks until the next frame is decoded or captured into `out` (whose image holds a picture of
+  // frameSize() in pixelFormat()).
   virtual ReadStatus read(Frame& out) = 0;
   virtual const std::string& lastError() const = 0;
   // Opens the device again after kLost, keeping frameSize() and nominalPeriod(). Throws

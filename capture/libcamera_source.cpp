@@ -192,6 +192,8 @@ LibcameraSource::~LibcameraSource() { impl_->close(); }
 
 cv::Size LibcameraSource::frameSize() const { return impl_->settings.size; }
 
+PixelFormat LibcameraSource::pixelFormat() const { return heldFormat(impl_->layout); }
+
 Timestamp LibcameraSource::nominalPeriod() const {
   return std::chrono::duration_cast<Timestamp>(
       std::chrono::duration<double>(1 / impl_->settings.fps));
@@ -242,8 +244,8 @@ ReadStatus LibcameraSource::read(Frame& out) {
     std::size_t bytes = 0;
     for (const auto& plane : metadata.planes()) bytes += plane.bytesused;
     const auto* data = static_cast<const std::uint8_t*>(mapping.address) + mapping.offset;
-    good = convertToBgr(s.layout, std::span(data, std::min(bytes, mapping.length - mapping.offset)),
-                        s.stride, s.jpeg, out.image, s.error);
+    good = holdFrame(s.layout, std::span(data, std::min(bytes, mapping.length - mapping.offset)),
+                     s.stride, s.jpeg, s.settings.size, out.image, s.error);
     out.timestamp = Timestamp(static_cast<std::int64_t>(metadata.timestamp));
   }
   request->reuse(libcamera::Request::ReuseBuffers);

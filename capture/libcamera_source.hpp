@@ -38,6 +38,7 @@ class LibcameraSource final : public FrameSource {
   ~LibcameraSource() override;
 
   cv::Size frameSize() const override;
+  PixelFormat pixelFormat() const override;
   Timestamp nominalPeriod() const override;
   ReadStatus read(Frame& out) override;
   const std::string& lastError() const override;

@@ -19,6 +19,7 @@ LibcameraSource::LibcameraSource(std::string cameraName, LibcameraSettings /*set
 
 LibcameraSource::~LibcameraSource() = default;
 cv::Size LibcameraSource::frameSize() const { return {}; }
+PixelFormat LibcameraSource::pixelFormat() const { return PixelFormat::kBgr; }
 Timestamp LibcameraSource::nominalPeriod() const { return {}; }
 ReadStatus LibcameraSource::read(Frame& /*out*/) { return ReadStatus::kEndOfStream; }
 void LibcameraSource::reopen() { throw CaptureError("built without libcamera"); }

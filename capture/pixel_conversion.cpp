@@ -1,5 +1,7 @@
 #include "capture/pixel_conversion.hpp"
 
+#include <cstring>
+
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
@@ -50,22 +52,61 @@ bool convertToBgr(PixelLayout layout, std::span<const std::uint8_t> data, std::s
   return false;
 }
 
-bool convertNv12PlanesToBgr(PlaneView luma, PlaneView chroma, cv::Mat& bgr, std::string& error) {
-  const auto rows = static_cast<std::size_t>(bgr.rows);
-  const auto cols = static_cast<std::size_t>(bgr.cols);
-  if (luma.bytesPerLine < cols || chroma.bytesPerLine < cols ||
-      luma.data.size() < luma.bytesPerLine * rows ||
-      chroma.data.size() < chroma.bytesPerLine * (rows / 2)) {
-    error = fmt::format("a two-plane NV12 frame of {} + {} bytes is too short for {}x{}",
-                        luma.data.size(), chroma.data.size(), bgr.cols, bgr.rows);
+PixelFormat heldFormat(PixelLayout layout) {
+  switch (layout) {
+    case PixelLayout::kYuyv:
+      return PixelFormat::kYuyv;
+    case PixelLayout::kNv12:
+      return PixelFormat::kNv12;
+    case PixelLayout::kUyvy:
+    case PixelLayout::kBgr:
+    case PixelLayout::kMjpeg:
+      break;
+  }
+  return PixelFormat::kBgr;
+}
+
+namespace {
+
+// `rows` rows of `rowBytes` each, `bytesPerLine` apart in `data`, into the continuous `to`.
+bool copyRows(std::span<const std::uint8_t> data, std::size_t bytesPerLine, std::size_t rowBytes,
+              std::size_t rows, std::uint8_t* to) {
+  if (rows == 0) return true;
+  if (bytesPerLine < rowBytes || data.size() < bytesPerLine * (rows - 1) + rowBytes) return false;
+  for (std::size_t r = 0; r < rows; ++r) {
+    std::memcpy(to + r * rowBytes, data.data() + r * bytesPerLine, rowBytes);
+  }
+  return true;
+}
+
+}  // namespace
+
+bool holdFrame(PixelLayout layout, std::span<const std::uint8_t> data, std::size_t bytesPerLine,
+               JpegDecoder& jpeg, cv::Size size, cv::Mat& held, std::string& error) {
+  const PixelFormat format = heldFormat(layout);
+  if (format == PixelFormat::kBgr) return convertToBgr(layout, data, bytesPerLine, jpeg, held, error);
+  const cv::Size rows = heldSize(format, size);
+  const std::size_t rowBytes = static_cast<std::size_t>(rows.width) * (format == PixelFormat::kYuyv ? 2 : 1);
+  if (!copyRows(data, bytesPerLine, rowBytes, static_cast<std::size_t>(rows.height),
+                held.ptr<std::uint8_t>())) {
+    error = fmt::format("a {} frame of {} bytes ({} per line) is too short for {}x{}",
+                        toString(layout), data.size(), bytesPerLine, size.width, size.height);
     return false;
   }
-  // cv::Mat has no read-only header; the planes are only read.
-  const cv::Mat y(bgr.rows, bgr.cols, CV_8UC1, const_cast<std::uint8_t*>(luma.data.data()),
-                  luma.bytesPerLine);
-  const cv::Mat uv(bgr.rows / 2, bgr.cols / 2, CV_8UC2,
-                   const_cast<std::uint8_t*>(chroma.data.data()), chroma.bytesPerLine);
-  cv::cvtColorTwoPlane(y, uv, bgr, cv::COLOR_YUV2BGR_NV12);
+  return true;
+}
+
+bool holdNv12Planes(PlaneView luma, PlaneView chroma, cv::Size size, cv::Mat& held,
+                    std::string& error) {
+  const auto rows = static_cast<std::size_t>(size.height);
+  const auto cols = static_cast<std::size_t>(size.width);
+  if (!copyRows(luma.data, luma.bytesPerLine, cols, rows, held.ptr<std::uint8_t>()) ||
+      !copyRows(chroma.data, chroma.bytesPerLine, cols, rows / 2,
+                held.ptr<std::uint8_t>(size.height))) {
+    error = fmt::format("a two-plane NV12 frame of {} + {} bytes is too short for {}x{}",
+                        luma.data.size(), chroma.data.size(), size.width, size.height);
+    return false;
+  }
   return true;
 }
 

@@ -1,7 +1,8 @@
 #pragma once
-// Camera pixel formats to the pipeline's 8-bit BGR, once per frame, into the frame's own image:
-// packed 4:2:2 (YUYV, UYVY), NV12, 24-bit BGR, and MJPEG through libjpeg-turbo. Shared by the
-// live sources (V4L2, libcamera).
+// What a camera hands over into a frame's own image, once per frame: YUYV and NV12 kept as they
+// are (the stitch samples them directly, common/pixel_format.hpp); packed UYVY, 24-bit BGR and
+// MJPEG (through libjpeg-turbo) converted to 8-bit BGR. Shared by the live sources (V4L2,
+// libcamera) and the preloaded replay.
 
 #include <cstdint>
 #include <span>
@@ -10,6 +11,7 @@
 #include <opencv2/core.hpp>
 
 #include "capture/jpeg_decoder.hpp"
+#include "common/pixel_format.hpp"
 
 namespace surroundd::capture {
 
@@ -22,13 +24,22 @@ const char* toString(PixelLayout layout);
 bool convertToBgr(PixelLayout layout, std::span<const std::uint8_t> data, std::size_t bytesPerLine,
                   JpegDecoder& jpeg, cv::Mat& bgr, std::string& error);
 
+// How a frame delivered in `layout` is held: YUYV and NV12 as they came, the others as BGR.
+PixelFormat heldFormat(PixelLayout layout);
+// A delivered frame into `held`, a picture of `size` held in heldFormat(layout) (allocated by the
+// frame's pool): YUYV and NV12 copied without the driver's row padding, the others converted by
+// convertToBgr. False, with `error` set, as convertToBgr.
+bool holdFrame(PixelLayout layout, std::span<const std::uint8_t> data, std::size_t bytesPerLine,
+               JpegDecoder& jpeg, cv::Size size, cv::Mat& held, std::string& error);
+
 // One plane of a frame whose planes lie in separate buffers (V4L2 multi-planar formats).
 struct PlaneView {
   std::span<const std::uint8_t> data;
   std::size_t bytesPerLine = 0;
 };
-// NV12 with luma and interleaved chroma in two buffers (V4L2's NV12M). False, with `error` set,
-// for a plane too short for the frame's size.
-bool convertNv12PlanesToBgr(PlaneView luma, PlaneView chroma, cv::Mat& bgr, std::string& error);
+// NV12 with luma and interleaved chroma in two buffers (V4L2's NV12M), into `held`: a picture of
+// `size` held as NV12. False, with `error` set, for a plane too short for the frame's size.
+bool holdNv12Planes(PlaneView luma, PlaneView chroma, cv::Size size, cv::Mat& held,
+                    std::string& error);
 
 }  // namespace surroundd::capture

@@ -19,57 +19,6 @@ constexpr int kMaxFaultsInARow = 100;
 
 constexpr double kBytesPerMib = 1024.0 * 1024.0;
 
-// BGR to a camera's YUV as V4L2 cameras deliver YUYV and NV12: BT.601, limited range (luma
-// 16..235, chroma 16..240 around 128), what cv::cvtColor's YUV2BGR_YUYV and _NV12 take back.
-// Each chroma sample is that of the mean of the pixels sharing it (YUYV: two in a row; NV12: 2x2).
-// Computed here rather than by libswscale, whose packed 4:2:2 output comes out a level and a half
-// too blue and red against the decoded frames; only at start, so plain float arithmetic does.
-std::uint8_t level(float value) { return cv::saturate_cast<std::uint8_t>(value); }
-float lumaOf(const cv::Vec3f& bgr) {
-  return 16.0F + (24.966F * bgr[0] + 128.553F * bgr[1] + 65.481F * bgr[2]) / 255.0F;
-}
-float cbOf(const cv::Vec3f& bgr) {
-  return 128.0F + (112.0F * bgr[0] - 74.203F * bgr[1] - 37.797F * bgr[2]) / 255.0F;
-}
-float crOf(const cv::Vec3f& bgr) {
-  return 128.0F + (-18.214F * bgr[0] - 93.786F * bgr[1] + 112.0F * bgr[2]) / 255.0F;
-}
-
-void writeYuyv(const cv::Mat& bgr, std::uint8_t* out) {
-  for (int y = 0; y < bgr.rows; ++y) {
-    const auto* row = bgr.ptr<cv::Vec3b>(y);
-    for (int x = 0; x < bgr.cols; x += 2, out += 4) {
-      const cv::Vec3f left = row[x];
-      const cv::Vec3f right = row[x + 1];
-      const cv::Vec3f mean = (left + right) * 0.5F;
-      out[0] = level(lumaOf(left));
-      out[1] = level(cbOf(mean));
-      out[2] = level(lumaOf(right));
-      out[3] = level(crOf(mean));
-    }
-  }
-}
-
-void writeNv12(const cv::Mat& bgr, std::uint8_t* out) {
-  std::uint8_t* chroma = out + bgr.total();
-  for (int y = 0; y < bgr.rows; y += 2) {
-    const auto* top = bgr.ptr<cv::Vec3b>(y);
-    const auto* bottom = bgr.ptr<cv::Vec3b>(y + 1);
-    std::uint8_t* lumaTop = out + static_cast<std::size_t>(y) * bgr.cols;
-    std::uint8_t* lumaBottom = lumaTop + bgr.cols;
-    for (int x = 0; x < bgr.cols; x += 2, chroma += 2) {
-      const cv::Vec3f a = top[x], b = top[x + 1], c = bottom[x], d = bottom[x + 1];
-      lumaTop[x] = level(lumaOf(a));
-      lumaTop[x + 1] = level(lumaOf(b));
-      lumaBottom[x] = level(lumaOf(c));
-      lumaBottom[x + 1] = level(lumaOf(d));
-      const cv::Vec3f mean = (a + b + c + d) * 0.25F;
-      chroma[0] = level(cbOf(mean));
-      chroma[1] = level(crOf(mean));
-    }
-  }
-}
-
 // One frame as a camera of the format hands it over.
 struct HeldFrame {
   std::vector<std::uint8_t> data;
@@ -178,11 +127,9 @@ void PreloadedSource::Impl::load() {
     held.data.resize(frameBytes);
     held.timestamp = decoded.timestamp;
     if (decoded.concealedErrors) held.concealed = source.lastError();
-    if (settings.format == PixelLayout::kNv12) {
-      writeNv12(decoded.image, held.data.data());
-    } else {
-      writeYuyv(decoded.image, held.data.data());
-    }
+    cv::Mat into(heldSize(heldFormat(settings.format), size), heldType(heldFormat(settings.format)),
+                 held.data.data());
+    bgrToHeld(decoded.image, heldFormat(settings.format), into);
   }
   if (decodedFrames > fitting) failTooLarge(decodedFrames);
   if (frames.empty())
@@ -210,6 +157,8 @@ PreloadedSource::~PreloadedSource() = default;
 
 cv::Size PreloadedSource::frameSize() const { return impl_->size; }
 
+PixelFormat PreloadedSource::pixelFormat() const { return heldFormat(impl_->settings.format); }
+
 Timestamp PreloadedSource::nominalPeriod() const { return impl_->period; }
 
 const std::string& PreloadedSource::lastError() const { return impl_->lastError; }
@@ -236,12 +185,15 @@ ReadStatus PreloadedSource::read(Frame& out) {
     s.loopOffset += s.passShift;
   }
   const HeldFrame& held = s.frames[s.next++];
-  if (out.image.size() != s.size || out.image.type() != CV_8UC3) {
-    // The caller's pool should match frameSize(); rather than write out of bounds, fix it once.
-    out.image.create(s.size, CV_8UC3);
+  const PixelFormat format = pixelFormat();
+  if (!holds(out.image, format, s.size)) {
+    // The caller's pool should match; rather than write out of bounds, fix it once.
+    out.image.create(heldSize(format, s.size), heldType(format));
+    out.format = format;
   }
   // What a V4L2 camera's frame of this format goes through (v4l2_source.cpp): the per-frame cost.
-  if (!convertToBgr(s.settings.format, held.data, s.bytesPerLine, s.jpeg, out.image, s.lastError)) {
+  if (!holdFrame(s.settings.format, held.data, s.bytesPerLine, s.jpeg, s.size, out.image,
+                 s.lastError)) {
     s.lastError = fmt::format("camera '{}': {}", s.camera, s.lastError);
     return ReadStatus::kFault;
   }

@@ -1,10 +1,10 @@
 #pragma once
 // A recording played from memory as a live camera delivers it: decoded once at start (through
 // FileSource: any video, image sequence or picture) into frames of a camera's pixel format — YUYV
-// or NV12, BT.601 limited range as V4L2 cameras deliver them — and then each read() converts one of
-// them into the caller's BGR frame with the function a V4L2 camera's frames go through
-// (convertToBgr: cv::cvtColor). A replay then costs per frame what a live camera costs, the
-// conversion, instead of a video decode: what a benchmark of a live rig measures
+// or NV12, BT.601 limited range as V4L2 cameras deliver them — and then each read() hands one of
+// them over with the function a V4L2 camera's frames go through (holdFrame: a copy into the
+// caller's frame, which holds it in the same format). A replay then costs per frame what a live
+// camera costs instead of a video decode: what a benchmark of a live rig measures
 // (surround-bench pipeline --input raw).
 //
 // Timestamps, looping and pacing are the file's, as FileSource replays it: the file's own
@@ -50,6 +50,7 @@ class PreloadedSource final : public FrameSource {
   ~PreloadedSource() override;
 
   cv::Size frameSize() const override;
+  PixelFormat pixelFormat() const override;
   Timestamp nominalPeriod() const override;
   ReadStatus read(Frame& out) override;
   const std::string& lastError() const override;

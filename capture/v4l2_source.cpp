@@ -271,9 +271,16 @@ ReadStatus V4l2Source::fault(std::string message, bool lost) {
 }
 
 void V4l2Source::reopen() {
+  const PixelFormat held = pixelFormat();
   stop();
   try {
     start();
+    // The frames already allocated hold the first format; a device that now offers another
+    // (format: auto) cannot fill them.
+    if (pixelFormat() != held) {
+      throw CaptureError(fmt::format("{}: reopened in {}, but its frames are held as {}", where(),
+                                     toString(layout_), toString(held)));
+    }
   } catch (...) {
     stop();
     throw;
@@ -300,7 +307,7 @@ ReadStatus V4l2Source::read(Frame& out) {
   bool good = (buffer.flags & V4L2_BUF_FLAG_ERROR) == 0 && buffer.index < buffers_.size();
   std::string problem = good ? "" : "the driver marked the frame corrupt";
   if (good) {
-    good = convert(buffer, out.image);
+    good = hold(buffer, out.image);
     if (!good) problem = error_;
   }
   out.timestamp = std::chrono::seconds(buffer.timestamp.tv_sec) +
@@ -313,7 +320,7 @@ ReadStatus V4l2Source::read(Frame& out) {
   return ReadStatus::kFrame;
 }
 
-bool V4l2Source::convert(const v4l2_buffer& buffer, cv::Mat& bgr) {
+bool V4l2Source::hold(const v4l2_buffer& buffer, cv::Mat& held) {
   const std::vector<MappedPlane>& mapped = buffers_[buffer.index];
   // Each plane's bytes: what the driver filled, after the offset it starts at.
   std::array<std::span<const std::uint8_t>, 2> data;
@@ -328,10 +335,10 @@ bool V4l2Source::convert(const v4l2_buffer& buffer, cv::Mat& bgr) {
     data[p] = std::span(static_cast<const std::uint8_t*>(mapped[p].address) + offset, end - offset);
   }
   if (mapped.size() == 2) {
-    return convertNv12PlanesToBgr({data[0], bytesPerLine_[0]}, {data[1], bytesPerLine_[1]}, bgr,
-                                  error_);
+    return holdNv12Planes({data[0], bytesPerLine_[0]}, {data[1], bytesPerLine_[1]}, settings_.size,
+                          held, error_);
   }
-  return convertToBgr(layout_, data[0], bytesPerLine_[0], jpeg_, bgr, error_);
+  return holdFrame(layout_, data[0], bytesPerLine_[0], jpeg_, settings_.size, held, error_);
 }
 
 }  // namespace surroundd::capture

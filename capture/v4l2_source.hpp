@@ -1,8 +1,9 @@
 #pragma once
 // A live camera through V4L2 (video4linux2): opened by a stable path (/dev/v4l/by-path/...,
 // /dev/v4l/by-id/...) or /dev/videoN, the pixel format, size and frame rate negotiated from the
-// settings, MMAP streaming, frames converted to BGR once (YUYV, UYVY, NV12; MJPEG through
-// libjpeg-turbo) with the driver's monotonic timestamps. Single-planar devices (UVC) and
+// settings, MMAP streaming, frames copied out of the driver's buffers as they are (YUYV, NV12) or
+// converted to BGR once (UYVY, BGR; MJPEG through libjpeg-turbo: capture/pixel_conversion.hpp),
+// with the driver's monotonic timestamps. Single-planar devices (UVC) and
 // multi-planar ones (V4L2_CAP_VIDEO_CAPTURE_MPLANE: i.MX, Rockchip, TI capture drivers) alike;
 // through the multi-planar API, NV12 also comes as NV12M (luma and chroma in two buffers).
 //
@@ -62,6 +63,8 @@ class V4l2Source final : public FrameSource {
   ~V4l2Source() override;
 
   cv::Size frameSize() const override { return settings_.size; }
+  // YUYV and NV12 as the camera gives them, the other formats converted to BGR.
+  PixelFormat pixelFormat() const override { return heldFormat(layout_); }
   Timestamp nominalPeriod() const override { return period_; }
   ReadStatus read(Frame& out) override;
   const std::string& lastError() const override { return error_; }
@@ -87,7 +90,7 @@ class V4l2Source final : public FrameSource {
   void stop();  // stream off, unmap, close; never throws
   ReadStatus fault(std::string message, bool lost);
   v4l2_buffer bufferFor(std::span<v4l2_plane> planes) const;
-  bool convert(const v4l2_buffer& buffer, cv::Mat& bgr);
+  bool hold(const v4l2_buffer& buffer, cv::Mat& held);
   std::string where() const;
 
   std::string camera_;

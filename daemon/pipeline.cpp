@@ -251,11 +251,11 @@ void Pipeline::process(const capture::FrameSet& set) {
   times_.skip();
   if (!firstTimestamp_) firstTimestamp_ = set.timestamp;
   lastStreamTime_ = set.timestamp - *firstTimestamp_;
-  FrameWork work{
-      .set = set, .streamTime = lastStreamTime_, .origin = captureTimeOf(set), .outputs = outputs_};
-  for (std::size_t c = 0; c < set.cameraCount; ++c) {
-    work.images[c] = set.frame(c) != nullptr ? &set.frame(c)->image : nullptr;
-  }
+  FrameWork work{.set = set,
+                 .bgrBuffers = bgrBuffers_,
+                 .streamTime = lastStreamTime_,
+                 .origin = captureTimeOf(set),
+                 .outputs = outputs_};
   for (const auto& stage : stages_) stage->process(work, times_);
   times_.endSet();
 }
@@ -281,6 +281,17 @@ void Pipeline::finish(RunSummary& summary) {
     summary.cameraNames.push_back(camera->name());
     summary.cameras.push_back(camera->stats());
   }
+}
+
+const cv::Mat* FrameWork::bgr(std::size_t camera) {
+  const capture::Frame* frame = set.frame(camera);
+  if (frame == nullptr) return nullptr;
+  if (frame->format == PixelFormat::kBgr) return &frame->image;
+  if (converted[camera] == nullptr) {
+    heldToBgr(frame->image, frame->format, bgrBuffers[camera]);
+    converted[camera] = &bgrBuffers[camera];
+  }
+  return converted[camera];
 }
 
 }  // namespace surroundd::daemon

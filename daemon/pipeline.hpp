@@ -143,6 +143,7 @@ class Pipeline {
   CalibrationWatchStage* watch_ = nullptr;  // with the panorama stage
   PipelineOutputs outputs_;
   StageTimes times_;
+  std::array<cv::Mat, kMaxCameras> bgrBuffers_;  // FrameWork::bgr()'s, one per camera
   std::uint64_t frameSets_ = 0;
   std::uint64_t staleDropped_ = 0;
   Clock::time_point start_{};

@@ -24,13 +24,22 @@ namespace surroundd::daemon {
 // One frame set on its way through the stages.
 struct FrameWork {
   const capture::FrameSet& set;
-  std::array<const cv::Mat*, kMaxCameras> images{};  // per camera; null where the set has none
+  // Per camera: a buffer that bgr() converts a YUV frame into, kept by the pipeline from set to set
+  // (allocated at the first conversion, then reused).
+  std::array<cv::Mat, kMaxCameras>& bgrBuffers;
   std::chrono::nanoseconds streamTime{0};            // since the run's first set
   std::chrono::steady_clock::time_point origin{};    // the capture time of its oldest frame
   // Per camera: what is wrong with it (its health), or null; a faulty camera's picture is marked
   // and left out of colour correction.
   std::array<const char*, kMaxCameras> faults{};
   PipelineOutputs& outputs;
+
+  // Camera `camera`'s frame of the set as 8-bit BGR, or null where the set has none. A frame held
+  // in its camera's YUV (common/pixel_format.hpp) is converted once per set, at the first call:
+  // only what needs whole BGR frames asks (a camera shown as it is, the mosaic, the drift watch);
+  // the stitch samples the frames as they are.
+  const cv::Mat* bgr(std::size_t camera);
+  std::array<const cv::Mat*, kMaxCameras> converted{};  // bgr()'s answers so far, for this set
 };
 
 class PipelineStage {

@@ -10,6 +10,7 @@ namespace surroundd::daemon {
 RigRecorder::RigRecorder(RecordingSettings settings, std::vector<RigCamera> rig, double nominalFps)
     : settings_(std::move(settings)), rig_(std::move(rig)) {
   createOutputFolder(settings_.folder, settings_.folder);
+  bgr_.resize(rig_.size());
   for (auto& camera : rig_) {
     render::VideoEncoderSettings video;
     video.path = settings_.folder / (camera.calibration.name + ".mp4");
@@ -30,8 +31,14 @@ RigRecorder::RigRecorder(RecordingSettings settings, std::vector<RigCamera> rig,
 
 void RigRecorder::record(const capture::FrameSet& set) {
   for (std::size_t c = 0; c < encoders_.size(); ++c) {
-    if (const capture::Frame* frame = set.frame(c))
+    const capture::Frame* frame = set.frame(c);
+    if (frame == nullptr) continue;
+    if (frame->format == PixelFormat::kBgr) {
       encoders_[c]->write(frame->image, frame->timestamp);
+    } else {
+      heldToBgr(frame->image, frame->format, bgr_[c]);
+      encoders_[c]->write(bgr_[c], frame->timestamp);
+    }
   }
 }
 

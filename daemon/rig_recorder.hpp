@@ -44,6 +44,7 @@ class RigRecorder final : public CameraFramesSink {
   RecordingSettings settings_;
   std::vector<RigCamera> rig_;
   std::vector<std::unique_ptr<render::VideoEncoder>> encoders_;
+  std::vector<cv::Mat> bgr_;  // per camera: a YUV frame converted for its encoder, reused
   bool finished_ = false;
 };
 

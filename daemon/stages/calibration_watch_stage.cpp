@@ -40,8 +40,8 @@ void CalibrationWatchStage::process(FrameWork& work, StageTimes& /*times*/) {
   next_ = work.streamTime + interval_;
   for (Seam& seam : seams_) {
     const auto& line = seam.probe.seam();
-    const cv::Mat* left = work.images[line.left];
-    const cv::Mat* right = work.images[line.right];
+    const cv::Mat* left = work.bgr(line.left);
+    const cv::Mat* right = work.bgr(line.right);
     // A camera missing from the set, or faulty (black, frozen), says nothing of the calibration.
     if (left == nullptr || right == nullptr || work.faults[line.left] != nullptr ||
         work.faults[line.right] != nullptr) {

@@ -1,5 +1,6 @@
 #include "daemon/stages/mosaic_stage.hpp"
 
+#include <array>
 #include <span>
 
 #include "daemon/pipeline_ends.hpp"
@@ -15,7 +16,9 @@ void MosaicStage::process(FrameWork& work, StageTimes& times) {
   // snapshot asked for after the end is given.
   if (!work.outputs.shows(OutputStream::kMosaic)) return;
   const std::size_t cameras = work.set.cameraCount;
-  mosaic_.compose(std::span(work.images.data(), cameras), canvas_,
+  std::array<const cv::Mat*, kMaxCameras> images{};
+  for (std::size_t c = 0; c < cameras; ++c) images[c] = work.bgr(c);
+  mosaic_.compose(std::span(images.data(), cameras), canvas_,
                   std::span(work.faults.data(), cameras));
   times.lap(Stage::kMosaic);
 }

@@ -1,5 +1,7 @@
 #include "daemon/stages/panorama_stage.hpp"
 
+#include <optional>
+
 #include <spdlog/spdlog.h>
 
 #include "daemon/panorama_setup.hpp"
@@ -17,9 +19,6 @@ PanoramaStage::PanoramaStage(const Config& config, WorkPool& pool)
       corrected_(config.cameras.size()),
       stitched_(config.cameras.size()),
       panorama_(lut_.size, CV_8UC3) {
-  for (const auto& size : lut_.cameraSizes) {
-    blackFrames_.emplace_back(size, CV_8UC3, cv::Scalar::all(0));
-  }
   setUpColourCorrection(config, pool);
 }
 
@@ -38,24 +37,53 @@ void PanoramaStage::setUpColourCorrection(const Config& config, WorkPool& pool) 
   }
 }
 
-void PanoramaStage::process(FrameWork& work, StageTimes& times) {
+const cv::Mat& PanoramaStage::blackFrame(std::size_t camera, PixelFormat format) {
+  std::vector<cv::Mat>& frames = blackFrames_[static_cast<std::size_t>(format)];
+  if (frames.empty()) {
+    for (const auto& size : lut_.cameraSizes) frames.push_back(blackPicture(format, size));
+  }
+  return frames[camera];
+}
+
+PixelFormat PanoramaStage::gatherFrames(FrameWork& work) {
+  // The frames as their cameras gave them when they all hold one format (the kernels sample one
+  // format per stitch); a rig that mixes formats is sampled in BGR, each frame converted.
+  std::optional<PixelFormat> shared;
   for (std::size_t c = 0; c < work.set.cameraCount; ++c) {
-    const cv::Mat* image = work.images[c];
+    const capture::Frame* frame = work.set.frame(c);
+    if (frame == nullptr) continue;
+    if (shared && *shared != frame->format) {
+      shared = PixelFormat::kBgr;
+      break;
+    }
+    shared = frame->format;
+  }
+  const PixelFormat format = shared.value_or(PixelFormat::kBgr);
+  for (std::size_t c = 0; c < work.set.cameraCount; ++c) {
+    const capture::Frame* frame = work.set.frame(c);
+    const cv::Mat* image = frame == nullptr                 ? nullptr
+                           : format == PixelFormat::kBgr ? work.bgr(c)
+                                                         : &frame->image;
     // A faulty camera's picture would pull its neighbours' colours: correction goes without it.
     corrected_[c] = image != nullptr && work.faults[c] == nullptr ? *image : cv::Mat();
-    stitched_[c] = image != nullptr ? *image : blackFrames_[c];
+    stitched_[c] = image != nullptr ? *image : blackFrame(c, format);
   }
+  return format;
+}
+
+void PanoramaStage::process(FrameWork& work, StageTimes& times) {
+  format_ = gatherFrames(work);
   const bool wanted = !wanted_ || wanted_(work);
-  if (wanted) stitcher_.stitch(stitched_, panorama_);
+  if (wanted) stitcher_.stitch(stitched_, format_, panorama_);
   times.lap(Stage::kStitch);
   if (poisson_) {
-    poisson_->update(corrected_);
+    poisson_->update(corrected_, format_);
     for (const auto& note : poisson_->notesOfLastUpdate()) {
       spdlog::warn("colour correction: {}", note);
     }
     if (wanted) poisson_->apply(panorama_);
   } else if (gains_) {
-    gains_->update(corrected_);
+    gains_->update(corrected_, format_);
     for (const auto& note : gains_->notesOfLastUpdate()) {
       spdlog::warn("colour correction: {}", note);
     }
@@ -77,7 +105,7 @@ PanoramaStage::ViewPicture::ViewPicture(const PanoramaStage& stage,
 
 void PanoramaStage::draw(ViewPicture& view, const FrameWork& work, cv::Mat& picture) {
   // The same frames as the panorama's, corrected by the fields and gains its last update() fitted.
-  view.stitcher_.stitch(stitched_, picture);
+  view.stitcher_.stitch(stitched_, format_, picture);
   if (poisson_) {
     poisson_->applyAt(view.fieldSamples_, picture);
   } else if (gains_) {

@@ -4,6 +4,7 @@
 // each faulty camera's part marked. Made for every set, shown or not: colour correction follows
 // the pictures over time.
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <utility>
@@ -63,6 +64,10 @@ class PanoramaStage final : public PipelineStage {
 
  private:
   void setUpColourCorrection(const Config& config, WorkPool& pool);
+  // Fills stitched_ and corrected_ with the set's frames; returns the format they are held in.
+  PixelFormat gatherFrames(FrameWork& work);
+  // A missing camera's stand-in, made the first time a camera of that format is missing.
+  const cv::Mat& blackFrame(std::size_t camera, PixelFormat format);
 
   WorkPool& pool_;
   processing::Rig rig_;  // with its body masks
@@ -73,7 +78,8 @@ class PanoramaStage final : public PipelineStage {
   std::unique_ptr<processing::GainCompensation> gains_;           // colour_correction: gain
   std::vector<cv::Mat> corrected_;  // this set's frames (headers) that colour correction sees
   std::vector<cv::Mat> stitched_;   // this set's frames (headers), black for missing cameras
-  std::vector<cv::Mat> blackFrames_;
+  PixelFormat format_ = PixelFormat::kBgr;         // the one both hold this set
+  std::array<std::vector<cv::Mat>, 3> blackFrames_;  // per PixelFormat, per camera
   cv::Mat panorama_;
   std::function<bool(FrameWork&)> wanted_;
 };

@@ -138,7 +138,6 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
     if (!output.view || !output.sink) continue;
     const bool wanted = output.sink->wantsFrame(work.streamTime);
     work.outputs.guarded(output, [&] {
-      const capture::Frame* camera = work.set.frame(splitCamera_);
       if (FixedView* fixed = fixedView(*output.view)) {
         // Without a panorama this set, also when not wanted: the run's end hands over the last
         // set's picture, and there is no panorama to draw it from.
@@ -148,9 +147,10 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
         layGuidelines(*output.view, *fixed);
         // As the renderer samples it (bilinear, pixel centres at halves); a missing frame leaves
         // the last one shown.
-        if (const auto area = output.view->cameraArea(); area && camera != nullptr) {
+        const auto area = output.view->cameraArea();
+        if (const cv::Mat* camera = area ? work.bgr(splitCamera_) : nullptr; camera != nullptr) {
           cv::Mat into = fixed->picture(*area);
-          cv::resize(camera->image, into, area->size(), 0, 0, cv::INTER_LINEAR);
+          cv::resize(*camera, into, area->size(), 0, 0, cv::INTER_LINEAR);
         }
         fixed->drawnAt = work.streamTime;
         fixed->handOver = wanted;
@@ -162,9 +162,11 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
         scene_->uploadPanorama(panorama_);
         panoramaUploaded = true;
       }
-      if (output.view->view() == ViewKind::kSplit && !cameraUploaded && camera != nullptr) {
-        scene_->uploadCamera(camera->image);
-        cameraUploaded = true;
+      if (output.view->view() == ViewKind::kSplit && !cameraUploaded) {
+        if (const cv::Mat* camera = work.bgr(splitCamera_); camera != nullptr) {
+          scene_->uploadCamera(*camera);
+          cameraUploaded = true;
+        }
       }
       output.view->draw(std::chrono::duration<double>(work.streamTime).count());
       output.pendingTime = work.streamTime;

@@ -61,7 +61,7 @@ GainCompensation::GainCompensation(const PanoramaLut& lut, WorkPool& pool, doubl
   counts_.assign(n * n, 0);
 }
 
-void GainCompensation::update(std::span<const cv::Mat> frames) {
+void GainCompensation::update(std::span<const cv::Mat> frames, PixelFormat format) {
   const std::size_t n = gains_.size();
   notes_.clear();
   for (auto& histogram : histograms_) histogram.fill(0);
@@ -76,8 +76,8 @@ void GainCompensation::update(std::span<const cv::Mat> frames) {
     const cv::Mat& imageA = frames[a.camera];
     const cv::Mat& imageB = frames[b.camera];
     if (imageA.empty() || imageB.empty()) continue;
-    const std::uint32_t pixelA = bilinear(imageA.data, imageA.step, a);
-    const std::uint32_t pixelB = bilinear(imageB.data, imageB.step, b);
+    const std::uint32_t pixelA = bilinear(SampledImage::of(imageA, format), a);
+    const std::uint32_t pixelB = bilinear(SampledImage::of(imageB, format), b);
     if (!usable(pixelA) || !usable(pixelB)) continue;
     add(a.camera, b.camera, pixelA);
     add(b.camera, a.camera, pixelB);

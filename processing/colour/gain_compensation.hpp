@@ -18,6 +18,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "common/pixel_format.hpp"
 #include "processing/stitch/panorama_lut.hpp"
 
 namespace surroundd {
@@ -32,9 +33,9 @@ class GainCompensation {
   GainCompensation(const PanoramaLut& lut, WorkPool& pool, double minGain = 0.5,
                    double maxGain = 2.0, std::vector<std::string> cameraNames = {});
 
-  // Fits the gains to the overlaps of this frame set (an empty Mat: that camera is missing; its
-  // gain stays as it was).
-  void update(std::span<const cv::Mat> frames);
+  // Fits the gains to the overlaps of this frame set, held in `format` (common/pixel_format.hpp;
+  // an empty Mat: that camera is missing; its gain stays as it was).
+  void update(std::span<const cv::Mat> frames, PixelFormat format = PixelFormat::kBgr);
   // Multiplies each camera's share of every pixel of a panorama stitched from the same frames.
   void apply(cv::Mat& panorama) { apply(panorama, lut_); }
   // The same for a picture made through another LUT of this rig's cameras from the same frames (a

@@ -205,9 +205,9 @@ void PoissonColourCorrection::solveRegions(std::span<const std::uint8_t> which) 
       static_cast<int>(active.regions.size()));
 }
 
-int PoissonColourCorrection::update(std::span<const cv::Mat> frames) {
+int PoissonColourCorrection::update(std::span<const cv::Mat> frames, PixelFormat format) {
   followLostCameras(frames);
-  gatherSeams(frames);
+  gatherSeams(frames, format);
   Configuration& active = *active_;
   for (auto& state : active.regions) {
     state.iterations = 0;

@@ -39,6 +39,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "common/pixel_format.hpp"
 #include "processing/colour/correction_domain.hpp"
 #include "processing/colour/poisson_solver.hpp"
 #include "processing/colour/seam_statistics.hpp"
@@ -100,9 +101,10 @@ class PoissonColourCorrection {
   const CorrectionDomain& domain() const;
   std::string solverNames() const;
 
-  // Solves this frame's fields from the camera images (an empty Mat: that camera is missing).
-  // Returns the solvers' iterations, summed over regions (0 for direct solvers).
-  int update(std::span<const cv::Mat> frames);
+  // Solves this frame's fields from the camera frames, held in `format` (common/pixel_format.hpp;
+  // an empty Mat: that camera is missing). Returns the solvers' iterations, summed over regions
+  // (0 for direct solvers).
+  int update(std::span<const cv::Mat> frames, PixelFormat format = PixelFormat::kBgr);
 
   // Adds the fields to a panorama stitched from the same frames (8-bit BGR of the LUT's size).
   // `path`: the kernels to use (kernel_path.hpp), every one giving the same bytes.
@@ -143,7 +145,7 @@ class PoissonColourCorrection {
   struct Configuration;
   Configuration& configurationFor(std::uint32_t presentCameras);
   void followLostCameras(std::span<const cv::Mat> frames);
-  void gatherSeams(std::span<const cv::Mat> frames);
+  void gatherSeams(std::span<const cv::Mat> frames, PixelFormat format);
   // Gives the seam's blocks past the bowl's floor one value, their median (of each channel).
   void farGroundAsOneBand(const CorrectionRegion& region, const CorrectionSeam& seam,
                           RegionState& state);

@@ -86,7 +86,7 @@ void PoissonColourCorrection::farGroundAsOneBand(const CorrectionRegion& region,
   }
 }
 
-void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames) {
+void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames, PixelFormat format) {
   Configuration& active = *active_;
   const float keep = active.firstFrame ? 0.0f : static_cast<float>(settings_.temporalSmoothing);
   const bool multiplicative = settings_.field == CorrectionField::kMultiplicative;
@@ -99,7 +99,9 @@ void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames) {
       const cv::Mat& target = frames[d.target];
       state.measuredValid[k] = 0;
       if (source.empty() || target.empty()) continue;
-      const SeamBlockLevels levels = meter_.measure(active.domain, d, target, source);
+      const SeamBlockLevels levels = meter_.measure(active.domain, d,
+                                                    SampledImage::of(target, format),
+                                                    SampledImage::of(source, format));
       state.levels[k] = levels;
       state.measuredValid[k] = levels.valid ? 1 : 0;
       for (int c = 0; c < 3; ++c) {

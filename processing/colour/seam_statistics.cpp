@@ -46,13 +46,14 @@ SeamBlockMeter::SeamBlockMeter(std::size_t maxSamples)
     : scratch_(6 * std::max<std::size_t>(maxSamples, 1)), maxSamples_(maxSamples) {}
 
 SeamBlockLevels SeamBlockMeter::measure(const CorrectionDomain& domain, const DirichletBlock& block,
-                                        const cv::Mat& target, const cv::Mat& source) {
+                                        const SampledImage& target,
+                                        const SampledImage& source) {
   SeamBlockLevels levels;
   std::size_t count = 0;
   for (auto s = block.firstSample; s < block.endSample && count < maxSamples_; ++s) {
     const SeamSample& sample = domain.samples[s];
-    const std::uint32_t t = bilinear(target.data, target.step, sample.target);
-    const std::uint32_t o = bilinear(source.data, source.step, sample.source);
+    const std::uint32_t t = bilinear(target, sample.target);
+    const std::uint32_t o = bilinear(source, sample.source);
     if (!usable(t) || !usable(o)) continue;
     for (int c = 0; c < 3; ++c) {
       scratch_[c * maxSamples_ + count] = static_cast<float>((t >> (8 * c)) & 0xffU);

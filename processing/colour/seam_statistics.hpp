@@ -16,6 +16,7 @@
 #include <opencv2/core.hpp>
 
 #include "processing/colour/correction_domain.hpp"
+#include "processing/stitch/bilinear_sample.hpp"
 
 namespace surroundd::processing {
 
@@ -33,7 +34,7 @@ class SeamBlockMeter {
 
   // A block counts when at least half its samples are usable.
   SeamBlockLevels measure(const CorrectionDomain& domain, const DirichletBlock& block,
-                          const cv::Mat& target, const cv::Mat& source);
+                          const SampledImage& target, const SampledImage& source);
 
  private:
   std::vector<float> scratch_;  // 6 channels x maxSamples

@@ -19,31 +19,25 @@ namespace surroundd::processing {
 namespace {
 
 #if defined(__SSE2__)
-// Two pixels at once, the same arithmetic as bilinear() in eight 16-bit lanes: half the
+// Two pixels at once, the same arithmetic as interpolate() in eight 16-bit lanes: half the
 // instructions per pixel. kPairPath names the kernel path it serves. Returns pixel a in the low 32
 // bits and b in the high 32 (each c0 c1 c2 0).
-inline std::uint64_t bilinearPair(const std::uint8_t* sourceA, std::size_t rowBytesA,
-                                  const LutTap& a, const std::uint8_t* sourceB,
-                                  std::size_t rowBytesB, const LutTap& b) {
-  const std::uint8_t* topA = sourceA + static_cast<std::size_t>(a.offset) * 3;
-  const std::uint8_t* topB = sourceB + static_cast<std::size_t>(b.offset) * 3;
+inline std::uint64_t interpolatePair(const Neighbours& na, const LutTap& a, const Neighbours& nb,
+                                     const LutTap& b) {
   const __m128i zero = _mm_setzero_si128();
-  const auto load = [](const std::uint8_t* p, int column) {
-    return _mm_cvtsi32_si128(static_cast<int>(pixelBytes(p, column)));
-  };
-  // Left or right neighbours of both pixels in one row, 16-bit lanes: a in 0-3, b in 4-7.
-  const auto lanes = [&](const std::uint8_t* pa, const std::uint8_t* pb, int column) {
-    return _mm_unpacklo_epi8(_mm_unpacklo_epi32(load(pa, column), load(pb, column)), zero);
+  // Two pixels of both neighbourhoods, 16-bit lanes: a's in 0-3, b's in 4-7.
+  const auto lanes = [&](std::uint32_t pa, std::uint32_t pb) {
+    return _mm_unpacklo_epi8(_mm_unpacklo_epi32(_mm_cvtsi32_si128(static_cast<int>(pa)),
+                                                _mm_cvtsi32_si128(static_cast<int>(pb))),
+                             zero);
   };
   const __m128i wx1 = _mm_unpacklo_epi64(_mm_set1_epi16(static_cast<short>(a.fx)),
                                          _mm_set1_epi16(static_cast<short>(b.fx)));
   const __m128i wx0 = _mm_sub_epi16(_mm_set1_epi16(LutTap::kFractionOne), wx1);
-  const auto horizontal = [&](const std::uint8_t* pa, const std::uint8_t* pb) {
-    return _mm_add_epi16(_mm_mullo_epi16(lanes(pa, pb, 0), wx0),
-                         _mm_mullo_epi16(lanes(pa, pb, 1), wx1));
-  };
-  const __m128i upper = horizontal(topA, topB);
-  const __m128i lower = horizontal(topA + rowBytesA, topB + rowBytesB);
+  const __m128i upper = _mm_add_epi16(_mm_mullo_epi16(lanes(na.topLeft, nb.topLeft), wx0),
+                                      _mm_mullo_epi16(lanes(na.topRight, nb.topRight), wx1));
+  const __m128i lower = _mm_add_epi16(_mm_mullo_epi16(lanes(na.bottomLeft, nb.bottomLeft), wx0),
+                                      _mm_mullo_epi16(lanes(na.bottomRight, nb.bottomRight), wx1));
   const auto vertical = [](__m128i pairs, const LutTap& tap) {
     const int wy1 = tap.fy;
     const int wy0 = LutTap::kFractionOne - wy1;
@@ -58,24 +52,19 @@ inline std::uint64_t bilinearPair(const std::uint8_t* sourceA, std::size_t rowBy
 }
 constexpr KernelPath kPairPath = KernelPath::kSse2;
 #elif defined(__ARM_NEON)
-// The same two pixels at once in NEON's eight 16-bit lanes, a in 0-3 and b in 4-7.
-inline std::uint64_t bilinearPair(const std::uint8_t* sourceA, std::size_t rowBytesA,
-                                  const LutTap& a, const std::uint8_t* sourceB,
-                                  std::size_t rowBytesB, const LutTap& b) {
-  const std::uint8_t* topA = sourceA + static_cast<std::size_t>(a.offset) * 3;
-  const std::uint8_t* topB = sourceB + static_cast<std::size_t>(b.offset) * 3;
-  const auto lanes = [](const std::uint8_t* pa, const std::uint8_t* pb, int column) {
-    const std::uint64_t both = pixelBytes(pa, column) | std::uint64_t{pixelBytes(pb, column)} << 32;
-    return vmovl_u8(vcreate_u8(both));
+// The same two pixels at once in NEON's eight 16-bit lanes, a's in 0-3 and b's in 4-7.
+inline std::uint64_t interpolatePair(const Neighbours& na, const LutTap& a, const Neighbours& nb,
+                                     const LutTap& b) {
+  const auto lanes = [](std::uint32_t pa, std::uint32_t pb) {
+    return vmovl_u8(vcreate_u8(pa | std::uint64_t{pb} << 32));
   };
   const uint16x8_t wx1 = vcombine_u16(vdup_n_u16(static_cast<std::uint16_t>(a.fx)),
                                       vdup_n_u16(static_cast<std::uint16_t>(b.fx)));
   const uint16x8_t wx0 = vsubq_u16(vdupq_n_u16(LutTap::kFractionOne), wx1);
-  const auto horizontal = [&](const std::uint8_t* pa, const std::uint8_t* pb) {
-    return vmlaq_u16(vmulq_u16(lanes(pa, pb, 0), wx0), lanes(pa, pb, 1), wx1);
-  };
-  const uint16x8_t upper = horizontal(topA, topB);
-  const uint16x8_t lower = horizontal(topA + rowBytesA, topB + rowBytesB);
+  const uint16x8_t upper = vmlaq_u16(vmulq_u16(lanes(na.topLeft, nb.topLeft), wx0),
+                                     lanes(na.topRight, nb.topRight), wx1);
+  const uint16x8_t lower = vmlaq_u16(vmulq_u16(lanes(na.bottomLeft, nb.bottomLeft), wx0),
+                                     lanes(na.bottomRight, nb.bottomRight), wx1);
   const auto vertical = [](uint16x4_t up, uint16x4_t low, const LutTap& tap) {
     const auto wy1 = static_cast<std::uint16_t>(tap.fy);
     const auto wy0 = static_cast<std::uint16_t>(LutTap::kFractionOne - wy1);
@@ -93,9 +82,10 @@ constexpr int kPrefetchAhead = 64;  // pixels
 }  // namespace
 
 Stitcher::Stitcher(const PanoramaLut& lut, WorkPool& pool)
-    : lut_(lut), pool_(pool), unseen_(2, 2, CV_8UC3, cv::Scalar(PanoramaLut::kUnseenColour)) {
-  sources_[PanoramaLut::kUnseen] = unseen_.ptr<std::uint8_t>();
-  rowBytes_[PanoramaLut::kUnseen] = unseen_.step;
+    : lut_(lut),
+      pool_(pool),
+      unseen_{blackPicture(PixelFormat::kBgr, {2, 2}), blackPicture(PixelFormat::kYuyv, {2, 2}),
+              blackPicture(PixelFormat::kNv12, {2, 2})} {
   // Per row, the columns from the first to the last pixel a camera sees; outside them the row is
   // filled, not sampled (a quarter of the paper rig's panorama is above every camera's view).
   seenSpans_.reserve(static_cast<std::size_t>(lut_.size.height));
@@ -109,7 +99,8 @@ Stitcher::Stitcher(const PanoramaLut& lut, WorkPool& pool)
   }
 }
 
-void Stitcher::stitch(std::span<const cv::Mat> frames, cv::Mat& panorama, KernelPath path) {
+void Stitcher::stitch(std::span<const cv::Mat> frames, PixelFormat format, cv::Mat& panorama,
+                      KernelPath path) {
   if (!kernelPathBuilt(path)) {
     throw std::invalid_argument(
         fmt::format("stitch: this build has no {} kernels", kernelPathName(path)));
@@ -119,30 +110,49 @@ void Stitcher::stitch(std::span<const cv::Mat> frames, cv::Mat& panorama, Kernel
                                             frames.size(), lut_.cameraSizes.size()));
   }
   for (std::size_t i = 0; i < frames.size(); ++i) {
-    const cv::Mat& frame = frames[i];
-    if (frame.type() != CV_8UC3 || frame.size() != lut_.cameraSizes[i] || !frame.isContinuous()) {
-      throw std::invalid_argument(
-          fmt::format("stitch: frame {} is not a continuous 8-bit BGR image of {}x{}", i,
-                      lut_.cameraSizes[i].width, lut_.cameraSizes[i].height));
+    if (!holds(frames[i], format, lut_.cameraSizes[i])) {
+      throw std::invalid_argument(fmt::format(
+          "stitch: frame {} is not a continuous {} picture of {}x{}", i, toString(format),
+          lut_.cameraSizes[i].width, lut_.cameraSizes[i].height));
     }
-    sources_[i] = frame.ptr<std::uint8_t>();
-    rowBytes_[i] = frame.step;
+    images_[i] = SampledImage::of(frames[i], format);
   }
+  images_[PanoramaLut::kUnseen] =
+      SampledImage::of(unseen_[static_cast<std::size_t>(format)], format);
   panorama.create(lut_.size, CV_8UC3);
   // Chunks of rows, several per thread: rows cost unevenly (blend bands, memory locality).
-  auto rows = &Stitcher::stitchRows<KernelPath::kPortable>;
-  if (path == kNativeKernels) rows = &Stitcher::stitchRows<kNativeKernels>;
+  const auto rows = rowsFor(path, format);
   pool_.parallelFor(
       lut_.size.height, [&](int first, int last) { (this->*rows)(first, last, panorama); },
       pool_.threads() * 8);
 }
 
 template <KernelPath kPath>
+Stitcher::RowKernel Stitcher::rowsOf(PixelFormat format) {
+  switch (format) {
+    case PixelFormat::kYuyv:
+      return &Stitcher::stitchRows<kPath, PixelFormat::kYuyv>;
+    case PixelFormat::kNv12:
+      return &Stitcher::stitchRows<kPath, PixelFormat::kNv12>;
+    case PixelFormat::kBgr:
+      break;
+  }
+  return &Stitcher::stitchRows<kPath, PixelFormat::kBgr>;
+}
+
+Stitcher::RowKernel Stitcher::rowsFor(KernelPath path, PixelFormat format) {
+  return path == kNativeKernels ? rowsOf<kNativeKernels>(format)
+                                : rowsOf<KernelPath::kPortable>(format);
+}
+
+template <KernelPath kPath, PixelFormat kFormat>
 void Stitcher::stitchRows(int first, int last, cv::Mat& panorama) const {
-  // Locals, not members: stores through the byte pointer `row` could alias any member, which
-  // would make the compiler reload them for every pixel.
-  const auto sources = sources_;
-  const auto rowBytes = rowBytes_;
+  // A local copy, not the member: stores through the byte pointer `row` could alias any member,
+  // which would make the compiler reload them for every pixel.
+  const auto images = images_;
+  const auto sample = [&images](const LutTap& tap) {
+    return bilinear<kFormat, kPath>(images[tap.camera], tap);
+  };
   const int width = lut_.size.width;
   const std::array<std::uint8_t, 3> unseen = {
       PanoramaLut::kUnseenColour[0], PanoramaLut::kUnseenColour[1], PanoramaLut::kUnseenColour[2]};
@@ -164,31 +174,30 @@ void Stitcher::stitchRows(int first, int last, cv::Mat& panorama) const {
         for (int k = 0; k < 2; ++k) {
           if (u + k + kPrefetchAhead < end) {
             const LutTap ahead = taps[u + k + kPrefetchAhead];
-            const std::uint8_t* at =
-                sources[ahead.camera] + static_cast<std::size_t>(ahead.offset) * 3;
+            const SampledImage& image = images[ahead.camera];
+            const std::uint8_t* at = firstByte<kFormat>(image, ahead.offset);
             __builtin_prefetch(at);
-            __builtin_prefetch(at + rowBytes[ahead.camera]);
+            __builtin_prefetch(at + image.rowBytes);
           }
         }
         const LutTap a = taps[u];
         const LutTap b = taps[u + 1];
-        const std::uint64_t pair = bilinearPair(sources[a.camera], rowBytes[a.camera], a,
-                                                sources[b.camera], rowBytes[b.camera], b);
-        const auto left = static_cast<std::uint32_t>(pair);
-        const auto right = static_cast<std::uint32_t>(pair >> 32);
+        const std::uint64_t pair =
+            interpolatePair(neighbours<kFormat>(images[a.camera], a.offset), a,
+                            neighbours<kFormat>(images[b.camera], b.offset), b);
+        const std::uint32_t left = toBgr<kFormat>(static_cast<std::uint32_t>(pair));
+        const std::uint32_t right = toBgr<kFormat>(static_cast<std::uint32_t>(pair >> 32));
         std::memcpy(out(u), &left, 4);
         std::memcpy(out(u + 1), &right, 4);
       }
     }
 #endif
     for (; u < spillEnd; ++u) {
-      const LutTap tap = taps[u];
-      const std::uint32_t value = bilinear<kPath>(sources[tap.camera], rowBytes[tap.camera], tap);
+      const std::uint32_t value = sample(taps[u]);
       std::memcpy(out(u), &value, 4);
     }
     if (end == width && begin < end) {
-      const LutTap tap = taps[width - 1];
-      const std::uint32_t value = bilinear<kPath>(sources[tap.camera], rowBytes[tap.camera], tap);
+      const std::uint32_t value = sample(taps[width - 1]);
       std::memcpy(out(width - 1), &value, 3);
     }
     // What no camera sees, on either side of the span (whole rows above the cameras' view).
@@ -198,8 +207,7 @@ void Stitcher::stitchRows(int first, int last, cv::Mat& panorama) const {
     const std::size_t rowFirstPixel = static_cast<std::size_t>(v) * width;
     for (std::uint32_t b = lut_.blendRowBegin[v]; b < lut_.blendRowBegin[v + 1]; ++b) {
       const BlendTap& blend = lut_.blendTaps[b];
-      const std::uint32_t other =
-          bilinear<kPath>(sources[blend.tap.camera], rowBytes[blend.tap.camera], blend.tap);
+      const std::uint32_t other = sample(blend.tap);
       std::uint8_t* pixel = out(static_cast<int>(blend.pixel - rowFirstPixel));
       const std::uint32_t w = blend.tap.weight;
       for (int c = 0; c < 3; ++c) {

@@ -41,17 +41,20 @@ PreloadSettings preload(const std::filesystem::path& path, PixelLayout format, b
 }
 
 struct Played {
-  std::vector<cv::Mat> images;
+  std::vector<cv::Mat> images;  // BGR
+  std::vector<cv::Mat> held;    // as the source held them
   std::vector<Timestamp> timestamps;
   std::vector<std::uint64_t> sequences;
 };
 
 Played play(FrameSource& source, std::size_t limit = kMaxReads) {
   Frame frame;
-  frame.image.create(source.frameSize(), CV_8UC3);
+  frame.format = source.pixelFormat();
+  frame.image.create(heldSize(frame.format, source.frameSize()), heldType(frame.format));
   Played played;
   while (played.images.size() < limit && source.read(frame) == ReadStatus::kFrame) {
-    played.images.push_back(frame.image.clone());
+    heldToBgr(frame.image, frame.format, played.images.emplace_back());
+    played.held.push_back(frame.image.clone());
     played.timestamps.push_back(frame.timestamp);
     played.sequences.push_back(frame.sequence);
   }
@@ -102,10 +105,15 @@ TEST_P(PreloadedFormat, FramesAreTheDecodedOnesThroughTheCameraFormat) {
     for (int channel = 0; channel < 3; ++channel) {
       EXPECT_LT(std::abs(bias[channel]), 0.3) << "frame " << i << " channel " << channel;
     }
-    // Held as the camera hands it over, and shown through the one conversion a V4L2 camera's
-    // frames take: the same bytes give the same picture.
+    // Handed over as the camera hands it over, byte for byte, in a frame that says so; and
+    // converted as a V4L2 camera's frames would be: the same bytes give the same picture.
     const auto data = preloaded.frameData(i);
     ASSERT_EQ(data.size(), preloadedFrameBytes(format, {320, 180}));
+    EXPECT_EQ(preloaded.pixelFormat(), format == PixelLayout::kYuyv ? PixelFormat::kYuyv
+                                                                    : PixelFormat::kNv12);
+    ASSERT_EQ(got.held[i].total() * got.held[i].elemSize(), data.size());
+    EXPECT_TRUE(std::equal(data.begin(), data.end(), got.held[i].ptr<std::uint8_t>()))
+        << "frame " << i;
     cv::Mat converted(180, 320, CV_8UC3);
     std::string error;
     ASSERT_TRUE(convertToBgr(format, data, format == PixelLayout::kYuyv ? 640 : 320, jpeg,

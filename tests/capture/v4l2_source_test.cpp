@@ -58,13 +58,28 @@ std::string errorOpening(const std::function<void()>& open) {
   return {};
 }
 
-Frame frameOf(cv::Size size) {
+// A frame as the source's pool would make it: its picture held in the source's format.
+Frame frameOf(const V4l2Source& source) {
   Frame frame;
-  frame.image.create(size, CV_8UC3);
+  frame.format = source.pixelFormat();
+  frame.image.create(heldSize(frame.format, source.frameSize()), heldType(frame.format));
   return frame;
 }
 
-TEST(V4l2Source, DeliversEveryPixelFormatAsBgrWithTheDriversTimestamps) {
+cv::Mat bgrOf(const Frame& frame) {
+  cv::Mat bgr;
+  heldToBgr(frame.image, frame.format, bgr);
+  return bgr;
+}
+
+// YUYV and NV12 are held as the camera gave them; the others are converted to BGR.
+PixelFormat heldAs(V4l2Format format) {
+  if (format == V4l2Format::kYuyv) return PixelFormat::kYuyv;
+  if (format == V4l2Format::kNv12) return PixelFormat::kNv12;
+  return PixelFormat::kBgr;
+}
+
+TEST(V4l2Source, DeliversEveryPixelFormatWithTheDriversTimestamps) {
   for (const auto& [fourcc, format] : {std::pair{V4L2_PIX_FMT_YUYV, V4l2Format::kYuyv},
                                        std::pair{V4L2_PIX_FMT_UYVY, V4l2Format::kUyvy},
                                        std::pair{V4L2_PIX_FMT_NV12, V4l2Format::kNv12},
@@ -73,13 +88,14 @@ TEST(V4l2Source, DeliversEveryPixelFormatAsBgrWithTheDriversTimestamps) {
     const auto state = deviceOffering({{fourcc, {640, 480}}, {fourcc, kSize}});
     V4l2Source source = sourceOn(state);
     EXPECT_EQ(source.format(), format);
+    EXPECT_EQ(source.pixelFormat(), heldAs(format));
     EXPECT_EQ(source.frameSize(), kSize);
     EXPECT_EQ(source.nominalPeriod(), std::chrono::nanoseconds(33'333'333));
-    Frame frame = frameOf(kSize);
+    Frame frame = frameOf(source);
     const uchar* buffer = frame.image.data;
     for (int k = 0; k < 3; ++k) {
       ASSERT_EQ(source.read(frame), ReadStatus::kFrame) << source.lastError();
-      EXPECT_GE(cv::PSNR(frame.image, surroundd::testing::syntheticPicture(kSize, k)), 28.0)
+      EXPECT_GE(cv::PSNR(bgrOf(frame), surroundd::testing::syntheticPicture(kSize, k)), 28.0)
           << "frame " << k;
       EXPECT_EQ(frame.timestamp, std::chrono::microseconds(1'000'000 + k * 33'333));
     }
@@ -103,13 +119,14 @@ TEST(V4l2Source, AMultiPlanarOnlyDeviceDeliversEveryFormatWithItsStride) {
     V4l2Source source = sourceOn(state);
     EXPECT_TRUE(source.multiplanar());
     EXPECT_EQ(source.format(), format);
+    EXPECT_EQ(source.pixelFormat(), heldAs(format));
     EXPECT_EQ(source.nominalPeriod(), std::chrono::nanoseconds(33'333'333));
     // One DMABUF per plane of each of the 4 buffers.
     EXPECT_EQ(source.dmabufs().size(), fourcc == V4L2_PIX_FMT_NV12M ? 8u : 4u);
-    Frame frame = frameOf(kSize);
+    Frame frame = frameOf(source);
     for (int k = 0; k < 6; ++k) {  // past the 4 buffers: each is requeued and used again
       ASSERT_EQ(source.read(frame), ReadStatus::kFrame) << source.lastError();
-      EXPECT_GE(cv::PSNR(frame.image, surroundd::testing::syntheticPicture(kSize, k)), 28.0)
+      EXPECT_GE(cv::PSNR(bgrOf(frame), surroundd::testing::syntheticPicture(kSize, k)), 28.0)
           << "frame " << k;
       EXPECT_EQ(frame.timestamp, std::chrono::microseconds(1'000'000 + k * 33'333));
     }
@@ -120,7 +137,7 @@ TEST(V4l2Source, AMultiPlanarDeviceIsLostAndReopenedLikeAnyOther) {
   const auto state = deviceOffering({{V4L2_PIX_FMT_NV12M, kSize}});
   state->multiplanar = true;
   V4l2Source source = sourceOn(state);
-  Frame frame = frameOf(kSize);
+  Frame frame = frameOf(source);
   ASSERT_EQ(source.read(frame), ReadStatus::kFrame) << source.lastError();
   state->stalledPolls = 1;
   EXPECT_EQ(source.read(frame), ReadStatus::kLost);
@@ -181,7 +198,7 @@ TEST(V4l2Source, ControlsAreSetWithinTheirRangesAndRefusedOtherwise) {
 TEST(V4l2Source, AStallIsALostDeviceThatReopenStartsAgain) {
   const auto state = deviceOffering({{V4L2_PIX_FMT_YUYV, kSize}});
   V4l2Source source = sourceOn(state);
-  Frame frame = frameOf(kSize);
+  Frame frame = frameOf(source);
   ASSERT_EQ(source.read(frame), ReadStatus::kFrame);
   state->stalledPolls = 1;
   EXPECT_EQ(source.read(frame), ReadStatus::kLost);
@@ -196,7 +213,7 @@ TEST(V4l2Source, AStallIsALostDeviceThatReopenStartsAgain) {
 TEST(V4l2Source, UnpluggedItIsLostAndReopensOnceBack) {
   const auto state = deviceOffering({{V4L2_PIX_FMT_YUYV, kSize}});
   V4l2Source source = sourceOn(state);
-  Frame frame = frameOf(kSize);
+  Frame frame = frameOf(source);
   ASSERT_EQ(source.read(frame), ReadStatus::kFrame);
   state->plugged = false;
   EXPECT_EQ(source.read(frame), ReadStatus::kLost);
@@ -207,7 +224,7 @@ TEST(V4l2Source, UnpluggedItIsLostAndReopensOnceBack) {
   source.reopen();
   ASSERT_EQ(source.read(frame), ReadStatus::kFrame) << source.lastError();
   EXPECT_EQ(source.reopened(), 1u);
-  EXPECT_GE(cv::PSNR(frame.image, surroundd::testing::syntheticPicture(
+  EXPECT_GE(cv::PSNR(bgrOf(frame), surroundd::testing::syntheticPicture(
                                       kSize, static_cast<int>(state->produced - 1))),
             28.0);
 }
@@ -215,7 +232,7 @@ TEST(V4l2Source, UnpluggedItIsLostAndReopensOnceBack) {
 TEST(V4l2Source, ACorruptMjpegFrameIsAFaultAndTheStreamGoesOn) {
   const auto state = deviceOffering({{V4L2_PIX_FMT_MJPEG, kSize}});
   V4l2Source source = sourceOn(state);
-  Frame frame = frameOf(kSize);
+  Frame frame = frameOf(source);
   ASSERT_EQ(source.read(frame), ReadStatus::kFrame);
   state->corruptNext = true;
   EXPECT_EQ(source.read(frame), ReadStatus::kFault);

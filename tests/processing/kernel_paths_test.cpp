@@ -1,8 +1,9 @@
 // Every kernel path a build has (processing/stitch/kernel_path.hpp: SSE2 on x86-64, NEON on
 // arm64) gives exactly the bytes of the portable one (issue 19.4), on the synth_small recording's
-// first frame set through its own panorama LUT: every tap of the LUT and of its seam blends sampled
-// alone, the whole stitch, the colour correction's fields applied to it, and every pair of weights
-// on pictures of random and extreme bytes.
+// first frame set through its own panorama LUT, its frames held as BGR, YUYV and NV12 as cameras
+// deliver them (issue 19.3): every tap of the LUT and of its seam blends sampled alone, the whole
+// stitch, the colour correction's fields applied to it, and every pair of weights on pictures of
+// random and extreme bytes.
 
 #include <array>
 #include <cstdint>
@@ -39,21 +40,44 @@ class KernelPathsTest : public ::testing::Test {
     for (const auto& video : truth_.videos) {
       frames_.push_back(surroundd::testing::decodeAll(video, false, 1).images.at(0));
     }
+    for (const PixelFormat format : kFormats) {
+      auto& held = held_[static_cast<std::size_t>(format)];
+      for (const cv::Mat& frame : frames_) bgrToHeld(frame, format, held.emplace_back());
+    }
+  }
+  const std::vector<cv::Mat>& held(PixelFormat format) const {
+    return held_[static_cast<std::size_t>(format)];
   }
 
+  static constexpr std::array kFormats = {PixelFormat::kBgr, PixelFormat::kYuyv,
+                                          PixelFormat::kNv12};
   WorkPool pool_{2};
   const bench::RecordingTruth& truth_;
   PanoramaLut lut_;
-  std::vector<cv::Mat> frames_;
+  std::vector<cv::Mat> frames_;  // BGR, as decoded
+  std::array<std::vector<cv::Mat>, 3> held_;  // per PixelFormat
 };
+
+template <KernelPath kPath>
+std::uint32_t sampleAs(const SampledImage& image, const LutTap& tap) {
+  switch (image.format) {
+    case PixelFormat::kYuyv:
+      return bilinear<PixelFormat::kYuyv, kPath>(image, tap);
+    case PixelFormat::kNv12:
+      return bilinear<PixelFormat::kNv12, kPath>(image, tap);
+    case PixelFormat::kBgr:
+      break;
+  }
+  return bilinear<PixelFormat::kBgr, kPath>(image, tap);
+}
 
 // Each seen tap of the LUT, then each blend tap, sampled by path kPath.
 template <KernelPath kPath>
-std::vector<std::uint32_t> sampleEveryTap(const PanoramaLut& lut, std::span<const cv::Mat> frames) {
+std::vector<std::uint32_t> sampleEveryTap(const PanoramaLut& lut, std::span<const cv::Mat> frames,
+                                          PixelFormat format) {
   std::vector<std::uint32_t> samples;
   const auto sample = [&](const LutTap& tap) {
-    const cv::Mat& frame = frames[tap.camera];
-    samples.push_back(bilinear<kPath>(frame.data, frame.step, tap));
+    samples.push_back(sampleAs<kPath>(SampledImage::of(frames[tap.camera], format), tap));
   };
   for (const LutTap& tap : lut.taps) {
     if (tap.camera != PanoramaLut::kUnseen) sample(tap);
@@ -64,41 +88,48 @@ std::vector<std::uint32_t> sampleEveryTap(const PanoramaLut& lut, std::span<cons
 
 template <std::size_t... kIndex>
 std::array<std::vector<std::uint32_t>, kKernelPaths.size()> sampleEveryTapByEveryPath(
-    const PanoramaLut& lut, std::span<const cv::Mat> frames, std::index_sequence<kIndex...>) {
-  return {sampleEveryTap<kKernelPaths[kIndex]>(lut, frames)...};
+    const PanoramaLut& lut, std::span<const cv::Mat> frames, PixelFormat format,
+    std::index_sequence<kIndex...>) {
+  return {sampleEveryTap<kKernelPaths[kIndex]>(lut, frames, format)...};
 }
 
 TEST_F(KernelPathsTest, EveryPathSamplesEveryTapOfARealLutAlike) {
-  const auto samples =
-      sampleEveryTapByEveryPath(lut_, frames_, std::make_index_sequence<kKernelPaths.size()>());
-  ASSERT_EQ(kKernelPaths[0], KernelPath::kPortable);
-  ASSERT_GT(samples[0].size(), lut_.taps.size() / 2);
-  for (std::size_t p = 1; p < kKernelPaths.size(); ++p) {
-    SCOPED_TRACE(kernelPathName(kKernelPaths[p]));
-    ASSERT_EQ(samples[p].size(), samples[0].size());
-    std::size_t differing = 0;
-    for (std::size_t i = 0; i < samples[0].size(); ++i) {
-      differing += samples[p][i] != samples[0][i] ? 1 : 0;
+  for (const PixelFormat format : kFormats) {
+    SCOPED_TRACE(toString(format));
+    const auto samples = sampleEveryTapByEveryPath(lut_, held(format), format,
+                                                   std::make_index_sequence<kKernelPaths.size()>());
+    ASSERT_EQ(kKernelPaths[0], KernelPath::kPortable);
+    ASSERT_GT(samples[0].size(), lut_.taps.size() / 2);
+    for (std::size_t p = 1; p < kKernelPaths.size(); ++p) {
+      SCOPED_TRACE(kernelPathName(kKernelPaths[p]));
+      ASSERT_EQ(samples[p].size(), samples[0].size());
+      std::size_t differing = 0;
+      for (std::size_t i = 0; i < samples[0].size(); ++i) {
+        differing += samples[p][i] != samples[0][i] ? 1 : 0;
+      }
+      EXPECT_EQ(differing, 0u) << "of " << samples[0].size() << " taps";
     }
-    EXPECT_EQ(differing, 0u) << "of " << samples[0].size() << " taps";
   }
 }
 
 TEST_F(KernelPathsTest, EveryPathStitchesTheSameBytes) {
   Stitcher stitcher(lut_, pool_);
-  cv::Mat portable;
-  stitcher.stitch(frames_, portable, KernelPath::kPortable);
-  for (const KernelPath path : kKernelPaths) {
-    SCOPED_TRACE(kernelPathName(path));
-    cv::Mat panorama;
-    stitcher.stitch(frames_, panorama, path);
-    ASSERT_EQ(panorama.size(), portable.size());
-    EXPECT_EQ(cv::norm(panorama, portable, cv::NORM_INF), 0.0);
+  for (const PixelFormat format : kFormats) {
+    SCOPED_TRACE(toString(format));
+    cv::Mat portable;
+    stitcher.stitch(held(format), format, portable, KernelPath::kPortable);
+    for (const KernelPath path : kKernelPaths) {
+      SCOPED_TRACE(kernelPathName(path));
+      cv::Mat panorama;
+      stitcher.stitch(held(format), format, panorama, path);
+      ASSERT_EQ(panorama.size(), portable.size());
+      EXPECT_EQ(cv::norm(panorama, portable, cv::NORM_INF), 0.0);
+    }
+    // The native path is the one stitch() takes by default.
+    cv::Mat native;
+    stitcher.stitch(held(format), format, native);
+    EXPECT_EQ(cv::norm(native, portable, cv::NORM_INF), 0.0);
   }
-  // The native path is the one stitch() takes by default.
-  cv::Mat native;
-  stitcher.stitch(frames_, native);
-  EXPECT_EQ(cv::norm(native, portable, cv::NORM_INF), 0.0);
 }
 
 // The colour correction's field applied by each path, both fields, over the whole stitched
@@ -138,7 +169,9 @@ std::vector<std::uint32_t> sampleEveryWeight(const std::vector<cv::Mat>& picture
         LutTap tap;
         tap.fx = static_cast<std::uint8_t>(fx);
         tap.fy = static_cast<std::uint8_t>(fy);
-        samples.push_back(bilinear<kPath>(picture.data, picture.step, tap));
+        // The weights are those of every format: BGR's neighbours are the picture's bytes.
+        samples.push_back(
+            bilinear<PixelFormat::kBgr, kPath>(SampledImage::of(picture, PixelFormat::kBgr), tap));
       }
     }
   }
