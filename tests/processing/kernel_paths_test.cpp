@@ -54,7 +54,7 @@ class KernelPathsTest : public ::testing::Test {
   WorkPool pool_{2};
   const bench::RecordingTruth& truth_;
   PanoramaLut lut_;
-  std::vector<cv::Mat> frames_;  // BGR, as decoded
+  std::vector<cv::Mat> frames_;               // BGR, as decoded
   std::array<std::vector<cv::Mat>, 3> held_;  // per PixelFormat
 };
 
@@ -201,7 +201,8 @@ TEST(KernelPaths, EveryPathWeighsAlike) {
     EXPECT_EQ(samples[p], samples[0]);
   }
   // All 255 stays 255 at every weight, all 0 stays 0.
-  const std::size_t weights = (LutTap::kFractionOne + 1) * (LutTap::kFractionOne + 1);
+  constexpr std::size_t weights =
+      std::size_t{LutTap::kFractionOne + 1} * (LutTap::kFractionOne + 1);
   for (std::size_t i = 0; i < weights; ++i) {
     ASSERT_EQ(samples[0][i], 0u);
     ASSERT_EQ(samples[0][weights + i], 0xffffffu);

@@ -32,7 +32,7 @@ TEST(YuvToBgr, IsCvtColorsConversionOfEveryYuv) {
     for (int cr = 0; cr < 256; ++cr) {
       auto* row = yuyv.ptr<std::uint8_t>(cr);
       for (int cb = 0; cb < 256; ++cb) {
-        std::uint8_t* pair = row + 4 * cb;
+        std::uint8_t* pair = row + std::ptrdiff_t{4} * cb;
         pair[0] = pair[2] = static_cast<std::uint8_t>(luma);
         pair[1] = static_cast<std::uint8_t>(cb);
         pair[3] = static_cast<std::uint8_t>(cr);
@@ -155,8 +155,8 @@ TEST_F(YuvSamplingTest, ColourCorrectionMeasuresHeldFramesAsConvertedOnes) {
     ColourCorrectionSettings settings;
     PoissonColourCorrection fromHeld(truth_.rig, testing::settingsFor(truth_), lut_, settings,
                                      pool_);
-    PoissonColourCorrection fromConverted(truth_.rig, testing::settingsFor(truth_), lut_,
-                                          settings, pool_);
+    PoissonColourCorrection fromConverted(truth_.rig, testing::settingsFor(truth_), lut_, settings,
+                                          pool_);
     fromHeld.update(frames.frames, format);
     fromConverted.update(frames.converted);
     // The same seams measured, but for a block or two whose levels sit at the edge of what is
@@ -164,7 +164,9 @@ TEST_F(YuvSamplingTest, ColourCorrectionMeasuresHeldFramesAsConvertedOnes) {
     // levels at 255; measured 1.5), where they change pictures by up to 215.
     const cv::Mat& field = fromConverted.field();
     ASSERT_GT(cv::norm(field, cv::NORM_INF), 50.0);  // a field that corrects
-    EXPECT_LT(cv::norm(fromHeld.field(), field, cv::NORM_L1) / (field.total() * 3), 3.0);
+    EXPECT_LT(
+        cv::norm(fromHeld.field(), field, cv::NORM_L1) / static_cast<double>(field.total() * 3),
+        3.0);
     ASSERT_EQ(fromHeld.seams().size(), fromConverted.seams().size());
     for (std::size_t i = 0; i < fromHeld.seams().size(); ++i) {
       const auto& fromYuv = fromHeld.seams()[i];
