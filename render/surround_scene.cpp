@@ -244,6 +244,7 @@ SurroundScene::SurroundScene(const processing::SurroundMesh& mesh,
       guidelineProgram_("guidelines", kGuidelineVertex, kGuidelineFragment),
       guidelineViewProjection_(guidelineProgram_.uniform("u_viewProjection")),
       panoramaTexture_(panorama.size, GL_REPEAT),  // azimuth wraps around
+      panoramaSource_(panoramaTexture_.texture.name()),
       cameraTexture_(cameraSize, GL_CLAMP_TO_EDGE),
       meshIndexCount_(static_cast<GLsizei>(mesh.indices.size())) {
   glBindVertexArray(meshArray_.name());
@@ -347,6 +348,10 @@ void SurroundScene::uploadPanorama(const cv::Mat& bgr) {
   panoramaTexture_.upload(bgr);
 }
 
+void SurroundScene::samplePanoramaFrom(GLuint texture) {
+  panoramaSource_ = texture != 0 ? texture : panoramaTexture_.texture.name();
+}
+
 void SurroundScene::uploadCamera(const cv::Mat& bgr) {
   requireBgr(bgr, cameraTexture_.size, "camera picture");
   cameraTexture_.upload(bgr);
@@ -357,7 +362,7 @@ void SurroundScene::drawSurround(const cv::Matx44f& viewProjection, Pass pass) c
   glEnable(GL_DEPTH_TEST);
   glUseProgram(programs.mesh.name());
   glUniformMatrix4fv(programs.meshViewProjection, 1, GL_TRUE, viewProjection.val);
-  glBindTexture(GL_TEXTURE_2D, panoramaTexture_.texture.name());
+  glBindTexture(GL_TEXTURE_2D, panoramaSource_);
   glBindVertexArray(meshArray_.name());
   glDrawElements(GL_TRIANGLES, meshIndexCount_, GL_UNSIGNED_INT, nullptr);
   // Not where the view samples the panorama: they change with the steering, the view's LUT not.
@@ -371,7 +376,7 @@ void SurroundScene::drawStrips(const cv::Vec2f& stripTangents, Pass pass) const 
   const PassPrograms& programs = this->programs(pass);
   glUseProgram(programs.strip.name());
   glUniform2f(programs.stripTangents, stripTangents[0], stripTangents[1]);
-  glBindTexture(GL_TEXTURE_2D, panoramaTexture_.texture.name());
+  glBindTexture(GL_TEXTURE_2D, panoramaSource_);
   glBindVertexArray(emptyArray_.name());
   glDrawArrays(GL_TRIANGLES, 0, 3);
 }

@@ -30,6 +30,10 @@ class SurroundScene {
   // 8-bit BGR, of the panorama's size (resp. cameraSize); throws std::invalid_argument otherwise.
   void uploadPanorama(const cv::Mat& bgr);
   void uploadCamera(const cv::Mat& bgr);
+  // Samples the panorama from `texture` (RGB, the panorama's size, repeated across azimuth:
+  // GpuStitcher's) instead of the uploaded one, from the next draw on; 0 goes back to uploads.
+  // The texture must outlive the scene's use of it.
+  void samplePanoramaFrom(GLuint texture);
   // The guidelines' triangles, drawn on the ground by the picture pass from now on (none: empty).
   // A buffer of reserveGuidelines() vertices is filled in place: nothing is allocated when they
   // change with the steering.
@@ -92,6 +96,7 @@ class SurroundScene {
   ShaderProgram guidelineProgram_;
   GLint guidelineViewProjection_;
   StreamedTexture panoramaTexture_;
+  GLuint panoramaSource_;  // what the panorama passes sample: panoramaTexture_'s, or a stitcher's
   StreamedTexture cameraTexture_;
   gl::VertexArray meshArray_;
   gl::Buffer meshVertices_;

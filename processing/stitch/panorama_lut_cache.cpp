@@ -174,7 +174,15 @@ std::filesystem::path PanoramaLutCache::fileFor(const std::string& key) const {
 }
 
 PanoramaLutCache::Lookup PanoramaLutCache::load(const std::string& key) const {
-  const auto path = fileFor(key);
+  return read(fileFor(key), key);
+}
+
+PanoramaLutCache::Lookup PanoramaLutCache::loadFile(const std::filesystem::path& file) {
+  return read(file, std::nullopt);
+}
+
+PanoramaLutCache::Lookup PanoramaLutCache::read(const std::filesystem::path& path,
+                                                std::optional<std::string_view> key) {
   std::error_code ec;
   if (!std::filesystem::exists(std::filesystem::symlink_status(path, ec))) {
     return {std::nullopt, "absent"};
@@ -207,7 +215,7 @@ PanoramaLutCache::Lookup PanoramaLutCache::load(const std::string& key) const {
   Reader reader(body.substr(sizeof(kMagic) + sizeof(std::uint32_t)));
   std::string storedKey;
   if (!reader.text(storedKey)) return corrupt("bad key");
-  if (storedKey != key) {
+  if (key && storedKey != *key) {
     return {std::nullopt, fmt::format("{} is stale (built for other inputs)", path.string())};
   }
   PanoramaLut lut;

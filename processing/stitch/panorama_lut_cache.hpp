@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "processing/stitch/panorama_lut.hpp"
 
@@ -31,11 +32,16 @@ class PanoramaLutCache {
     std::string problem;  // when there is no LUT: "absent", or why the file was not usable
   };
   Lookup load(const std::string& key) const;
+  // A LUT file whatever inputs it was built for (its key is not checked; its checksum and
+  // contents are): one carried to another machine of the same byte order.
+  static Lookup loadFile(const std::filesystem::path& file);
 
   // Creates the folder if needed. Throws std::runtime_error naming the file when it cannot write.
   void store(const std::string& key, const PanoramaLut& lut) const;
 
  private:
+  static Lookup read(const std::filesystem::path& path, std::optional<std::string_view> key);
+
   std::filesystem::path folder_;
 };
 

@@ -25,7 +25,7 @@ using ::testing::AllOf;
 using ::testing::ContainsRegex;
 using ::testing::HasSubstr;
 
-const std::string kRecording = std::string(SURROUNDD_FIXTURE_DIR) + "/synth_small";
+constexpr const char* kRecording = SURROUNDD_FIXTURE_DIR "/synth_small";
 
 TEST(BenchCli, StitchReportsTimingsAndAccuracyAsJson) {
   const testing::TempDir dir;
@@ -134,7 +134,9 @@ TEST(BenchCli, BadCommandLinesAreUsageErrors) {
   for (const auto& [arguments, message] :
        {std::pair{std::vector<std::string>{"stitch"}, "no recording given"},
         std::pair{std::vector<std::string>{"stich", kRecording},
-                  "expected 'stitch', 'colour', 'pipeline' or 'receive'"},
+                  "expected 'stitch', 'colour', 'pipeline', 'receive' or 'gpu-kit'"},
+        std::pair{std::vector<std::string>{"gpu-kit", "kit"},
+                  "gpu-kit needs a folder and at least one recording"},
         std::pair{std::vector<std::string>{"receive"}, "no URL given"},
         std::pair{std::vector<std::string>{"receive", "--transport", "sctp", "rtsp://h/s"},
                   "--transport needs udp or tcp"},

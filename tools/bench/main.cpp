@@ -7,6 +7,7 @@
 //                           [--view V] [--size WxH] [--input decode|raw] [--raw-format F]
 //                           RECORDING...
 //   surround-bench receive [--transport udp|tcp] [--seconds N] [--save PICTURE] URL
+//   surround-bench gpu-kit KIT RECORDING...
 //
 // Exit codes: 0 done, 1 failed while measuring, 2 bad command line.
 
@@ -21,6 +22,7 @@
 
 #include "common/work_pool.hpp"
 #include "tools/bench/colour_benchmark.hpp"
+#include "tools/bench/gpu_kit.hpp"
 #include "tools/bench/pipeline_benchmark.hpp"
 #include "tools/bench/receive_benchmark.hpp"
 #include "tools/bench/rig_colour_report.hpp"
@@ -35,6 +37,7 @@ constexpr std::string_view kUsage =
                                [--projection P] [--view V] [--size WxH] [--input I]
                                [--raw-format F] RECORDING...
        surround-bench receive [--transport T] [--seconds N] [--save PICTURE] URL
+       surround-bench gpu-kit KIT RECORDING...
   stitch        LUT build, stitch against cv::remap, accuracy against the ground truth
   colour        Poisson colour correction: solvers, per-frame cost, seam colour error; for a
                 CONFIG (a surroundd .yaml: any rig, the shared real ones, your own car): per
@@ -46,6 +49,9 @@ constexpr std::string_view kUsage =
                 (cold and warm LUT cache) beside their limits
   receive       a surroundd stream watched as a viewer would (FFmpeg): pictures per second and
                 capture to decoded picture, from the capture times the stream carries
+  gpu-kit       writes into the folder KIT, per recording, its panorama LUT and first frame set
+                as raw YUYV: what surround-gpu-check measures on a machine with a GPU
+                (scripts/gpu-check.sh)
   RECORDING     a surround-synth recording folder (with ground truth); scripts/bench.sh makes
                 4x480p, 720p and 1080p ones
   --threads N   worker threads (default 2); stitch measures 1 thread too
@@ -130,6 +136,18 @@ int receive(int argc, char** argv) {
   }
 }
 
+int gpuKit(int argc, char** argv) {
+  if (argc < 4) return usageError("gpu-kit needs a folder and at least one recording");
+  try {
+    surroundd::WorkPool pool(2);
+    for (int i = 3; i < argc; ++i) surroundd::bench::writeGpuKit(argv[i], argv[2], pool);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "surround-bench: {}\n", e.what());
+    return 1;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -144,8 +162,9 @@ int main(int argc, char** argv) {
   }
   const std::string_view command = argc >= 2 ? argv[1] : "";
   if (command == "receive") return receive(argc, argv);
+  if (command == "gpu-kit") return gpuKit(argc, argv);
   if (command != "stitch" && command != "colour" && command != "pipeline") {
-    return usageError("expected 'stitch', 'colour', 'pipeline' or 'receive'");
+    return usageError("expected 'stitch', 'colour', 'pipeline', 'receive' or 'gpu-kit'");
   }
   bench::StitchBenchmarkOptions options;
   bench::PipelineBenchmarkOptions pipeline;

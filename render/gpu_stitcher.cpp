@@ -1,0 +1,250 @@
+#include "render/gpu_stitcher.hpp"
+
+#include <cstdint>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include <fmt/core.h>
+#include <opencv2/imgproc.hpp>
+
+#include "common/work_pool.hpp"
+#include "render/render_error.hpp"
+
+namespace surroundd::render {
+namespace {
+
+using processing::LutTap;
+using processing::PanoramaLut;
+
+constexpr const char* kVertex = R"(#version 300 es
+void main() {
+  gl_Position = vec4(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0, 0.0, 1.0);
+})";
+
+// The parts of the fragment shader that do not depend on the rig. A tap's second word is
+// fx | fy << 8 | camera << 16 | weight << 24 (LutTap's bytes in order, little-endian as the
+// upload left them). Colours are levels 0..255 in the frame's channel order until the end.
+constexpr const char* kFragmentHead = R"(#version 300 es
+precision highp float;
+precision highp int;
+precision highp usampler2D;
+uniform usampler2D u_taps;
+uniform usampler2D u_blends;
+out vec4 o_colour;
+
+// cv::cvtColor's BT.601 limited-range constants (its 20-bit fixed point, as yuvToBgr() in
+// common/pixel_format.hpp), to B G R levels.
+vec3 toBgr(vec3 yuv) {
+  float luma = max(yuv.x - 16.0, 0.0) * (1220542.0 / 1048576.0);
+  float cb = yuv.y - 128.0;
+  float cr = yuv.z - 128.0;
+  return clamp(vec3(luma + (2116026.0 / 1048576.0) * cb,
+                    luma - (409993.0 / 1048576.0) * cb - (852492.0 / 1048576.0) * cr,
+                    luma + (1673527.0 / 1048576.0) * cr), 0.0, 255.0);
+}
+)";
+
+// One camera's texel at a pixel, in the frame's format: `{0}` is the camera's index.
+std::string texelFunction(PixelFormat format, std::size_t camera) {
+  switch (format) {
+    case PixelFormat::kBgr:
+      return fmt::format(R"(uniform sampler2D u_pixels{0};
+vec3 texel{0}(ivec2 p) {{ return texelFetch(u_pixels{0}, p, 0).rgb * 255.0; }}
+)",
+                         camera);
+    case PixelFormat::kYuyv:
+      // Each texel is Y0 Cb Y1 Cr: a pixel takes its pair's chroma, as cvtColor does.
+      return fmt::format(R"(uniform sampler2D u_pixels{0};
+vec3 texel{0}(ivec2 p) {{
+  vec4 pair = texelFetch(u_pixels{0}, ivec2(p.x >> 1, p.y), 0) * 255.0;
+  return vec3((p.x & 1) == 0 ? pair.r : pair.b, pair.g, pair.a);
+}}
+)",
+                         camera);
+    case PixelFormat::kNv12:
+      return fmt::format(R"(uniform sampler2D u_pixels{0};
+uniform sampler2D u_chroma{0};
+vec3 texel{0}(ivec2 p) {{
+  return vec3(texelFetch(u_pixels{0}, p, 0).r, texelFetch(u_chroma{0}, p >> 1, 0).rg) * 255.0;
+}}
+)",
+                         camera);
+  }
+  return {};
+}
+
+// Camera `camera`'s bilinear sample at a tap (its pixel offset and fractions), in B G R levels.
+std::string sampleFunction(PixelFormat format, std::size_t camera, int width) {
+  return fmt::format(R"(vec3 sample{0}(uint offset, vec2 fraction) {{
+  ivec2 p = ivec2(int(offset % {1}u), int(offset / {1}u));
+  vec3 top = mix(texel{0}(p), texel{0}(p + ivec2(1, 0)), fraction.x);
+  vec3 bottom = mix(texel{0}(p + ivec2(0, 1)), texel{0}(p + ivec2(1, 1)), fraction.x);
+  return {2}(mix(top, bottom, fraction.y));
+}}
+)",
+                     camera, width, format == PixelFormat::kBgr ? "" : "toBgr");
+}
+
+std::string fragmentSource(const PanoramaLut& lut, PixelFormat format) {
+  std::string source = kFragmentHead;
+  std::string dispatch;
+  for (std::size_t camera = 0; camera < lut.cameraSizes.size(); ++camera) {
+    source += texelFunction(format, camera);
+    source += sampleFunction(format, camera, lut.cameraSizes[camera].width);
+    // GLSL ES 3.00 indexes sampler arrays only with constants: one branch per camera instead.
+    dispatch += fmt::format("  if (camera == {0}u) return sample{0}(tap.x, fraction);\n", camera);
+  }
+  const cv::Vec3b unseen = PanoramaLut::kUnseenColour;
+  source += fmt::format(R"(vec3 sampleTap(uvec2 tap) {{
+  uint camera = (tap.y >> 16) & 255u;
+  vec2 fraction = vec2(float(tap.y & 255u), float((tap.y >> 8) & 255u)) / {0}.0;
+{1}  return vec3({2}.0, {3}.0, {4}.0);
+}}
+void main() {{
+  ivec2 pixel = ivec2(gl_FragCoord.xy);
+  vec3 colour = sampleTap(texelFetch(u_taps, pixel, 0).xy);
+  uvec2 blend = texelFetch(u_blends, pixel, 0).xy;
+  uint weight = blend.y >> 24;
+  if (weight != 0u) colour = mix(colour, sampleTap(blend), float(weight) / 256.0);
+  o_colour = vec4(colour.bgr / 255.0, 1.0);
+}}
+)",
+                        LutTap::kFractionOne, dispatch, unseen[0], unseen[1], unseen[2]);
+  return source;
+}
+
+// Taps as an RG32UI texture of the panorama's size.
+void uploadTaps(GLuint texture, cv::Size size, const LutTap* taps) {
+  static_assert(sizeof(LutTap) == 2 * sizeof(std::uint32_t));
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glTexStorage2D(GL_TEXTURE_2D, 1, GL_RG32UI, size.width, size.height);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, size.width, size.height, GL_RG_INTEGER, GL_UNSIGNED_INT,
+                  taps);
+}
+
+}  // namespace
+
+GpuStitcher::GpuStitcher(const PanoramaLut& lut, PixelFormat format, WorkPool& pool)
+    : size_(lut.size),
+      format_(format),
+      pool_(pool),
+      program_(fmt::format("GPU stitch ({})", toString(format)), kVertex,
+               fragmentSource(lut, format)) {
+  GLint maxSize = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
+  if (size_.width > maxSize || size_.height > maxSize) {
+    throw RenderError(fmt::format("a {}x{} panorama exceeds this GPU's textures ({} pixels)",
+                                  size_.width, size_.height, maxSize));
+  }
+  cameras_.reserve(lut.cameraSizes.size());
+  for (const cv::Size& cameraSize : lut.cameraSizes) cameras_.emplace_back(format, cameraSize);
+  mapped_.resize(cameras_.size());
+
+  uploadTaps(taps_.name(), size_, lut.taps.data());
+  // The blend taps spread out to one per pixel (weight 0: none), so that the shader finds a
+  // pixel's own without a search. Set-up only.
+  std::vector<LutTap> blends(lut.taps.size());
+  for (const auto& blend : lut.blendTaps) blends[blend.pixel] = blend.tap;
+  uploadTaps(blends_.name(), size_, blends.data());
+
+  glBindTexture(GL_TEXTURE_2D, panorama_.name());
+  glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, size_.width, size_.height);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);  // azimuth wraps around
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.name());
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, panorama_.name(), 0);
+  const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    throw RenderError(
+        fmt::format("the GPU panorama's framebuffer is incomplete (0x{:04x})", status));
+  }
+
+  // Texture units: 0 taps, 1 blends, then each camera's pixels (and chroma) in turn.
+  glUseProgram(program_.name());
+  glUniform1i(program_.uniform("u_taps"), 0);
+  glUniform1i(program_.uniform("u_blends"), 1);
+  GLint unit = 2;
+  for (std::size_t camera = 0; camera < cameras_.size(); ++camera) {
+    glUniform1i(program_.uniform(fmt::format("u_pixels{}", camera).c_str()), unit++);
+    if (format == PixelFormat::kNv12) {
+      glUniform1i(program_.uniform(fmt::format("u_chroma{}", camera).c_str()), unit++);
+    }
+  }
+  GLint maxUnits = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &maxUnits);
+  if (unit > maxUnits) {
+    throw RenderError(
+        fmt::format("the GPU stitch of {} cameras needs {} texture units, this GPU "
+                    "has {}",
+                    cameras_.size(), unit, maxUnits));
+  }
+  gl::check("setting up the GPU stitch");
+}
+
+void GpuStitcher::upload(std::span<const cv::Mat> frames) {
+  if (frames.size() != cameras_.size()) {
+    throw std::invalid_argument(
+        fmt::format("the GPU stitch takes {} frames, got {}", cameras_.size(), frames.size()));
+  }
+  for (std::size_t camera = 0; camera < frames.size(); ++camera)
+    cameras_[camera].check(frames[camera]);
+  for (std::size_t camera = 0; camera < frames.size(); ++camera) {
+    mapped_[camera] = cameras_[camera].map();
+  }
+  // Each camera's bytes in a few pieces, so that every thread has a share whatever the count.
+  constexpr int kPieces = 4;
+  const auto cameras = static_cast<int>(frames.size());
+  pool_.parallelFor(cameras * kPieces, [&](int begin, int end) {
+    for (int piece = begin; piece < end; ++piece) {
+      const auto camera = static_cast<std::size_t>(piece / kPieces);
+      const std::span<std::uint8_t> buffer = mapped_[camera];
+      const std::size_t first = buffer.size() * (piece % kPieces) / kPieces;
+      const std::size_t last = buffer.size() * (piece % kPieces + 1) / kPieces;
+      std::memcpy(buffer.data() + first, frames[camera].data + first, last - first);
+    }
+  });
+  for (auto& camera : cameras_) camera.commit();
+}
+
+void GpuStitcher::stitch() {
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.name());
+  glViewport(0, 0, size_.width, size_.height);
+  glDisable(GL_DEPTH_TEST);
+  glUseProgram(program_.name());
+  const auto bind = [](GLint unit, GLuint texture) {
+    glActiveTexture(GL_TEXTURE0 + unit);
+    glBindTexture(GL_TEXTURE_2D, texture);
+  };
+  bind(0, taps_.name());
+  bind(1, blends_.name());
+  GLint unit = 2;
+  for (const auto& camera : cameras_) {
+    bind(unit++, camera.pixels());
+    if (format_ == PixelFormat::kNv12) bind(unit++, camera.chroma());
+  }
+  glBindVertexArray(emptyArray_.name());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+  glActiveTexture(GL_TEXTURE0);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  gl::check("stitching on the GPU");
+}
+
+void GpuStitcher::readPanorama(cv::Mat& bgr) const {
+  cv::Mat rgba(size_, CV_8UC4);
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.name());
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(0, 0, size_.width, size_.height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  gl::check("reading the GPU panorama back");
+  cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
+}
+
+}  // namespace surroundd::render
