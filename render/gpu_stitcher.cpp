@@ -31,6 +31,10 @@ precision highp int;
 precision highp usampler2D;
 uniform usampler2D u_taps;
 uniform usampler2D u_blends;
+uniform int u_correction;   // 0 none, 1 multiplicative, 2 additive
+uniform int u_block;        // the correction's block side, pixels
+uniform sampler2D u_field;  // its field on the block grid, levels at 255 (texelFetch only)
+uniform usampler2D u_shares;
 out vec4 o_colour;
 
 // cv::cvtColor's BT.601 limited-range constants (its 20-bit fixed point, as yuvToBgr() in
@@ -42,6 +46,47 @@ vec3 toBgr(vec3 yuv) {
   return clamp(vec3(luma + (2116026.0 / 1048576.0) * cb,
                     luma - (409993.0 / 1048576.0) * cb - (852492.0 / 1048576.0) * cr,
                     luma + (1673527.0 / 1048576.0) * cr), 0.0, 255.0);
+}
+
+// PoissonColourCorrection::apply() in processing/colour/poisson_correction.cpp: its Catmull-Rom
+// weights, the taps of a pixel's sub-block phase (columns wrap around, rows are clamped), and
+// its rule for a pixel's level given the source cameras' share of it.
+vec4 catmullRom(float t) {
+  float t2 = t * t;
+  float t3 = t2 * t;
+  return vec4(-t3 + 2.0 * t2 - t, 3.0 * t3 - 5.0 * t2 + 2.0, -3.0 * t3 + 4.0 * t2 + t, t3 - t2) *
+         0.5;
+}
+vec3 fieldAt(ivec2 pixel) {
+  ivec2 grid = textureSize(u_field, 0);
+  vec2 t = (vec2(pixel % u_block) + 0.5) / float(u_block) - 0.5;
+  vec2 below = floor(t);
+  ivec2 first = pixel / u_block + ivec2(below) - 1;
+  vec4 wx = catmullRom(t.x - below.x);
+  vec4 wy = catmullRom(t.y - below.y);
+  vec3 sum = vec3(0.0);
+  for (int j = 0; j < 4; ++j) {
+    int row = clamp(first.y + j, 0, grid.y - 1);
+    vec3 across = vec3(0.0);
+    for (int i = 0; i < 4; ++i) {
+      int column = (first.x + i + grid.x) % grid.x;
+      across += wx[i] * texelFetch(u_field, ivec2(column, row), 0).rgb;
+    }
+    sum += wy[j] * across;
+  }
+  return sum;
+}
+vec3 corrected(vec3 level, ivec2 pixel) {
+  uint share = texelFetch(u_shares, pixel, 0).r;
+  if (share == 0u) return level;
+  vec3 value = fieldAt(pixel);
+  float weight = float(share) / 256.0;
+  level = floor(level + 0.5);  // the stitched panorama's 8-bit levels, which apply() corrects
+  if (u_correction == 2) return clamp(level + weight * value, 0.0, 255.0);
+  vec3 gain = 1.0 + value / 255.0;
+  // In the seam band the pixel is w * source + (1 - w) * target: only the source's part scales.
+  return clamp(share == 256u ? level * gain : level * gain / (weight + (1.0 - weight) * gain),
+               0.0, 255.0);
 }
 )";
 
@@ -107,6 +152,7 @@ void main() {{
   uvec2 blend = texelFetch(u_blends, pixel, 0).xy;
   uint weight = blend.y >> 24;
   if (weight != 0u) colour = mix(colour, sampleTap(blend), float(weight) / 256.0);
+  if (u_correction != 0) colour = corrected(colour, pixel);
   o_colour = vec4(colour.bgr / 255.0, 1.0);
 }}
 )",
@@ -133,7 +179,9 @@ GpuStitcher::GpuStitcher(const PanoramaLut& lut, PixelFormat format, WorkPool& p
       format_(format),
       pool_(pool),
       program_(fmt::format("GPU stitch ({})", toString(format)), kVertex,
-               fragmentSource(lut, format)) {
+               fragmentSource(lut, format)),
+      correctionUniform_(program_.uniform("u_correction")),
+      blockUniform_(program_.uniform("u_block")) {
   GLint maxSize = 0;
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
   if (size_.width > maxSize || size_.height > maxSize) {
@@ -166,11 +214,15 @@ GpuStitcher::GpuStitcher(const PanoramaLut& lut, PixelFormat format, WorkPool& p
         fmt::format("the GPU panorama's framebuffer is incomplete (0x{:04x})", status));
   }
 
-  // Texture units: 0 taps, 1 blends, then each camera's pixels (and chroma) in turn.
+  // Texture units: 0 taps, 1 blends, 2 the correction's field, 3 its shares, then each camera's
+  // pixels (and chroma) in turn.
   glUseProgram(program_.name());
   glUniform1i(program_.uniform("u_taps"), 0);
   glUniform1i(program_.uniform("u_blends"), 1);
-  GLint unit = 2;
+  glUniform1i(program_.uniform("u_field"), 2);
+  glUniform1i(program_.uniform("u_shares"), 3);
+  glUniform1i(correctionUniform_, 0);
+  GLint unit = 4;
   for (std::size_t camera = 0; camera < cameras_.size(); ++camera) {
     glUniform1i(program_.uniform(fmt::format("u_pixels{}", camera).c_str()), unit++);
     if (format == PixelFormat::kNv12) {
@@ -213,7 +265,46 @@ void GpuStitcher::upload(std::span<const cv::Mat> frames) {
   for (auto& camera : cameras_) camera.commit();
 }
 
+void GpuStitcher::correctWith(const processing::PoissonColourCorrection* correction) {
+  correction_ = correction;
+  glUseProgram(program_.name());
+  if (correction == nullptr) {
+    glUniform1i(correctionUniform_, 0);
+    return;
+  }
+  const processing::CorrectionDomain& domain = correction->domain();
+  if (domain.share.size() != static_cast<std::size_t>(size_.area())) {
+    throw std::invalid_argument("the correction was set up for another panorama");
+  }
+  const cv::Size grid = correction->field().size();
+  field_ = gl::Texture();
+  glBindTexture(GL_TEXTURE_2D, field_.name());
+  glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGB32F, grid.width, grid.height);
+  shares_ = gl::Texture();
+  glBindTexture(GL_TEXTURE_2D, shares_.name());
+  glTexStorage2D(GL_TEXTURE_2D, 1, GL_R16UI, size_.width, size_.height);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 2);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, size_.width, size_.height, GL_RED_INTEGER,
+                  GL_UNSIGNED_SHORT, domain.share.data());
+  for (const GLuint texture : {field_.name(), shares_.name()}) {
+    glBindTexture(GL_TEXTURE_2D, texture);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  }
+  glUniform1i(correctionUniform_,
+              correction->settings().field == processing::CorrectionField::kAdditive ? 2 : 1);
+  glUniform1i(blockUniform_, domain.block);
+  gl::check("setting up the GPU colour correction");
+}
+
 void GpuStitcher::stitch() {
+  if (correction_ != nullptr) {
+    // The field as the last update() left it: a few thousand blocks, uploaded as they are.
+    const cv::Mat& field = correction_->field();
+    glBindTexture(GL_TEXTURE_2D, field_.name());
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, field.cols, field.rows, GL_RGB, GL_FLOAT, field.data);
+  }
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.name());
   glViewport(0, 0, size_.width, size_.height);
   glDisable(GL_DEPTH_TEST);
@@ -224,7 +315,9 @@ void GpuStitcher::stitch() {
   };
   bind(0, taps_.name());
   bind(1, blends_.name());
-  GLint unit = 2;
+  bind(2, field_.name());
+  bind(3, shares_.name());
+  GLint unit = 4;
   for (const auto& camera : cameras_) {
     bind(unit++, camera.pixels());
     if (format_ == PixelFormat::kNv12) bind(unit++, camera.chroma());

@@ -8,7 +8,10 @@
 // neighbourhood interpolated bilinearly in the frame's own format and converted to colour with
 // cv::cvtColor's BT.601 constants, its blend tap mixed in by its weight, the unseen colour where
 // no camera sees; in floating point rather than in Stitcher's fixed point, so the two agree
-// within rounding (tested: gpu_stitcher_test).
+// within rounding (tested: gpu_stitcher_test). With a Poisson colour correction it applies its
+// field in the same pass as PoissonColourCorrection::apply() does (the block grid upsampled with
+// the same Catmull-Rom weights, the same multiplicative or additive rule and seam-band shares):
+// the correction's solve stays on the CPU, and only its small field is uploaded per frame.
 //
 // Built at start-up on the thread of the current EglContext; upload() and stitch() are the
 // per-frame calls and allocate nothing.
@@ -20,6 +23,7 @@
 #include <opencv2/core.hpp>
 
 #include "common/pixel_format.hpp"
+#include "processing/colour/poisson_correction.hpp"
 #include "processing/stitch/panorama_lut.hpp"
 #include "render/camera_texture.hpp"
 #include "render/gl_objects.hpp"
@@ -42,8 +46,12 @@ class GpuStitcher {
   // std::invalid_argument otherwise. The copies into the mapped pixel buffers run on the pool
   // (one memcpy per thread cannot keep up with the bus: 12 GB/s where PCIe carries 25 or more).
   void upload(std::span<const cv::Mat> frames);
-  // Writes the panorama texture from the frames last uploaded. Leaves framebuffer 0 bound and
-  // texture unit 0 active.
+  // Applies `correction`'s field from the next stitch() on, as it stands after each update()
+  // (borrowed: it must outlive its use here); nullptr: none. Set-up, not per frame: the first
+  // call for a correction uploads its seam-band shares (two bytes a panorama pixel).
+  void correctWith(const processing::PoissonColourCorrection* correction);
+  // Writes the panorama texture from the frames last uploaded (and the correction's field as it
+  // is now). Leaves framebuffer 0 bound and texture unit 0 active.
   void stitch();
 
   // RGBA8, the LUT's size, row 0 the panorama's top at texture coordinate t = 0, repeated
@@ -64,10 +72,15 @@ class GpuStitcher {
   std::vector<std::span<std::uint8_t>> mapped_;  // each camera's buffer while an upload fills it
   gl::Texture taps_;                             // RG32UI: each pixel's LutTap as two words
   gl::Texture blends_;  // the same for its blend tap; weight 0 where it has none
+  const processing::PoissonColourCorrection* correction_ = nullptr;
+  gl::Texture field_;   // RGB32F, the correction's block grid
+  gl::Texture shares_;  // R16UI, each panorama pixel's source share 0..256
   gl::Texture panorama_;
   gl::Framebuffer framebuffer_;
   gl::VertexArray emptyArray_;  // the full-screen triangle makes its vertices from gl_VertexID
   ShaderProgram program_;
+  GLint correctionUniform_;  // 0 none, 1 multiplicative, 2 additive
+  GLint blockUniform_;
 };
 
 }  // namespace surroundd::render

@@ -99,6 +99,7 @@ class PoissonColourCorrection {
   const std::vector<std::string>& notesOfLastUpdate() const { return changes_; }
   // The domain in use: the full rig's, or the one without the cameras lost now.
   const CorrectionDomain& domain() const;
+  const ColourCorrectionSettings& settings() const { return settings_; }
   std::string solverNames() const;
 
   // Solves this frame's fields from the camera frames, held in `format` (common/pixel_format.hpp;

@@ -1,12 +1,15 @@
 // The panorama stitched on the GPU (render/gpu_stitcher.hpp) from camera frames held as YUYV,
-// NV12 or BGR is the CPU Stitcher's panorama of the same frames within rounding, and every view
-// drawn from it is the view drawn from the CPU panorama: on the synth_small recording's first
-// frame set, through whatever EGL gives (llvmpipe here, a GPU where there is one).
+// NV12 or BGR is the CPU Stitcher's panorama of the same frames within rounding, with or without
+// either Poisson correction field applied in the same pass, and every view drawn from it is the
+// view drawn from the CPU panorama: on the synth_small recording's first frame set, through
+// whatever EGL gives (llvmpipe here, a GPU where there is one).
 
 #include "render/gpu_stitcher.hpp"
 
 #include <array>
+#include <cstdlib>
 #include <memory>
+#include <new>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -14,11 +17,31 @@
 
 #include "common/pixel_format.hpp"
 #include "common/work_pool.hpp"
+#include "processing/colour/poisson_correction.hpp"
 #include "processing/stitch/stitcher.hpp"
 #include "processing/surround_mesh.hpp"
 #include "render/egl_context.hpp"
 #include "render/surround_view.hpp"
 #include "tests/processing/panorama_test_support.hpp"
+
+// Counts operator new on the thread that sets `countAllocations` (the GL driver's threads and its
+// own C allocations are not the stitcher's to count).
+namespace {
+thread_local bool countAllocations = false;
+int allocations = 0;
+}  // namespace
+
+// GCC sees free() meet operator new once these are inlined into the standard library's callers.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+void* operator new(std::size_t size) {
+  if (countAllocations) ++allocations;
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#pragma GCC diagnostic pop
 
 namespace surroundd::render {
 namespace {
@@ -111,6 +134,78 @@ TEST_F(GpuStitcherTest, ThePanoramaIsTheCpuStitchersForEveryFormat) {
 
 // A second set of frames through the same stitcher replaces the first (the pixel buffers taken
 // in turn): the panorama follows the frames.
+// Camera 1 a quarter darker, so that the correction has a step to take out; the field solved on
+// the CPU from the held frames, applied by Stitcher + apply() and by the GPU pass.
+TEST_F(GpuStitcherTest, BothCorrectionFieldsAreAppliedAsTheCpuAppliesThem) {
+  const auto& truth = processing::testing::smallRecording();
+  std::vector<cv::Mat> darker = bgrFrames;
+  darker[1] = darker[1] * 0.75;
+  for (const auto field :
+       {processing::CorrectionField::kMultiplicative, processing::CorrectionField::kAdditive}) {
+    for (const PixelFormat format : kFormats) {
+      SCOPED_TRACE(std::string(processing::correctionFieldName(field)) + ", " + toString(format));
+      std::vector<cv::Mat> frames(darker.size());
+      for (std::size_t i = 0; i < frames.size(); ++i) bgrToHeld(darker[i], format, frames[i]);
+      processing::ColourCorrectionSettings settings;
+      settings.field = field;
+      processing::PoissonColourCorrection correction(
+          truth.rig, processing::testing::settingsFor(truth), *lut, settings, *pool);
+      correction.update(frames, format);
+
+      cv::Mat uncorrected;
+      processing::Stitcher(*lut, *pool).stitch(frames, format, uncorrected);
+      cv::Mat cpu = uncorrected.clone();
+      correction.apply(cpu);
+      // A correction that changes the picture, so that agreeing is not agreeing on none.
+      ASSERT_GT(cv::norm(cpu, uncorrected, cv::NORM_L1) / static_cast<double>(cpu.total()), 3.0);
+
+      GpuStitcher gpu(*lut, format, *pool);
+      gpu.correctWith(&correction);
+      gpu.upload(frames);
+      gpu.stitch();
+      cv::Mat corrected;
+      gpu.readPanorama(corrected);
+      cv::Mat difference;
+      cv::absdiff(corrected, cpu, difference);
+      const cv::Scalar mean = cv::mean(difference);
+      for (int c = 0; c < 3; ++c) EXPECT_LE(mean[c], 1.0) << "channel " << c;
+      EXPECT_LE(percentile(difference, 0.99), 4);
+
+      gpu.correctWith(nullptr);  // and back to none
+      gpu.stitch();
+      gpu.readPanorama(corrected);
+      EXPECT_LE(cv::norm(corrected, uncorrected, cv::NORM_L1) /
+                    static_cast<double>(uncorrected.total() * 3),
+                1.0);
+    }
+  }
+}
+
+// The per-frame calls, the correction's field upload included, once the driver has seen them.
+TEST_F(GpuStitcherTest, UploadAndStitchAllocateNothing) {
+  const auto& truth = processing::testing::smallRecording();
+  const auto frames = held(PixelFormat::kNv12);
+  processing::PoissonColourCorrection correction(truth.rig, processing::testing::settingsFor(truth),
+                                                 *lut, {}, *pool);
+  correction.update(frames, PixelFormat::kNv12);
+  GpuStitcher gpu(*lut, PixelFormat::kNv12, *pool);
+  gpu.correctWith(&correction);
+  for (int round = 0; round < 2; ++round) {
+    gpu.upload(frames);
+    gpu.stitch();
+    glFinish();
+  }
+  allocations = 0;
+  countAllocations = true;
+  for (int round = 0; round < 3; ++round) {
+    gpu.upload(frames);
+    gpu.stitch();
+  }
+  countAllocations = false;
+  glFinish();
+  EXPECT_EQ(allocations, 0);
+}
+
 TEST_F(GpuStitcherTest, EachUploadReplacesTheLastFrames) {
   GpuStitcher gpu(*lut, PixelFormat::kYuyv, *pool);
   const auto frames = held(PixelFormat::kYuyv);
