@@ -45,7 +45,7 @@ constexpr std::string_view kUsage =
                 no correction, gains and Poisson, and the mean level
   pipeline      the whole daemon pipeline (the paper's tables 1 and 2): frames per second,
                 milliseconds per stage, CPU and peak memory, against a decode-only replay
-                (--input raw: convert-only); frame rate, latency and time to the first picture
+                (--input raw: copy-only); frame rate, latency and time to the first picture
                 (cold and warm LUT cache) beside their limits
   receive       a surroundd stream watched as a viewer would (FFmpeg): pictures per second and
                 capture to decoded picture, from the capture times the stream carries
@@ -62,8 +62,8 @@ constexpr std::string_view kUsage =
   --view V      pipeline: top | 360 | orbit | split | rear (default orbit)
   --size WxH    pipeline: output size (default 1280x720)
   --input I     pipeline: decode (each video decoded as it plays: replay figures; the default) |
-                raw (decoded once at start into memory as a camera's frames, converted to BGR per
-                frame as a V4L2 camera's are: live-rig figures)
+                raw (decoded once at start into memory as a camera's frames, handed over per
+                frame as a V4L2 camera's are, kept in their YUV: live-rig figures)
   --raw-format F  pipeline, --input raw: yuyv | nv12 (default yuyv)
   --pictures DIR  colour, CONFIG: also write the panoramas (none, gain, Poisson) and body masks
   URL           receive: rtsp://HOST:PORT/NAME (an rtsp output) or udp://HOST:PORT (a network

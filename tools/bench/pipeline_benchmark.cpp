@@ -222,8 +222,9 @@ void printText(const std::vector<RecordingFigures>& all, const PipelineBenchmark
     fmt::print("input: decode (each camera's H.264 video decoded as it plays)\n");
   } else {
     fmt::print(
-        "input: {} (each recording decoded once at start into memory as {} frames, converted to "
-        "BGR per frame as a V4L2 camera's are; peak MB includes them)\n",
+        "input: {} (each recording decoded once at start into memory as {} frames, handed over "
+        "per frame as a V4L2 camera's are, kept in their YUV; convert: that copy; peak MB "
+        "includes them)\n",
         inputName(options), capture::toString(options.rawFormat));
   }
   fmt::print("{:<26} {:>7} {:>13} {:>7} {:>6} {:>8}\n", "input -> panorama", "FPS",
