@@ -6,10 +6,11 @@
 // then one interleaved Cb Cr pair per 2x2 pixels. YUV is BT.601, limited range (luma 16..235,
 // chroma 16..240 around 128), as V4L2 cameras deliver it.
 
-#include <algorithm>
 #include <cstdint>
 
 #include <opencv2/core.hpp>
+
+#include "common/bt601.hpp"
 
 namespace surroundd {
 
@@ -39,26 +40,8 @@ void heldToBgr(const cv::Mat& held, PixelFormat format, cv::Mat& bgr);
 // (preloading a recording) and tests.
 void bgrToHeld(const cv::Mat& bgr, PixelFormat format, cv::Mat& held);
 
-// One pixel: Y | Cb << 8 | Cr << 16 to B | G | R << 16, exactly as cv::cvtColor's YUV2BGR_YUYV
-// and YUV2BGR_NV12 convert each pixel (20-bit fixed point, BT.601 limited range).
-inline std::uint32_t yuvToBgr(std::uint32_t yuv) {
-  constexpr int kShift = 20;
-  constexpr int kLuma = 1220542;       // 1.164 * 2^20
-  constexpr int kCbToBlue = 2116026;   // 2.018
-  constexpr int kCbToGreen = -409993;  // -0.391
-  constexpr int kCrToGreen = -852492;  // -0.813
-  constexpr int kCrToRed = 1673527;    // 1.596
-  constexpr int kHalf = 1 << (kShift - 1);
-  const int luma = std::max(0, static_cast<int>(yuv & 0xffU) - 16) * kLuma;
-  const int cb = static_cast<int>((yuv >> 8) & 0xffU) - 128;
-  const int cr = static_cast<int>((yuv >> 16) & 0xffU) - 128;
-  const auto level = [](int fixed) {
-    return static_cast<std::uint32_t>(std::clamp(fixed >> kShift, 0, 255));
-  };
-  return level(luma + kHalf + kCbToBlue * cb) |
-         level(luma + kHalf + kCbToGreen * cb + kCrToGreen * cr) << 8 |
-         level(luma + kHalf + kCrToRed * cr) << 16;
-}
+// One pixel of YUV to BGR, as cv::cvtColor converts it (common/bt601.hpp).
+using bt601::yuvToBgr;
 
 // Pixel (x, y) of a held picture as B | G << 8 | R << 16: for a few pixels of a frame (camera
 // health's samples), where converting the frame would cost more than the pixels.

@@ -8,6 +8,9 @@
 
 #include <cstdint>
 #include <cstring>
+#include <stdexcept>
+
+#include <fmt/format.h>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -21,6 +24,14 @@
 
 namespace surroundd::processing {
 
+// The most pixels an NV12 frame may have for rowOf() to be exact (4096 x 4096).
+inline constexpr int kMaxRowOfPixels = 1 << 24;
+
+// ceil(2^40 / width): what rowOf() multiplies by (0 for no width).
+constexpr std::uint64_t rowReciprocalOf(std::uint32_t width) {
+  return width == 0 ? 0 : ((std::uint64_t{1} << 40) + width - 1) / width;
+}
+
 // A camera frame as the kernels read it. Taps address pixels as row * width + column, so the
 // frame must be continuous (holds() in common/pixel_format.hpp).
 struct SampledImage {
@@ -28,7 +39,8 @@ struct SampledImage {
   const std::uint8_t* chroma = nullptr;  // NV12: the Cb Cr plane
   std::size_t rowBytes = 0;              // of `pixels`
   std::uint32_t width = 0;
-  double inverseWidth = 0;  // NV12: 1 / width, to find a tap's row without a division
+  // NV12: ceil(2^40 / width), to find a tap's row without a division (rowOf()).
+  std::uint64_t rowReciprocal = 0;
   PixelFormat format = PixelFormat::kBgr;
 
   // `held` must hold a picture in `format` (common/pixel_format.hpp) and outlive the result.
@@ -38,9 +50,16 @@ struct SampledImage {
     image.pixels = held.ptr<std::uint8_t>();
     image.rowBytes = held.step;
     image.width = static_cast<std::uint32_t>(size.width);
-    image.inverseWidth = 1.0 / size.width;
     image.format = format;
-    if (format == PixelFormat::kNv12) image.chroma = held.ptr<std::uint8_t>(size.height);
+    if (format == PixelFormat::kNv12) {
+      if (size.area() > kMaxRowOfPixels) {
+        throw std::invalid_argument(
+            fmt::format("an NV12 frame of {}x{} is beyond the {} pixels its sampling can address",
+                        size.width, size.height, kMaxRowOfPixels));
+      }
+      image.rowReciprocal = rowReciprocalOf(image.width);
+      image.chroma = held.ptr<std::uint8_t>(size.height);
+    }
     return image;
   }
 };
@@ -65,13 +84,21 @@ inline std::uint32_t pixelBytes(const std::uint8_t* p, int column) {
 
 // Bytes per pixel of a frame's first plane (NV12: its luma).
 template <PixelFormat kFormat>
-inline constexpr std::size_t kFirstPlaneBytes =
-    kFormat == PixelFormat::kBgr ? 3 : (kFormat == PixelFormat::kYuyv ? 2 : 1);
+inline constexpr std::size_t kFirstPlaneBytes = kFormat == PixelFormat::kBgr
+                                                    ? 3
+                                                    : (kFormat == PixelFormat::kYuyv ? 2 : 1);
 
 // Where a tap's top-left pixel starts in the frame's first plane: to prefetch it.
 template <PixelFormat kFormat>
 inline const std::uint8_t* firstByte(const SampledImage& image, std::uint32_t offset) {
   return image.pixels + static_cast<std::size_t>(offset) * kFirstPlaneBytes<kFormat>;
+}
+
+// The row of the pixel at `offset`, without a division: offset * ceil(2^40 / width) / 2^40 exceeds
+// offset / width by less than offset / 2^40 <= 2^-16 (kMaxRowOfPixels), less than the 1 / width
+// that a fraction of offset / width stays below 1 by, so the floor is the row.
+inline std::uint32_t rowOf(const SampledImage& image, std::uint32_t offset) {
+  return static_cast<std::uint32_t>((std::uint64_t{offset} * image.rowReciprocal) >> 40);
 }
 
 template <PixelFormat kFormat>
@@ -81,20 +108,24 @@ inline Neighbours neighbours(const SampledImage& image, std::uint32_t offset) {
     const std::uint8_t* bottom = top + image.rowBytes;
     return {pixelBytes(top, 0), pixelBytes(top, 1), pixelBytes(bottom, 0), pixelBytes(bottom, 1)};
   } else if constexpr (kFormat == PixelFormat::kYuyv) {
-    // Y0 Cb Y1 Cr: an odd pixel's chroma is two bytes back of an even one's. The width is even,
-    // so a pixel's column has the parity of its offset.
-    const int odd = static_cast<int>(offset & 1U);
-    const auto row = [odd](const std::uint8_t* p, int column) {
-      const int chroma = column == 0 ? 1 - 2 * odd : 1 + 2 * odd;
-      return p[2 * column] | std::uint32_t{p[chroma]} << 8 | std::uint32_t{p[chroma + 2]} << 16;
+    // Y0 Cb Y1 Cr: each pixel's pair read whole (the left pixel's, then the right one's: the
+    // same pair for an even offset, the next for an odd one), its Y picked by the offset's
+    // parity. The width is even, so a pixel's column has the parity of its offset.
+    const std::uint32_t odd = offset & 1U;
+    const std::uint8_t* base = image.pixels + static_cast<std::size_t>(offset & ~1U) * 2;
+    const std::size_t next = 4 * odd;
+    const auto pixel = [](const std::uint8_t* pair, std::uint32_t lumaShift) {
+      std::uint32_t bytes = 0;
+      std::memcpy(&bytes, pair, 4);
+      return ((bytes >> lumaShift) & 0xffU) | (bytes & 0xff00U) | ((bytes >> 8) & 0xff0000U);
     };
-    const std::uint8_t* top = image.pixels + static_cast<std::size_t>(offset) * 2;
-    const std::uint8_t* bottom = top + image.rowBytes;
-    return {row(top, 0), row(top, 1), row(bottom, 0), row(bottom, 1)};
+    const std::uint32_t leftShift = 16 * odd;
+    const std::uint32_t rightShift = 16 - leftShift;
+    const std::uint8_t* bottom = base + image.rowBytes;
+    return {pixel(base, leftShift), pixel(base + next, rightShift), pixel(bottom, leftShift),
+            pixel(bottom + next, rightShift)};
   } else {
-    // The row from the offset without a division: (offset + 0.5) / width lies at least half a
-    // pixel's share away from a whole number, far beyond a double's rounding.
-    const auto y = static_cast<std::uint32_t>((offset + 0.5) * image.inverseWidth);
+    const std::uint32_t y = rowOf(image, offset);
     const std::uint32_t x = offset - y * image.width;
     const std::uint8_t* luma = image.pixels + offset;
     const std::size_t pairColumn = x & ~1U;
@@ -149,8 +180,8 @@ inline std::uint32_t interpolate(const Neighbours& n, const LutTap& tap) {
     };
     uint32x4_t sum =
         vmull_n_u16(horizontal(n.topLeft, n.topRight), static_cast<std::uint16_t>(wy0));
-    sum = vmlal_n_u16(sum, horizontal(n.bottomLeft, n.bottomRight),
-                      static_cast<std::uint16_t>(wy1));
+    sum =
+        vmlal_n_u16(sum, horizontal(n.bottomLeft, n.bottomRight), static_cast<std::uint16_t>(wy1));
     // Rounded: (sum + 2^13) >> 14, at most 255, so the narrowing moves lose nothing.
     const uint8x8_t bytes = vmovn_u16(vcombine_u16(vrshrn_n_u32(sum, 14), vdup_n_u16(0)));
     return vget_lane_u32(vreinterpret_u32_u8(bytes), 0) & 0xffffffU;
@@ -158,7 +189,9 @@ inline std::uint32_t interpolate(const Neighbours& n, const LutTap& tap) {
 #endif
   std::uint32_t packed = 0;
   for (int c = 0; c < 3; ++c) {
-    const auto level = [c](std::uint32_t pixel) { return static_cast<int>((pixel >> (8 * c)) & 0xffU); };
+    const auto level = [c](std::uint32_t pixel) {
+      return static_cast<int>((pixel >> (8 * c)) & 0xffU);
+    };
     const int upper = level(n.topLeft) * wx0 + level(n.topRight) * wx1;
     const int lower = level(n.bottomLeft) * wx0 + level(n.bottomRight) * wx1;
     packed |= static_cast<std::uint32_t>((upper * wy0 + lower * wy1 + (1 << 13)) >> 14) << (8 * c);

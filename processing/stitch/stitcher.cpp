@@ -14,16 +14,19 @@
 
 #include "common/work_pool.hpp"
 #include "processing/stitch/bilinear_sample.hpp"
+#include "processing/stitch/yuv_lanes.hpp"
 
 namespace surroundd::processing {
 namespace {
 
 #if defined(__SSE2__)
 // Two pixels at once, the same arithmetic as interpolate() in eight 16-bit lanes: half the
-// instructions per pixel. kPairPath names the kernel path it serves. Returns pixel a in the low 32
-// bits and b in the high 32 (each c0 c1 c2 0).
-inline std::uint64_t interpolatePair(const Neighbours& na, const LutTap& a, const Neighbours& nb,
-                                     const LutTap& b) {
+// instructions per pixel; a YUV frame's are converted to BGR in the same lanes (yuv_lanes.hpp).
+// kPairPath names the kernel path it serves. Returns pixel a in the low 32 bits and b in the high
+// 32 (each B G R 0).
+template <PixelFormat kFormat>
+[[gnu::always_inline]] inline std::uint64_t interpolatePair(const Neighbours& na, const LutTap& a,
+                                                            const Neighbours& nb, const LutTap& b) {
   const __m128i zero = _mm_setzero_si128();
   // Two pixels of both neighbourhoods, 16-bit lanes: a's in 0-3, b's in 4-7.
   const auto lanes = [&](std::uint32_t pa, std::uint32_t pb) {
@@ -46,15 +49,17 @@ inline std::uint64_t interpolatePair(const Neighbours& na, const LutTap& a, cons
   };
   const __m128i resultA = vertical(_mm_unpacklo_epi16(upper, lower), a);
   const __m128i resultB = vertical(_mm_unpackhi_epi16(upper, lower), b);
-  const __m128i words = _mm_packs_epi32(resultA, resultB);
+  __m128i words = _mm_packs_epi32(resultA, resultB);
+  if constexpr (kFormat != PixelFormat::kBgr) words = yuvToBgrLanes(words);
   const __m128i bytes = _mm_packus_epi16(words, words);
   return static_cast<std::uint64_t>(_mm_cvtsi128_si64(bytes)) & 0x00ffffff00ffffffULL;
 }
 constexpr KernelPath kPairPath = KernelPath::kSse2;
 #elif defined(__ARM_NEON)
 // The same two pixels at once in NEON's eight 16-bit lanes, a's in 0-3 and b's in 4-7.
-inline std::uint64_t interpolatePair(const Neighbours& na, const LutTap& a, const Neighbours& nb,
-                                     const LutTap& b) {
+template <PixelFormat kFormat>
+[[gnu::always_inline]] inline std::uint64_t interpolatePair(const Neighbours& na, const LutTap& a,
+                                                            const Neighbours& nb, const LutTap& b) {
   const auto lanes = [](std::uint32_t pa, std::uint32_t pb) {
     return vmovl_u8(vcreate_u8(pa | std::uint64_t{pb} << 32));
   };
@@ -72,7 +77,13 @@ inline std::uint64_t interpolatePair(const Neighbours& na, const LutTap& a, cons
   };
   const uint16x8_t words = vcombine_u16(vertical(vget_low_u16(upper), vget_low_u16(lower), a),
                                         vertical(vget_high_u16(upper), vget_high_u16(lower), b));
-  return vget_lane_u64(vreinterpret_u64_u8(vmovn_u16(words)), 0) & 0x00ffffff00ffffffULL;
+  uint8x8_t bytes;
+  if constexpr (kFormat == PixelFormat::kBgr) {
+    bytes = vmovn_u16(words);
+  } else {
+    bytes = vqmovun_s16(yuvToBgrLanes(words));
+  }
+  return vget_lane_u64(vreinterpret_u64_u8(bytes), 0) & 0x00ffffff00ffffffULL;
 }
 constexpr KernelPath kPairPath = KernelPath::kNeon;
 #endif
@@ -111,9 +122,9 @@ void Stitcher::stitch(std::span<const cv::Mat> frames, PixelFormat format, cv::M
   }
   for (std::size_t i = 0; i < frames.size(); ++i) {
     if (!holds(frames[i], format, lut_.cameraSizes[i])) {
-      throw std::invalid_argument(fmt::format(
-          "stitch: frame {} is not a continuous {} picture of {}x{}", i, toString(format),
-          lut_.cameraSizes[i].width, lut_.cameraSizes[i].height));
+      throw std::invalid_argument(
+          fmt::format("stitch: frame {} is not a continuous {} picture of {}x{}", i,
+                      toString(format), lut_.cameraSizes[i].width, lut_.cameraSizes[i].height));
     }
     images_[i] = SampledImage::of(frames[i], format);
   }
@@ -183,10 +194,10 @@ void Stitcher::stitchRows(int first, int last, cv::Mat& panorama) const {
         const LutTap a = taps[u];
         const LutTap b = taps[u + 1];
         const std::uint64_t pair =
-            interpolatePair(neighbours<kFormat>(images[a.camera], a.offset), a,
-                            neighbours<kFormat>(images[b.camera], b.offset), b);
-        const std::uint32_t left = toBgr<kFormat>(static_cast<std::uint32_t>(pair));
-        const std::uint32_t right = toBgr<kFormat>(static_cast<std::uint32_t>(pair >> 32));
+            interpolatePair<kFormat>(neighbours<kFormat>(images[a.camera], a.offset), a,
+                                     neighbours<kFormat>(images[b.camera], b.offset), b);
+        const auto left = static_cast<std::uint32_t>(pair);
+        const auto right = static_cast<std::uint32_t>(pair >> 32);
         std::memcpy(out(u), &left, 4);
         std::memcpy(out(u + 1), &right, 4);
       }

@@ -41,6 +41,15 @@ struct ThreadTiming {
   double portableMs = 0;  // the stitcher on its portable kernels (kernel_path.hpp)
 };
 
+// The same stitch from frames held as a camera hands them over (common/pixel_format.hpp), on
+// `threads` threads, through the panorama's LUT and through the top view's: what sampling YUV
+// straight costs against sampling BGR.
+struct FormatTiming {
+  PixelFormat format = PixelFormat::kBgr;
+  double panoramaMs = 0;
+  double topViewMs = 0;
+};
+
 // The top view through its view LUT (processing/stitch/view_lut.hpp) and the Poisson field
 // applied to it, against the panorama stitched and corrected, uploaded, drawn and read back, for
 // the same picture.
@@ -51,6 +60,7 @@ struct TopViewTiming {
   double renderedMs = 0;  // stitch + field + upload + draw + read-back
   double psnr = 0;        // of the direct picture against the rendered one, where both show the
                           // panorama
+  std::vector<FormatTiming> formats;
 };
 
 struct InputReport {
@@ -136,6 +146,15 @@ TopViewTiming measureTopView(const processing::Rig& rig,
                                           repeats);
   timing.directMs = medians[0];
   timing.renderedMs = medians[1];
+  for (const PixelFormat format : {PixelFormat::kBgr, PixelFormat::kYuyv, PixelFormat::kNv12}) {
+    std::vector<cv::Mat> held(images.size());
+    for (std::size_t c = 0; c < images.size(); ++c) bgrToHeld(images[c], format, held[c]);
+    const auto formatMedians =
+        interleavedMedians({[&] { stitcher.stitch(held, format, panorama); },
+                            [&] { direct.stitch(held, format, directPicture); }},
+                           repeats);
+    timing.formats.push_back({format, formatMedians[0], formatMedians[1]});
+  }
   const cv::Mat shown = render::SurroundView::panoramaShown(positions);
   cv::Mat difference;
   cv::absdiff(directPicture, rendered, difference);
@@ -217,6 +236,14 @@ void printText(const std::vector<InputReport>& reports) {
         "view LUT composed in {:.2f} s\n",
         top.size.width, top.size.height, r.timings.back().threads, top.directMs,
         1000 / top.directMs, top.renderedMs, top.directMs / top.renderedMs, top.psnr, top.composeS);
+    const FormatTiming& bgr = top.formats.front();
+    for (const FormatTiming& f : top.formats) {
+      fmt::print(
+          "  frames held in {:<4}: panorama stitch {:6.2f} ms ({:.2f}x BGR's)   top view gather "
+          "{:6.2f} ms ({:.2f}x BGR's)\n",
+          toString(f.format), f.panoramaMs, f.panoramaMs / bgr.panoramaMs, f.topViewMs,
+          f.topViewMs / bgr.topViewMs);
+    }
     for (const auto& [name, a] : {std::pair{"bowl  ", r.bowl}, std::pair{"sphere", r.sphere}}) {
       fmt::print(
           "  {}: ground seams {:.2f} px mean, {:.2f} px max ({} seam pixels); error vs "

@@ -5,6 +5,8 @@
 
 #include <array>
 #include <cstdint>
+#include <cstring>
+#include <stdexcept>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -16,6 +18,7 @@
 #include "processing/colour/poisson_correction.hpp"
 #include "processing/stitch/bilinear_sample.hpp"
 #include "processing/stitch/stitcher.hpp"
+#include "processing/stitch/yuv_lanes.hpp"
 #include "tests/processing/panorama_test_support.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -50,6 +53,66 @@ TEST(YuvToBgr, IsCvtColorsConversionOfEveryYuv) {
     }
     ASSERT_EQ(differing, 0) << "luma " << luma;
   }
+}
+
+// The stitcher's SIMD conversion of two pixels at once (yuv_lanes.hpp) against yuvToBgr() for every
+// Y, Cb, Cr in either lane, the other lane holding a different pixel and the ignored lanes garbage.
+TEST(YuvToBgr, TheSimdLanesConvertEveryYuvAsOnePixelIs) {
+#if defined(__SSE2__) || defined(__ARM_NEON)
+  const auto convert = [](std::uint32_t a, std::uint32_t b) {
+    std::array<std::uint16_t, 8> lanes{};
+    for (int c = 0; c < 3; ++c) {
+      lanes[static_cast<std::size_t>(c)] = static_cast<std::uint16_t>((a >> (8 * c)) & 0xffU);
+      lanes[static_cast<std::size_t>(c) + 4] = static_cast<std::uint16_t>((b >> (8 * c)) & 0xffU);
+    }
+    lanes[3] = static_cast<std::uint16_t>(a >> 24);
+    lanes[7] = 255;
+    std::array<std::uint8_t, 8> bytes{};
+#if defined(__SSE2__)
+    __m128i words;
+    std::memcpy(&words, lanes.data(), sizeof words);
+    const __m128i packed = _mm_packus_epi16(yuvToBgrLanes(words), yuvToBgrLanes(words));
+    std::memcpy(bytes.data(), &packed, bytes.size());
+#else
+    vst1_u8(bytes.data(), vqmovun_s16(yuvToBgrLanes(vld1q_u16(lanes.data()))));
+#endif
+    std::uint64_t both = 0;
+    std::memcpy(&both, bytes.data(), bytes.size());
+    return both;
+  };
+  int differing = 0;
+  for (std::uint32_t yuv = 0; yuv < (1U << 24); ++yuv) {
+    const std::uint32_t other = yuv ^ 0x5a3c96U;
+    const std::uint64_t expected = yuvToBgr(yuv) | std::uint64_t{yuvToBgr(other)} << 32;
+    differing += convert(yuv | 0xab000000U, other) != expected ? 1 : 0;
+  }
+  EXPECT_EQ(differing, 0);
+#else
+  GTEST_SKIP() << "this build has no SIMD kernels (kernel_path.hpp)";
+#endif
+}
+
+// An NV12 tap's row is found without a division (rowOf()): exact up to the largest frame allowed,
+// which is refused beyond it.
+TEST(YuvSampling, AnNv12TapsRowIsItsOffsetOverTheWidthUpToTheLimit) {
+  for (const std::uint32_t width : {2U, 640U, 854U, 1280U, 1920U, 2592U, 4096U, 8190U}) {
+    SampledImage image;
+    image.width = width;
+    image.rowReciprocal = rowReciprocalOf(width);
+    const std::uint32_t rows = (1U << 24) / width;
+    int wrong = 0;
+    for (std::uint32_t y = 0; y < rows; ++y) {
+      for (const std::uint32_t x : {0U, 1U, width / 2, width - 1}) {
+        const std::uint32_t offset = y * width + x;
+        wrong += rowOf(image, offset) != y ? 1 : 0;
+      }
+    }
+    EXPECT_EQ(wrong, 0) << "width " << width;
+  }
+  const cv::Mat tooLarge = blackPicture(PixelFormat::kNv12, {4096, 4098});
+  EXPECT_THROW((void)SampledImage::of(tooLarge, PixelFormat::kNv12), std::invalid_argument);
+  const cv::Mat largest = blackPicture(PixelFormat::kNv12, {4096, 4096});
+  EXPECT_NO_THROW((void)SampledImage::of(largest, PixelFormat::kNv12));
 }
 
 class YuvSamplingTest : public ::testing::Test {
