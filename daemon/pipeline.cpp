@@ -74,6 +74,7 @@ Pipeline::Pipeline(const Config& config, RunStart start)
   }
   stages_.push_back(std::make_unique<StreamOutputStage>());
   openOutputs(config, mosaicStage, panorama);
+  if (surround_ != nullptr) surround_->prepare(outputs_);
 }
 
 void Pipeline::openOutputs(const Config& config, const MosaicStage& mosaic,

@@ -81,6 +81,12 @@ SurroundStage::FixedView* SurroundStage::fixedView(render::SurroundView& view) {
   return &fixed;
 }
 
+void SurroundStage::prepare(PipelineOutputs& outputs) {
+  for (auto& output : outputs.pictures()) {
+    if (output.view && output.sink) (void)fixedView(*output.view);
+  }
+}
+
 bool SurroundStage::needsPanorama(PipelineOutputs& outputs) {
   panoramaSkipped_ = false;
   for (auto& output : outputs.pictures()) {

@@ -43,9 +43,13 @@ class SurroundStage final : public PipelineStage {
   // A view for an output of `size` (even sides), first showing `view`.
   std::unique_ptr<render::SurroundView> makeView(cv::Size size, ViewKind view) const;
 
+  // Maps each output's first view ahead of the first set when it does not move: composing its
+  // view table takes tenths of a second, which belong to start-up, not to a set's frame time.
+  void prepare(PipelineOutputs& outputs);
+
   // Whether this set needs the panorama: an output shows it, or a view drawn from it. Each output's
-  // view that does not move is mapped here the first time (so that one the renderer cannot map is
-  // drawn from the panorama too). For PanoramaStage::setWanted().
+  // view that does not move is mapped here the first time it is shown (a view switched to; so that
+  // one the renderer cannot map is drawn from the panorama too). For PanoramaStage::setWanted().
   bool needsPanorama(PipelineOutputs& outputs);
 
   void process(FrameWork& work, StageTimes& times) override;
