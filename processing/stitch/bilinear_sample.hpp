@@ -8,9 +8,6 @@
 
 #include <cstdint>
 #include <cstring>
-#include <stdexcept>
-
-#include <fmt/format.h>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -24,12 +21,9 @@
 
 namespace surroundd::processing {
 
-// The most pixels an NV12 frame may have for rowOf() to be exact (4096 x 4096).
-inline constexpr int kMaxRowOfPixels = 1 << 24;
-
-// ceil(2^40 / width): what rowOf() multiplies by (0 for no width).
+// ceil(2^64 / width): what rowOf() multiplies by (0 for no width).
 constexpr std::uint64_t rowReciprocalOf(std::uint32_t width) {
-  return width == 0 ? 0 : ((std::uint64_t{1} << 40) + width - 1) / width;
+  return width == 0 ? 0 : ~std::uint64_t{0} / width + 1;
 }
 
 // A camera frame as the kernels read it. Taps address pixels as row * width + column, so the
@@ -39,7 +33,7 @@ struct SampledImage {
   const std::uint8_t* chroma = nullptr;  // NV12: the Cb Cr plane
   std::size_t rowBytes = 0;              // of `pixels`
   std::uint32_t width = 0;
-  // NV12: ceil(2^40 / width), to find a tap's row without a division (rowOf()).
+  // NV12: ceil(2^64 / width), to find a tap's row without a division (rowOf()).
   std::uint64_t rowReciprocal = 0;
   PixelFormat format = PixelFormat::kBgr;
 
@@ -52,11 +46,6 @@ struct SampledImage {
     image.width = static_cast<std::uint32_t>(size.width);
     image.format = format;
     if (format == PixelFormat::kNv12) {
-      if (size.area() > kMaxRowOfPixels) {
-        throw std::invalid_argument(
-            fmt::format("an NV12 frame of {}x{} is beyond the {} pixels its sampling can address",
-                        size.width, size.height, kMaxRowOfPixels));
-      }
       image.rowReciprocal = rowReciprocalOf(image.width);
       image.chroma = held.ptr<std::uint8_t>(size.height);
     }
@@ -94,11 +83,12 @@ inline const std::uint8_t* firstByte(const SampledImage& image, std::uint32_t of
   return image.pixels + static_cast<std::size_t>(offset) * kFirstPlaneBytes<kFormat>;
 }
 
-// The row of the pixel at `offset`, without a division: offset * ceil(2^40 / width) / 2^40 exceeds
-// offset / width by less than offset / 2^40 <= 2^-16 (kMaxRowOfPixels), less than the 1 / width
-// that a fraction of offset / width stays below 1 by, so the floor is the row.
+// The row of the pixel at `offset`, without a division: offset * ceil(2^64 / width) / 2^64 exceeds
+// offset / width by less than offset / 2^64 < 2^-32, less than the 1 / width that a fraction of
+// offset / width stays below 1 by, so the floor is the row for any offset and width.
 inline std::uint32_t rowOf(const SampledImage& image, std::uint32_t offset) {
-  return static_cast<std::uint32_t>((std::uint64_t{offset} * image.rowReciprocal) >> 40);
+  __extension__ using Wide = unsigned __int128;
+  return static_cast<std::uint32_t>((Wide{offset} * image.rowReciprocal) >> 64);
 }
 
 template <PixelFormat kFormat>
