@@ -2,6 +2,7 @@
 // cv::remap baseline, accuracy for both projections) and prints it as JSON for machines; bad
 // command lines are usage errors. surround-bench receive reads a stream as a player would.
 
+#include <array>
 #include <chrono>
 #include <regex>
 #include <thread>
@@ -53,6 +54,15 @@ TEST(BenchCli, StitchReportsTimingsAndAccuracyAsJson) {
   EXPECT_GT(top["view_lut_ms"].as<double>(), 0);
   EXPECT_GT(top["rendered_ms"].as<double>(), 0);
   EXPECT_GT(top["psnr_db"].as<double>(), 30.0);
+  // Both gathers from the frames held in each format a camera may hand over.
+  const std::array<std::string, 3> formats = {"BGR", "YUYV", "NV12"};
+  ASSERT_EQ(top["held_formats"].size(), formats.size());
+  for (std::size_t f = 0; f < formats.size(); ++f) {
+    const YAML::Node held = top["held_formats"][f];
+    EXPECT_EQ(held["format"].as<std::string>(), formats[f]);
+    EXPECT_GT(held["panorama_ms"].as<double>(), 0);
+    EXPECT_GT(held["top_view_ms"].as<double>(), 0);
+  }
   EXPECT_LT(report["bowl"]["seam_mean_px"].as<double>(), 0.01);
   EXPECT_GT(report["sphere"]["seam_mean_px"].as<double>(), 3.0);
   EXPECT_LT(report["bowl"]["ground_mae_levels"].as<double>(),

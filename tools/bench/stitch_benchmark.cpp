@@ -266,6 +266,12 @@ void printJson(const std::vector<InputReport>& reports) {
           timings.empty() ? "" : ", ", t.threads, t.stitchMs, t.remapMs, t.stitchMs / t.remapMs,
           t.portableMs);
     }
+    std::string formats;
+    for (const auto& f : r.topView.formats) {
+      formats +=
+          fmt::format("{}{{\"format\": \"{}\", \"panorama_ms\": {:.4f}, \"top_view_ms\": {:.4f}}}",
+                      formats.empty() ? "" : ", ", toString(f.format), f.panoramaMs, f.topViewMs);
+    }
     const auto accuracy = [](const Accuracy& a) {
       return fmt::format(
           "{{\"seam_mean_px\": {:.4f}, \"seam_max_px\": {:.4f}, \"seam_samples\": "
@@ -276,12 +282,13 @@ void printJson(const std::vector<InputReport>& reports) {
         "{}\n  {{\"input\": \"{}\", \"camera\": [{}, {}], \"panorama\": [{}, {}], "
         "\"lut_build_s\": {:.4f}, \"lut_load_s\": {:.4f}, \"lut_bytes\": {}, "
         "\"timings\": [{}], \"top_view\": {{\"size\": [{}, {}], \"view_lut_ms\": {:.4f}, "
-        "\"rendered_ms\": {:.4f}, \"psnr_db\": {:.2f}, \"compose_s\": {:.4f}}}, \"bowl\": {}, "
+        "\"rendered_ms\": {:.4f}, \"psnr_db\": {:.2f}, \"compose_s\": {:.4f}, \"held_formats\": "
+        "[{}]}}, \"bowl\": {}, "
         "\"sphere\": {}}}",
         i == 0 ? "" : ",", r.name, r.camera.width, r.camera.height, r.panorama.width,
         r.panorama.height, r.lutBuildS, r.lutLoadS, r.lutBytes, timings, r.topView.size.width,
         r.topView.size.height, r.topView.directMs, r.topView.renderedMs, r.topView.psnr,
-        r.topView.composeS, accuracy(r.bowl), accuracy(r.sphere));
+        r.topView.composeS, formats, accuracy(r.bowl), accuracy(r.sphere));
   }
   fmt::print("\n]}}\n");
 }
