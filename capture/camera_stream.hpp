@@ -53,6 +53,7 @@ class CameraStream {
 
   const std::string& name() const { return name_; }
   cv::Size frameSize() const { return pool_.frameSize(); }
+  PixelFormat pixelFormat() const { return pool_.pixelFormat(); }  // the frames are held in
   Timestamp nominalPeriod() const { return nominalPeriod_; }
   bool repeatsOnePicture() const { return repeatsOnePicture_; }  // see FrameSource
   CameraStreamStats stats() const;

@@ -60,6 +60,7 @@ class FramePool {
   FrameRef tryAcquire();
 
   cv::Size frameSize() const { return size_; }
+  PixelFormat pixelFormat() const { return format_; }
   std::size_t capacity() const;
   std::size_t available() const;
 
@@ -68,6 +69,7 @@ class FramePool {
 
   std::shared_ptr<detail::FramePoolState> state_;
   cv::Size size_;
+  PixelFormat format_;
 };
 
 }  // namespace surroundd::capture

@@ -20,7 +20,7 @@ void FrameReturner::operator()(Frame* frame) const noexcept {
 }  // namespace detail
 
 FramePool::FramePool(std::size_t count, cv::Size size, PixelFormat format)
-    : state_(std::make_shared<detail::FramePoolState>()), size_(size) {
+    : state_(std::make_shared<detail::FramePoolState>()), size_(size), format_(format) {
   state_->storage.reserve(count);
   state_->free.reserve(count);
   for (std::size_t i = 0; i < count; ++i) {

@@ -58,6 +58,17 @@ struct PipelineConfig {
   bool operator==(const PipelineConfig&) const = default;
 };
 
+// Where each set's panorama is stitched and colour-corrected: on the CPU (processing/stitch/), on
+// the GPU by OpenGL ES (render/gpu_stitcher.hpp), or auto: the GPU when the EGL renderer is a
+// hardware one, the CPU on a software renderer (llvmpipe, softpipe), where the GPU path is slower.
+enum class ProcessingBackend { kAuto, kCpu, kGpu };
+
+struct ProcessingConfig {
+  ProcessingBackend backend = ProcessingBackend::kAuto;
+
+  bool operator==(const ProcessingConfig&) const = default;
+};
+
 using processing::PanoramaProjection;
 
 struct PanoramaConfig {
@@ -270,6 +281,7 @@ struct Config {
   std::optional<VehicleConfig> vehicle;
   CaptureConfig capture;
   PipelineConfig pipeline;
+  ProcessingConfig processing;
   PanoramaConfig panorama;
   ColourCorrectionConfig colour;
   MeshConfig mesh;

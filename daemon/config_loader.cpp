@@ -269,6 +269,8 @@ Config readConfig(const YAML::Node& document, const std::filesystem::path& file)
   readSection(root, "logging", [&](YamlObject& s) { loggingKeys().read(s, config); });
   readSection(root, "capture", [&](YamlObject& s) { readCapture(s, config.capture); });
   readSection(root, "pipeline", [&](YamlObject& s) { pipelineKeys().read(s, config.pipeline); });
+  readSection(root, "processing",
+              [&](YamlObject& s) { processingKeys().read(s, config.processing); });
   readSection(root, "panorama", [&](YamlObject& s) { readPanorama(s, config.panorama); });
   readSection(root, "colour_correction",
               [&](YamlObject& s) { colourKeys().read(s, config.colour); });

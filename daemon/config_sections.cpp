@@ -179,6 +179,22 @@ const ConfigKeys<PipelineConfig>& pipelineKeys() {
   return kKeys;
 }
 
+const ConfigKeys<ProcessingConfig>& processingKeys() {
+  using Key = ConfigKey<ProcessingConfig>;
+  static constexpr std::array<std::pair<std::string_view, ProcessingBackend>, 3> kBackends{{
+      {"auto", ProcessingBackend::kAuto},
+      {"cpu", ProcessingBackend::kCpu},
+      {"gpu", ProcessingBackend::kGpu},
+  }};
+  static const ConfigKeys<ProcessingConfig> kKeys{
+      Key::choice("backend", &ProcessingConfig::backend, kBackends,
+                  "where the panorama is stitched and colour-corrected for the surround views: "
+                  "cpu, gpu (OpenGL ES, from the camera frames as textures) or auto (gpu on a "
+                  "hardware renderer, cpu on a software one)"),
+  };
+  return kKeys;
+}
+
 const ConfigKeys<PanoramaConfig>& panoramaKeys() {
   using Key = ConfigKey<PanoramaConfig>;
   const NumberRange elevation{-90.0, 90.0, false, "degrees"};
@@ -377,6 +393,7 @@ std::vector<SectionDocs> sectionDocs() {
   return {{"logging", loggingKeys().docs()},
           {"capture", captureKeys().docs()},
           {"pipeline", pipelineKeys().docs()},
+          {"processing", processingKeys().docs()},
           {"panorama", panoramaKeys().docs()},
           {"colour_correction", colourKeys().docs()},
           {"mesh", meshKeys().docs()},

@@ -14,6 +14,7 @@ namespace surroundd::daemon {
 const ConfigKeys<Config>& loggingKeys();  // logging: the level, in Config itself
 const ConfigKeys<CaptureConfig>& captureKeys();
 const ConfigKeys<PipelineConfig>& pipelineKeys();
+const ConfigKeys<ProcessingConfig>& processingKeys();
 const ConfigKeys<PanoramaConfig>& panoramaKeys();
 const ConfigKeys<ColourCorrectionConfig>& colourKeys();
 const ConfigKeys<MeshConfig>& meshKeys();

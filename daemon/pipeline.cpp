@@ -29,6 +29,16 @@ bool configured(const Config& config, OutputStream stream) {
   return std::ranges::any_of(config.outputs, [&](const auto& o) { return o.stream == stream; });
 }
 
+// The format the panorama samples the cameras' frames in: theirs when they all hold one
+// (PanoramaStage), else BGR.
+PixelFormat cameraFormatOf(const std::vector<std::unique_ptr<capture::CameraStream>>& cameras) {
+  if (cameras.empty()) return PixelFormat::kBgr;
+  const PixelFormat first = cameras.front()->pixelFormat();
+  return std::ranges::all_of(cameras, [&](const auto& c) { return c->pixelFormat() == first; })
+             ? first
+             : PixelFormat::kBgr;
+}
+
 double nominalFpsOf(const std::vector<std::unique_ptr<capture::CameraStream>>& cameras) {
   return 1e9 / static_cast<double>(cameras.front()->nominalPeriod().count());
 }
@@ -66,11 +76,14 @@ Pipeline::Pipeline(const Config& config, RunStart start)
     stages_.push_back(std::move(watch));
   }
   if (configured(config, OutputStream::kSurround)) {
-    auto stage = std::make_unique<SurroundStage>(config, *panorama);
+    auto stage = std::make_unique<SurroundStage>(config, *panorama, cameraFormatOf(cameras_));
     surround_ = stage.get();
     stages_.push_back(std::move(stage));
     panorama->setWanted(
-        [surround = surround_](FrameWork& work) { return surround->needsPanorama(work.outputs); });
+        [surround = surround_](FrameWork& work) { return surround->needsPanorama(work); });
+  }
+  if (surround_ == nullptr && config.processing.backend == ProcessingBackend::kGpu) {
+    spdlog::info("processing: cpu (no surround output: the GPU stitch is for the surround views)");
   }
   stages_.push_back(std::make_unique<StreamOutputStage>());
   openOutputs(config, mosaicStage, panorama);

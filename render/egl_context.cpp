@@ -1,5 +1,6 @@
 #include "render/egl_context.hpp"
 
+#include <algorithm>
 #include <array>
 #include <string_view>
 #include <vector>
@@ -12,6 +13,10 @@
 
 namespace surroundd::render {
 namespace {
+
+// GL_RENDERER of the renderers that run on the CPU.
+constexpr std::array<std::string_view, 4> kSoftwareRenderers{"llvmpipe", "softpipe", "swrast",
+                                                             "SwiftShader"};
 
 bool hasExtension(const char* list, std::string_view name) {
   if (list == nullptr) return false;
@@ -175,8 +180,11 @@ bool EglContext::open(EglPlatform platform, std::string& why) {
     return false;
   }
   platform_ = platform;
-  description_ = fmt::format("{}: {}, {}", toString(platform),
-                             reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
+  const std::string_view renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  software_ = std::ranges::any_of(kSoftwareRenderers, [&](std::string_view name) {
+    return renderer.find(name) != std::string_view::npos;
+  });
+  description_ = fmt::format("{}: {}, {}", toString(platform), renderer,
                              reinterpret_cast<const char*>(glGetString(GL_VERSION)));
   return true;
 }

@@ -26,6 +26,9 @@ class EglContext {
   // "surfaceless: llvmpipe (LLVM 15.0.6, 256 bits), OpenGL ES 3.2 Mesa 22.3.6"
   const std::string& description() const { return description_; }
   EglPlatform platform() const { return platform_; }
+  // Whether the renderer runs on the CPU (Mesa's llvmpipe, softpipe or swrast; SwiftShader):
+  // there, pixel work is faster in the CPU path than through OpenGL.
+  bool software() const { return software_; }
 
  private:
   bool open(EglPlatform platform, std::string& why);
@@ -36,6 +39,7 @@ class EglContext {
   EGLSurface surface_ = EGL_NO_SURFACE;  // only for the default platform
   EglPlatform platform_ = EglPlatform::kAuto;
   std::string description_;
+  bool software_ = false;
 };
 
 const char* toString(EglPlatform platform);

@@ -42,6 +42,13 @@ class PanoramaStage final : public PipelineStage {
   const processing::PanoramaLut& lut() const { return lut_; }
   // The rig the LUT was built for (body masks included).
   const processing::Rig& rig() const { return rig_; }
+  WorkPool& pool() const { return pool_; }
+  // The frames of the set process() was last given, as the stitch samples them (a missing
+  // camera's black), all held in frameFormat(): for a stitch elsewhere (the GPU's).
+  const std::vector<cv::Mat>& frames() const { return stitched_; }
+  PixelFormat frameFormat() const { return format_; }
+  // The Poisson correction, updated by each process(); null with another colour_correction.
+  const processing::PoissonColourCorrection* poisson() const { return poisson_.get(); }
 
   // A view that does not move, made the way the panorama is made but through the view's own LUT
   // (processing/stitch/view_lut.hpp): gathered from the set's frames straight into the view's
@@ -78,7 +85,7 @@ class PanoramaStage final : public PipelineStage {
   std::unique_ptr<processing::GainCompensation> gains_;           // colour_correction: gain
   std::vector<cv::Mat> corrected_;  // this set's frames (headers) that colour correction sees
   std::vector<cv::Mat> stitched_;   // this set's frames (headers), black for missing cameras
-  PixelFormat format_ = PixelFormat::kBgr;         // the one both hold this set
+  PixelFormat format_ = PixelFormat::kBgr;           // the one both hold this set
   std::array<std::vector<cv::Mat>, 3> blackFrames_;  // per PixelFormat, per camera
   cv::Mat panorama_;
   std::function<bool(FrameWork&)> wanted_;

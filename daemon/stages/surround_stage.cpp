@@ -1,6 +1,8 @@
 #include "daemon/stages/surround_stage.hpp"
 
 #include <algorithm>
+#include <span>
+#include <string_view>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -11,8 +13,28 @@
 #include "render/render_error.hpp"
 
 namespace surroundd::daemon {
+namespace {
 
-SurroundStage::SurroundStage(const Config& config, PanoramaStage& panorama)
+// Whether processing.backend comes to the GPU on this renderer, and why.
+std::pair<bool, std::string_view> gpuBackendOf(const Config& config, const render::EglContext& gl) {
+  const ProcessingBackend backend = config.processing.backend;
+  if (backend == ProcessingBackend::kCpu) return {false, "processing.backend: cpu"};
+  if (backend == ProcessingBackend::kAuto && gl.software()) {
+    return {false, "auto: the renderer runs on the CPU, where the CPU path is faster"};
+  }
+  if (config.colour.method == ColourMethod::kGain) {
+    return {false, "gain compensation is applied on the CPU only"};
+  }
+  if (backend == ProcessingBackend::kAuto) return {true, "auto: a hardware renderer"};
+  return {true, gl.software() ? "processing.backend: gpu, on a renderer that runs on the CPU "
+                                "(slower than the CPU path)"
+                              : "processing.backend: gpu"};
+}
+
+}  // namespace
+
+SurroundStage::SurroundStage(const Config& config, PanoramaStage& panorama,
+                             PixelFormat cameraFormat)
     : views_(config.render.views),
       gl_(config.render.platform),
       panoramaStage_(panorama),
@@ -39,6 +61,19 @@ SurroundStage::SurroundStage(const Config& config, PanoramaStage& panorama)
     guideVertices_.reserve(vertices);
     scene_->reserveGuidelines(vertices);
   }
+  auto [gpu, why] = gpuBackendOf(config, gl_);
+  if (gpu) {
+    try {
+      gpu_ = std::make_unique<render::GpuStitcher>(panorama.lut(), cameraFormat, panorama.pool());
+      gpu_->correctWith(panorama.poisson());
+    } catch (const render::RenderError& e) {
+      spdlog::warn("processing: the GPU cannot stitch the panorama: {}", e.what());
+      gpu_.reset();
+      why = "the GPU stitch could not be set up";
+    }
+  }
+  spdlog::info("processing: {} ({}){}", gpu_ ? "gpu" : "cpu", why,
+               gpu_ ? fmt::format(", frames uploaded as {}", toString(cameraFormat)) : "");
   spdlog::info("render: {} mesh of {} triangles, split view shows '{}'",
                config.mesh.model == MeshModel::kBowl   ? "bowl"
                : config.mesh.model == MeshModel::kFlat ? "flat"
@@ -52,7 +87,7 @@ std::unique_ptr<render::SurroundView> SurroundStage::makeView(cv::Size size, Vie
 
 SurroundStage::FixedView* SurroundStage::fixedView(render::SurroundView& view) {
   const ViewKind kind = view.view();
-  if (!viewLut_ || view.moves()) return nullptr;
+  if (!viewLut_ || gpu_ || view.moves()) return nullptr;
   const auto key = std::pair{static_cast<const render::SurroundView*>(&view), kind};
   if (const auto known = fixedViews_.find(key); known != fixedViews_.end()) {
     return known->second.view ? &known->second : nullptr;
@@ -87,13 +122,41 @@ void SurroundStage::prepare(PipelineOutputs& outputs) {
   }
 }
 
-bool SurroundStage::needsPanorama(PipelineOutputs& outputs) {
+bool SurroundStage::gpuStitches(const FrameWork& work) const {
+  if (!gpu_) return false;
+  const auto faults = std::span(work.faults).first(work.set.cameraCount);
+  return std::ranges::none_of(faults, [](const char* fault) { return fault != nullptr; });
+}
+
+void SurroundStage::stitchOnGpu() {
+  const PixelFormat format = panoramaStage_.frameFormat();
+  if (gpu_->format() != format) {
+    spdlog::info("processing: the frames come in {}, not {}: the GPU stitch is set up for them",
+                 toString(format), toString(gpu_->format()));
+    gpu_ =
+        std::make_unique<render::GpuStitcher>(panoramaStage_.lut(), format, panoramaStage_.pool());
+    gpu_->correctWith(panoramaStage_.poisson());
+  }
+  gpu_->upload(panoramaStage_.frames());
+  gpu_->stitch();
+  scene_->samplePanoramaFrom(gpu_->panorama());
+  panoramaOnGpu_ = true;
+}
+
+void SurroundStage::uploadPanorama() {
+  scene_->samplePanoramaFrom(0);
+  scene_->uploadPanorama(panorama_);
+  panoramaOnGpu_ = false;
+}
+
+bool SurroundStage::needsPanorama(const FrameWork& work) {
   panoramaSkipped_ = false;
-  for (auto& output : outputs.pictures()) {
+  const bool gpuSet = gpuStitches(work);
+  for (auto& output : work.outputs.pictures()) {
     // An output of the panorama takes it whether or not it wants this set: the run's end hands
     // it the last one.
     if (output.picture == &panorama_ && output.sink) return true;
-    if (!output.view || !output.sink) continue;
+    if (!output.view || !output.sink || gpuSet) continue;
     // A view with a read-back pending is mapped after it is collected, in process().
     if (output.view->pending() || fixedView(*output.view) == nullptr) return true;
   }
@@ -137,7 +200,15 @@ void SurroundStage::layGuidelines(render::SurroundView& view, FixedView& fixed) 
 void SurroundStage::process(FrameWork& work, StageTimes& times) {
   deliver(work.outputs, &times);
   lastStreamTime_ = work.streamTime;
+  // Drawn views or not, as the CPU's panorama is made for them: the run's end may draw one again.
   bool panoramaUploaded = false;
+  if (gpuStitches(work) && std::ranges::any_of(work.outputs.pictures(), [](const auto& output) {
+        return output.view && output.sink;
+      })) {
+    stitchOnGpu();
+    panoramaUploaded = true;
+    times.lap(Stage::kStitch);
+  }
   bool cameraUploaded = false;
   bool anyFixed = false;
   for (auto& output : work.outputs.pictures()) {
@@ -165,7 +236,7 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
       }
       if (!wanted) return;
       if (!panoramaUploaded) {
-        scene_->uploadPanorama(panorama_);
+        uploadPanorama();
         panoramaUploaded = true;
       }
       if (output.view->view() == ViewKind::kSplit && !cameraUploaded) {
@@ -216,7 +287,7 @@ cv::Mat SurroundStage::redraw(PipelineOutputs::PictureOutput& output) {
       fixed->second.drawnAt == lastStreamTime_) {
     return fixed->second.picture;
   }
-  scene_->uploadPanorama(panorama_);
+  if (!panoramaOnGpu_) uploadPanorama();
   output.view->draw(std::chrono::duration<double>(lastStreamTime_).count());
   return output.view->collect();
 }

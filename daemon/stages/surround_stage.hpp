@@ -11,6 +11,12 @@
 // background are laid over it, and the split view's camera picture is scaled into its half. The
 // output gets it in the same set. Kept for when the output shows that view again.
 //
+// With processing.backend gpu (or auto on a hardware renderer) the panorama the views sample is
+// stitched and colour-corrected on the GPU (render/gpu_stitcher.hpp) from the set's frames in
+// their own format, and every view is drawn by OpenGL from it (a GPU draws a fixed view faster
+// than the CPU gathers it). The CPU's panorama is then made only when something needs it: an
+// output of the panorama, or a set with a faulty camera (whose part the CPU marks).
+//
 // Threads: the EGL context is made current on the thread that constructs the stage, which must be
 // the one that runs it.
 
@@ -28,6 +34,7 @@
 #include "daemon/pipeline_stage.hpp"
 #include "daemon/stages/panorama_stage.hpp"
 #include "render/egl_context.hpp"
+#include "render/gpu_stitcher.hpp"
 #include "render/surround_scene.hpp"
 #include "render/surround_view.hpp"
 #include "vehicle/vehicle_signals.hpp"
@@ -36,9 +43,11 @@ namespace surroundd::daemon {
 
 class SurroundStage final : public PipelineStage {
  public:
-  // Opens the EGL context and builds the scene; `panorama` must outlive the stage. Throws
-  // RenderError, or std::runtime_error naming the config for a mesh that cannot be built.
-  SurroundStage(const Config& config, PanoramaStage& panorama);
+  // Opens the EGL context and builds the scene; `panorama` must outlive the stage. The GPU
+  // stitch, where processing.backend chooses it, is built for frames held in `cameraFormat` (and
+  // built again should a set's frames come in another). Throws RenderError, or
+  // std::runtime_error naming the config for a mesh that cannot be built.
+  SurroundStage(const Config& config, PanoramaStage& panorama, PixelFormat cameraFormat);
 
   // A view for an output of `size` (even sides), first showing `view`.
   std::unique_ptr<render::SurroundView> makeView(cv::Size size, ViewKind view) const;
@@ -47,17 +56,23 @@ class SurroundStage final : public PipelineStage {
   // view table takes tenths of a second, which belong to start-up, not to a set's frame time.
   void prepare(PipelineOutputs& outputs);
 
-  // Whether this set needs the panorama: an output shows it, or a view drawn from it. Each output's
-  // view that does not move is mapped here the first time it is shown (a view switched to; so that
-  // one the renderer cannot map is drawn from the panorama too). For PanoramaStage::setWanted().
-  bool needsPanorama(PipelineOutputs& outputs);
+  // Whether this set needs the CPU's panorama: an output shows it, or a view drawn from it (on
+  // the CPU backend, or in a set the GPU does not stitch). Each output's view that does not move
+  // is mapped here the first time it is shown (a view switched to; so that one the renderer
+  // cannot map is drawn from the panorama too). For PanoramaStage::setWanted().
+  bool needsPanorama(const FrameWork& work);
 
   void process(FrameWork& work, StageTimes& times) override;
   void finish(PipelineOutputs& outputs) override;
   // The view of the last set, drawn again for an output that writes it at the end.
   cv::Mat redraw(PipelineOutputs::PictureOutput& output);
 
-  std::string description() const { return gl_.description(); }
+  // The renderer, and where the panorama is stitched when that is the GPU.
+  std::string description() const {
+    return gpu_ ? gl_.description() + "; panorama stitched on the GPU" : gl_.description();
+  }
+  // Whether the GPU stitches the panorama (processing.backend as it came out on this renderer).
+  bool stitchesOnGpu() const { return gpu_ != nullptr; }
 
   // The vehicle's signals as they are now: the guidelines follow its gear and steering (drawn
   // again only when they change by a tenth of a degree or more).
@@ -83,8 +98,14 @@ class SurroundStage final : public PipelineStage {
   // Lays the guidelines over a fixed view's picture, drawing them again when they have changed.
   void layGuidelines(render::SurroundView& view, FixedView& fixed);
   // The output's fixed view, built the first time it shows it; null for a view that moves, with
-  // render.view_lut off, or where the renderer cannot map views (said once).
+  // render.view_lut off, on the GPU backend, or where the renderer cannot map views (said once).
   FixedView* fixedView(render::SurroundView& view);
+  // Whether the GPU stitches this set: the GPU backend, and no camera faulty.
+  bool gpuStitches(const FrameWork& work) const;
+  // The set's panorama into the texture the scene samples: stitched on the GPU, or the CPU's
+  // uploaded.
+  void stitchOnGpu();
+  void uploadPanorama();
 
   render::ViewSettings views_;
   // The context first, so that it outlives the GL objects of the scene (and of the outputs' views,
@@ -93,6 +114,8 @@ class SurroundStage final : public PipelineStage {
   std::unique_ptr<render::SurroundScene> scene_;
   PanoramaStage& panoramaStage_;
   const cv::Mat& panorama_;
+  std::unique_ptr<render::GpuStitcher> gpu_;  // processing.backend: gpu
+  bool panoramaOnGpu_ = false;                // the scene samples gpu_'s panorama (the last set's)
   bool viewLut_;
   GuidelineMode guidelineMode_;
   render::GuidelineSettings guide_;

@@ -5,7 +5,7 @@
 //   surround-bench colour [--threads N] [--repeats N] [--pictures DIR] RECORDING|CONFIG...
 //   surround-bench pipeline [--threads N] [--repeats N] [--json] [--solver S] [--projection P]
 //                           [--view V] [--size WxH] [--input decode|raw] [--raw-format F]
-//                           RECORDING...
+//                           [--backend B] RECORDING...
 //   surround-bench receive [--transport udp|tcp] [--seconds N] [--save PICTURE] URL
 //   surround-bench gpu-kit KIT RECORDING...
 //
@@ -35,7 +35,7 @@ constexpr std::string_view kUsage =
        surround-bench colour [--threads N] [--repeats N] [--pictures DIR] RECORDING|CONFIG...
        surround-bench pipeline [--threads N] [--repeats N] [--json] [--solver S]
                                [--projection P] [--view V] [--size WxH] [--input I]
-                               [--raw-format F] RECORDING...
+                               [--raw-format F] [--backend B] RECORDING...
        surround-bench receive [--transport T] [--seconds N] [--save PICTURE] URL
        surround-bench gpu-kit KIT RECORDING...
   stitch        LUT build, stitch against cv::remap, accuracy against the ground truth
@@ -65,6 +65,8 @@ constexpr std::string_view kUsage =
                 raw (decoded once at start into memory as a camera's frames, handed over per
                 frame as a V4L2 camera's are, kept in their YUV: live-rig figures)
   --raw-format F  pipeline, --input raw: yuyv | nv12 (default yuyv)
+  --backend B   pipeline: where the panorama is made, as processing.backend: auto | cpu | gpu
+                (default auto: the CPU on a software renderer such as llvmpipe)
   --pictures DIR  colour, CONFIG: also write the panoramas (none, gain, Poisson) and body masks
   URL           receive: rtsp://HOST:PORT/NAME (an rtsp output) or udp://HOST:PORT (a network
                 output's address, bound here)
@@ -215,6 +217,14 @@ int main(int argc, char** argv) {
       if (!format) return usageError("--raw-format needs yuyv or nv12");
       pipeline.rawFormat = *format;
       rawFormat = true;
+      ++i;
+    } else if (command == "pipeline" && arg == "--backend") {
+      using surroundd::daemon::ProcessingBackend;
+      const auto backend = parseWord<ProcessingBackend>(value, {{"auto", ProcessingBackend::kAuto},
+                                                                {"cpu", ProcessingBackend::kCpu},
+                                                                {"gpu", ProcessingBackend::kGpu}});
+      if (!backend) return usageError("--backend needs auto, cpu or gpu");
+      pipeline.backend = *backend;
       ++i;
     } else if (command == "colour" && arg == "--pictures") {
       if (!hasValue) return usageError("--pictures needs a folder");

@@ -102,6 +102,7 @@ daemon::Config configFor(const std::filesystem::path& folder, const RecordingTru
     for (auto& camera : config.cameras) camera.preload = options.rawFormat;
   }
   config.render.view = options.view;
+  config.processing.backend = options.backend;
   config.render.widthPx = options.outputSize.width;
   config.render.heightPx = options.outputSize.height;
   daemon::OutputConfig video;

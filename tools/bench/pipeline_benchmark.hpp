@@ -19,6 +19,7 @@
 #include <opencv2/core.hpp>
 
 #include "capture/pixel_conversion.hpp"
+#include "daemon/config.hpp"
 #include "processing/colour/poisson_solver.hpp"
 #include "processing/stitch/panorama_lut.hpp"
 #include "render/view_camera.hpp"
@@ -38,6 +39,7 @@ struct PipelineBenchmarkOptions {
   processing::PanoramaProjection projection = processing::PanoramaProjection::kBowl;
   render::ViewKind view = render::ViewKind::kOrbit;
   cv::Size outputSize{1280, 720};
+  daemon::ProcessingBackend backend = daemon::ProcessingBackend::kAuto;
 };
 
 int runPipelineBenchmark(const PipelineBenchmarkOptions& options);
