@@ -111,8 +111,9 @@ void LibcameraSource::Impl::open() {
   const libcamera::Size wanted(static_cast<unsigned>(settings.size.width),
                                static_cast<unsigned>(settings.size.height));
   // RGB888 is libcamera's name for bytes in the order B, G, R.
-  const std::array<Candidate, 3> candidates{{{libcamera::formats::RGB888, PixelLayout::kBgr},
+  const std::array<Candidate, 4> candidates{{{libcamera::formats::RGB888, PixelLayout::kBgr},
                                              {libcamera::formats::YUYV, PixelLayout::kYuyv},
+                                             {libcamera::formats::UYVY, PixelLayout::kUyvy},
                                              {libcamera::formats::NV12, PixelLayout::kNv12}}};
   bool chosen = false;
   for (const auto& candidate : candidates) {
@@ -131,7 +132,7 @@ void LibcameraSource::Impl::open() {
     for (const auto& format : config.formats().pixelformats()) {
       offers += (offers.empty() ? "" : ", ") + format.toString();
     }
-    throw CaptureError(fmt::format("{}: cannot give BGR, YUYV or NV12 at {}x{} (formats: {})",
+    throw CaptureError(fmt::format("{}: cannot give BGR, YUYV, UYVY or NV12 at {}x{} (formats: {})",
                                    where(), settings.size.width, settings.size.height, offers));
   }
   stride = config.stride;

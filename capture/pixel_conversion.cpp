@@ -59,6 +59,7 @@ PixelFormat heldFormat(PixelLayout layout) {
     case PixelLayout::kNv12:
       return PixelFormat::kNv12;
     case PixelLayout::kUyvy:
+      return PixelFormat::kUyvy;
     case PixelLayout::kBgr:
     case PixelLayout::kMjpeg:
       break;
@@ -84,9 +85,11 @@ bool copyRows(std::span<const std::uint8_t> data, std::size_t bytesPerLine, std:
 bool holdFrame(PixelLayout layout, std::span<const std::uint8_t> data, std::size_t bytesPerLine,
                JpegDecoder& jpeg, cv::Size size, cv::Mat& held, std::string& error) {
   const PixelFormat format = heldFormat(layout);
-  if (format == PixelFormat::kBgr) return convertToBgr(layout, data, bytesPerLine, jpeg, held, error);
+  if (format == PixelFormat::kBgr)
+    return convertToBgr(layout, data, bytesPerLine, jpeg, held, error);
   const cv::Size rows = heldSize(format, size);
-  const std::size_t rowBytes = static_cast<std::size_t>(rows.width) * (format == PixelFormat::kYuyv ? 2 : 1);
+  const std::size_t rowBytes =
+      static_cast<std::size_t>(rows.width) * CV_ELEM_SIZE(heldType(format));
   if (!copyRows(data, bytesPerLine, rowBytes, static_cast<std::size_t>(rows.height),
                 held.ptr<std::uint8_t>())) {
     error = fmt::format("a {} frame of {} bytes ({} per line) is too short for {}x{}",

@@ -24,11 +24,11 @@ const char* toString(PixelLayout layout);
 bool convertToBgr(PixelLayout layout, std::span<const std::uint8_t> data, std::size_t bytesPerLine,
                   JpegDecoder& jpeg, cv::Mat& bgr, std::string& error);
 
-// How a frame delivered in `layout` is held: YUYV and NV12 as they came, the others as BGR.
+// How a frame delivered in `layout` is held: YUYV, UYVY and NV12 as they came, the others as BGR.
 PixelFormat heldFormat(PixelLayout layout);
 // A delivered frame into `held`, a picture of `size` held in heldFormat(layout) (allocated by the
-// frame's pool): YUYV and NV12 copied without the driver's row padding, the others converted by
-// convertToBgr. False, with `error` set, as convertToBgr.
+// frame's pool): YUYV, UYVY and NV12 copied without the driver's row padding, the others converted
+// by convertToBgr. False, with `error` set, as convertToBgr.
 bool holdFrame(PixelLayout layout, std::span<const std::uint8_t> data, std::size_t bytesPerLine,
                JpegDecoder& jpeg, cv::Size size, cv::Mat& held, std::string& error);
 

@@ -71,10 +71,12 @@ void PreloadedSource::Impl::failTooLarge(std::uint64_t frameCount) const {
 }
 
 void PreloadedSource::Impl::checkFormat() const {
-  if (settings.format != PixelLayout::kYuyv && settings.format != PixelLayout::kNv12) {
-    fail(fmt::format("cannot be preloaded as {}: only as YUYV or NV12", toString(settings.format)));
+  if (settings.format != PixelLayout::kYuyv && settings.format != PixelLayout::kUyvy &&
+      settings.format != PixelLayout::kNv12) {
+    fail(fmt::format("cannot be preloaded as {}: only as YUYV, UYVY or NV12",
+                     toString(settings.format)));
   }
-  // YUYV shares one chroma pair between two pixels of a row; NV12 between 2x2 pixels.
+  // YUYV and UYVY share one chroma pair between two pixels of a row; NV12 between 2x2 pixels.
   const bool nv12 = settings.format == PixelLayout::kNv12;
   if (size.width % 2 != 0 || (nv12 && size.height % 2 != 0)) {
     fail(fmt::format("has {}x{} frames, which {} cannot hold (it needs an even width{})",

@@ -29,7 +29,7 @@ namespace surroundd::capture {
 
 struct PreloadSettings {
   FileSourceSettings file;                  // what to decode, and how to play it (loop, pacing)
-  PixelLayout format = PixelLayout::kYuyv;  // as held in memory: kYuyv or kNv12 only
+  PixelLayout format = PixelLayout::kYuyv;  // as held in memory: kYuyv, kUyvy or kNv12 only
   std::uint64_t maxBytes = std::uint64_t{1} << 30;  // the most all its frames may take
   // Where `maxBytes` comes from, added to the message when it is exceeded (e.g. the config key).
   std::string maxBytesOrigin;
@@ -37,15 +37,15 @@ struct PreloadSettings {
   bool operator==(const PreloadSettings&) const = default;
 };
 
-// Bytes of one frame of `size` in `format` (kYuyv or kNv12), tightly packed.
+// Bytes of one frame of `size` in `format` (kYuyv, kUyvy or kNv12), tightly packed.
 std::size_t preloadedFrameBytes(PixelLayout format, cv::Size size);
 
 class PreloadedSource final : public FrameSource {
  public:
   // Decodes the whole file. Throws CaptureError naming the camera and the file: as FileSource's
-  // constructor does, for a format other than YUYV or NV12, for a size the format cannot hold
-  // (YUYV: even width; NV12: even width and height), when the frames would take more than
-  // maxBytes, or when no frame decodes.
+  // constructor does, for a format other than YUYV, UYVY or NV12, for a size the format cannot
+  // hold (YUYV, UYVY: even width; NV12: even width and height), when the frames would take more
+  // than maxBytes, or when no frame decodes.
   PreloadedSource(std::string cameraName, PreloadSettings settings);
   ~PreloadedSource() override;
 

@@ -1,8 +1,8 @@
 #pragma once
 // A live camera through V4L2 (video4linux2): opened by a stable path (/dev/v4l/by-path/...,
 // /dev/v4l/by-id/...) or /dev/videoN, the pixel format, size and frame rate negotiated from the
-// settings, MMAP streaming, frames copied out of the driver's buffers as they are (YUYV, NV12) or
-// converted to BGR once (UYVY, BGR; MJPEG through libjpeg-turbo: capture/pixel_conversion.hpp),
+// settings, MMAP streaming, frames copied out of the driver's buffers as they are (YUYV, UYVY,
+// NV12) or converted to BGR once (BGR; MJPEG through libjpeg-turbo: capture/pixel_conversion.hpp),
 // with the driver's monotonic timestamps. Single-planar devices (UVC) and
 // multi-planar ones (V4L2_CAP_VIDEO_CAPTURE_MPLANE: i.MX, Rockchip, TI capture drivers) alike;
 // through the multi-planar API, NV12 also comes as NV12M (luma and chroma in two buffers).
@@ -63,7 +63,7 @@ class V4l2Source final : public FrameSource {
   ~V4l2Source() override;
 
   cv::Size frameSize() const override { return settings_.size; }
-  // YUYV and NV12 as the camera gives them, the other formats converted to BGR.
+  // YUYV, UYVY and NV12 as the camera gives them, the other formats converted to BGR.
   PixelFormat pixelFormat() const override { return heldFormat(layout_); }
   Timestamp nominalPeriod() const override { return period_; }
   ReadStatus read(Frame& out) override;

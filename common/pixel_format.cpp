@@ -5,7 +5,8 @@
 namespace surroundd {
 namespace {
 
-// Each chroma sample is that of the mean of the pixels sharing it (YUYV: two in a row; NV12: 2x2).
+// Each chroma sample is that of the mean of the pixels sharing it (YUYV, UYVY: two in a row; NV12:
+// 2x2).
 // Computed here rather than by libswscale, whose packed 4:2:2 output comes out a level and a half
 // too blue and red against decoded frames; plain float arithmetic: this is for start-up and tests.
 std::uint8_t level(float value) { return cv::saturate_cast<std::uint8_t>(value); }
@@ -19,17 +20,20 @@ float crOf(const cv::Vec3f& bgr) {
   return 128.0F + (-18.214F * bgr[0] - 93.786F * bgr[1] + 112.0F * bgr[2]) / 255.0F;
 }
 
-void writeYuyv(const cv::Mat& bgr, std::uint8_t* out) {
+// Packed 4:2:2, its luma first (YUYV: Y0 Cb Y1 Cr) or its chroma first (UYVY: Cb Y0 Cr Y1).
+void writePacked422(const cv::Mat& bgr, bool lumaFirst, std::uint8_t* out) {
+  const int luma = lumaFirst ? 0 : 1;
+  const int chroma = 1 - luma;
   for (int y = 0; y < bgr.rows; ++y) {
     const auto* row = bgr.ptr<cv::Vec3b>(y);
     for (int x = 0; x < bgr.cols; x += 2, out += 4) {
       const cv::Vec3f left = row[x];
       const cv::Vec3f right = row[x + 1];
       const cv::Vec3f mean = (left + right) * 0.5F;
-      out[0] = level(lumaOf(left));
-      out[1] = level(cbOf(mean));
-      out[2] = level(lumaOf(right));
-      out[3] = level(crOf(mean));
+      out[luma] = level(lumaOf(left));
+      out[chroma] = level(cbOf(mean));
+      out[luma + 2] = level(lumaOf(right));
+      out[chroma + 2] = level(crOf(mean));
     }
   }
 }
@@ -56,13 +60,14 @@ void writeNv12(const cv::Mat& bgr, std::uint8_t* out) {
 
 }  // namespace
 
-
 const char* toString(PixelFormat format) {
   switch (format) {
     case PixelFormat::kBgr:
       return "BGR";
     case PixelFormat::kYuyv:
       return "YUYV";
+    case PixelFormat::kUyvy:
+      return "UYVY";
     case PixelFormat::kNv12:
       return "NV12";
   }
@@ -72,6 +77,7 @@ const char* toString(PixelFormat format) {
 int heldType(PixelFormat format) {
   switch (format) {
     case PixelFormat::kYuyv:
+    case PixelFormat::kUyvy:
       return CV_8UC2;
     case PixelFormat::kNv12:
       return CV_8UC1;
@@ -103,6 +109,8 @@ cv::Mat blackPicture(PixelFormat format, cv::Size size) {
       break;
     case PixelFormat::kYuyv:
       return {held, CV_8UC2, cv::Scalar(16, 128)};
+    case PixelFormat::kUyvy:
+      return {held, CV_8UC2, cv::Scalar(128, 16)};
     case PixelFormat::kNv12: {
       cv::Mat picture(held, CV_8UC1, cv::Scalar(128));
       picture.rowRange(0, size.height).setTo(16);
@@ -120,6 +128,9 @@ void heldToBgr(const cv::Mat& held, PixelFormat format, cv::Mat& bgr) {
     case PixelFormat::kYuyv:
       cv::cvtColor(held, bgr, cv::COLOR_YUV2BGR_YUYV);
       return;
+    case PixelFormat::kUyvy:
+      cv::cvtColor(held, bgr, cv::COLOR_YUV2BGR_UYVY);
+      return;
     case PixelFormat::kNv12:
       cv::cvtColor(held, bgr, cv::COLOR_YUV2BGR_NV12);
       return;
@@ -133,7 +144,8 @@ void bgrToHeld(const cv::Mat& bgr, PixelFormat format, cv::Mat& held) {
       bgr.copyTo(held);
       return;
     case PixelFormat::kYuyv:
-      writeYuyv(bgr, held.ptr<std::uint8_t>());
+    case PixelFormat::kUyvy:
+      writePacked422(bgr, format == PixelFormat::kYuyv, held.ptr<std::uint8_t>());
       return;
     case PixelFormat::kNv12:
       writeNv12(bgr, held.ptr<std::uint8_t>());

@@ -2,10 +2,12 @@
 // How a camera frame's pixels are held on their way from capture to the stitch: 8-bit BGR, or the
 // YUV the camera handed over, kept as it came so that only the pixels a picture needs are ever
 // converted (a 1280x720 view of four 1920x1080 cameras samples a ninth of their pixels). YUYV is
-// packed 4:2:2 (Y0 Cb Y1 Cr per two pixels, the chroma shared by both); NV12 is the luma plane and
-// then one interleaved Cb Cr pair per 2x2 pixels. YUV is BT.601, limited range (luma 16..235,
+// packed 4:2:2 (Y0 Cb Y1 Cr per two pixels, the chroma shared by both), UYVY the same with the
+// chroma first (Cb Y0 Cr Y1: what most automotive serializer links carry); NV12 is the luma plane
+// and then one interleaved Cb Cr pair per 2x2 pixels. YUV is BT.601, limited range (luma 16..235,
 // chroma 16..240 around 128), as V4L2 cameras deliver it.
 
+#include <cstddef>
 #include <cstdint>
 
 #include <opencv2/core.hpp>
@@ -14,13 +16,14 @@
 
 namespace surroundd {
 
-enum class PixelFormat : std::uint8_t { kBgr, kYuyv, kNv12 };
+enum class PixelFormat : std::uint8_t { kBgr, kYuyv, kNv12, kUyvy };
+inline constexpr std::size_t kPixelFormats = 4;
 
 const char* toString(PixelFormat format);
 
-// The cv::Mat that holds a picture of `size` in `format`: BGR CV_8UC3 of `size`; YUYV CV_8UC2 of
-// `size`; NV12 CV_8UC1 of width x height * 3 / 2, luma rows then chroma rows. YUV needs an even
-// width, NV12 an even height too.
+// The cv::Mat that holds a picture of `size` in `format`: BGR CV_8UC3 of `size`; YUYV, UYVY
+// CV_8UC2 of `size`; NV12 CV_8UC1 of width x height * 3 / 2, luma rows then chroma rows. YUV needs
+// an even width, NV12 an even height too.
 int heldType(PixelFormat format);
 cv::Size heldSize(PixelFormat format, cv::Size pictureSize);
 // The picture size of a held frame: heldSize()'s inverse.
@@ -48,10 +51,12 @@ using bt601::yuvToBgr;
 inline std::uint32_t bgrAt(const cv::Mat& held, PixelFormat format, int x, int y) {
   const std::uint8_t* row = held.ptr<std::uint8_t>(y);
   switch (format) {
-    case PixelFormat::kYuyv: {
+    case PixelFormat::kYuyv:
+    case PixelFormat::kUyvy: {
+      const std::size_t luma = format == PixelFormat::kYuyv ? 0 : 1;
       const std::uint8_t* pair = row + 4 * static_cast<std::size_t>(x / 2);
-      return yuvToBgr(row[2 * static_cast<std::size_t>(x)] | std::uint32_t{pair[1]} << 8 |
-                      std::uint32_t{pair[3]} << 16);
+      return yuvToBgr(row[2 * static_cast<std::size_t>(x) + luma] |
+                      std::uint32_t{pair[1 - luma]} << 8 | std::uint32_t{pair[3 - luma]} << 16);
     }
     case PixelFormat::kNv12: {
       const std::uint8_t* pair =

@@ -16,8 +16,9 @@
 namespace surroundd::daemon {
 
 // The words of a source's `format`: a file source's preload format, a V4L2 device's format.
-inline constexpr std::array<std::pair<std::string_view, capture::PixelLayout>, 2> kPreloadFormats{{
+inline constexpr std::array<std::pair<std::string_view, capture::PixelLayout>, 3> kPreloadFormats{{
     {"yuyv", capture::PixelLayout::kYuyv},
+    {"uyvy", capture::PixelLayout::kUyvy},
     {"nv12", capture::PixelLayout::kNv12},
 }};
 

@@ -6,7 +6,8 @@
 //       role: source                       # source | target (colour correction)
 //       source: {file: front.mkv}          # relative to the file that names it, or a live camera:
 //       source: {file: front.mkv, preload: true, format: yuyv}  # decoded once into memory, as
-//                                          # YUYV or NV12, and played from there as a camera's
+//                                          # YUYV, UYVY or NV12, and played from there as a
+//                                          camera's
 //       source: {device: /dev/v4l/by-path/...-video-index0, format: yuyv, fps: 30}
 //       source: {libcamera: "/base/soc/i2c0mux/i2c@1/imx219@10"}  # an id, or part of one
 //       lens: {model: pinhole, width_px: 1280, height_px: 720, fx_px: .., fy_px: .., cx_px: ..,
@@ -51,8 +52,8 @@ struct RigCamera {
   // Where the frames come from: a file (replay), or a live V4L2 device. Both absent in rig presets
   // (generator input).
   std::optional<capture::FileSourceSettings> source;
-  // With a file source: decoded once at start into memory in this pixel format (YUYV or NV12) and
-  // played from there, each frame converted as a V4L2 camera's is (capture::PreloadedSource).
+  // With a file source: decoded once at start into memory in this pixel format (YUYV, UYVY or
+  // NV12) and played from there, each frame held as a V4L2 camera's is (capture::PreloadedSource).
   std::optional<capture::PixelLayout> preload;
   std::optional<capture::V4l2Settings> device;
   std::optional<capture::LibcameraSettings> libcamera;

@@ -43,6 +43,7 @@ CameraTexture::CameraTexture(PixelFormat format, cv::Size size)
       allocate(pixels_.name(), GL_RGB8, size);
       break;
     case PixelFormat::kYuyv:
+    case PixelFormat::kUyvy:
       allocate(pixels_.name(), GL_RGBA8, {size.width / 2, size.height});
       break;
     case PixelFormat::kNv12:
@@ -96,6 +97,7 @@ void CameraTexture::commit() {
                       bufferOffset(0));
       break;
     case PixelFormat::kYuyv:
+    case PixelFormat::kUyvy:
       glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, size_.width / 2, size_.height, GL_RGBA,
                       GL_UNSIGNED_BYTE, bufferOffset(0));
       break;

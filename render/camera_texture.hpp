@@ -1,7 +1,8 @@
 #pragma once
 // One camera's frames on the GPU, in the format the camera held them (common/pixel_format.hpp):
 // uploaded as they are and converted by the shader that samples them, so the CPU never touches a
-// pixel. YUYV is one RGBA8 texture of half the width (a texel is Y0 Cb Y1 Cr); NV12 is an R8 luma
+// pixel. YUYV and UYVY are one RGBA8 texture of half the width (a texel is Y0 Cb Y1 Cr, or
+// Cb Y0 Cr Y1); NV12 is an R8 luma
 // texture and an RG8 chroma texture of half the width and height; BGR is one RGB8 texture (red
 // holding blue: the sampling shader knows). Every texture is sampled with texelFetch.
 //

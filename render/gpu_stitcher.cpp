@@ -107,6 +107,15 @@ vec3 texel{0}(ivec2 p) {{
 }}
 )",
                          camera);
+    case PixelFormat::kUyvy:
+      // Each texel is Cb Y0 Cr Y1.
+      return fmt::format(R"(uniform sampler2D u_pixels{0};
+vec3 texel{0}(ivec2 p) {{
+  vec4 pair = texelFetch(u_pixels{0}, ivec2(p.x >> 1, p.y), 0) * 255.0;
+  return vec3((p.x & 1) == 0 ? pair.g : pair.a, pair.r, pair.b);
+}}
+)",
+                         camera);
     case PixelFormat::kNv12:
       return fmt::format(R"(uniform sampler2D u_pixels{0};
 uniform sampler2D u_chroma{0};

@@ -85,8 +85,8 @@ class PanoramaStage final : public PipelineStage {
   std::unique_ptr<processing::GainCompensation> gains_;           // colour_correction: gain
   std::vector<cv::Mat> corrected_;  // this set's frames (headers) that colour correction sees
   std::vector<cv::Mat> stitched_;   // this set's frames (headers), black for missing cameras
-  PixelFormat format_ = PixelFormat::kBgr;           // the one both hold this set
-  std::array<std::vector<cv::Mat>, 3> blackFrames_;  // per PixelFormat, per camera
+  PixelFormat format_ = PixelFormat::kBgr;                       // the one both hold this set
+  std::array<std::vector<cv::Mat>, kPixelFormats> blackFrames_;  // per PixelFormat, per camera
   cv::Mat panorama_;
   std::function<bool(FrameWork&)> wanted_;
 };

@@ -29,7 +29,7 @@ constexpr std::uint64_t rowReciprocalOf(std::uint32_t width) {
 // A camera frame as the kernels read it. Taps address pixels as row * width + column, so the
 // frame must be continuous (holds() in common/pixel_format.hpp).
 struct SampledImage {
-  const std::uint8_t* pixels = nullptr;  // BGR or YUYV pixels, or NV12's luma plane
+  const std::uint8_t* pixels = nullptr;  // BGR, YUYV or UYVY pixels, or NV12's luma plane
   const std::uint8_t* chroma = nullptr;  // NV12: the Cb Cr plane
   std::size_t rowBytes = 0;              // of `pixels`
   std::uint32_t width = 0;
@@ -73,9 +73,11 @@ inline std::uint32_t pixelBytes(const std::uint8_t* p, int column) {
 
 // Bytes per pixel of a frame's first plane (NV12: its luma).
 template <PixelFormat kFormat>
-inline constexpr std::size_t kFirstPlaneBytes = kFormat == PixelFormat::kBgr
-                                                    ? 3
-                                                    : (kFormat == PixelFormat::kYuyv ? 2 : 1);
+inline constexpr bool kPacked422 = kFormat == PixelFormat::kYuyv || kFormat == PixelFormat::kUyvy;
+template <PixelFormat kFormat>
+inline constexpr std::size_t kFirstPlaneBytes = kFormat == PixelFormat::kBgr ? 3
+                                                : kPacked422<kFormat>        ? 2
+                                                                             : 1;
 
 // Where a tap's top-left pixel starts in the frame's first plane: to prefetch it.
 template <PixelFormat kFormat>
@@ -97,17 +99,22 @@ inline Neighbours neighbours(const SampledImage& image, std::uint32_t offset) {
     const std::uint8_t* top = image.pixels + static_cast<std::size_t>(offset) * 3;
     const std::uint8_t* bottom = top + image.rowBytes;
     return {pixelBytes(top, 0), pixelBytes(top, 1), pixelBytes(bottom, 0), pixelBytes(bottom, 1)};
-  } else if constexpr (kFormat == PixelFormat::kYuyv) {
-    // Y0 Cb Y1 Cr: each pixel's pair read whole (the left pixel's, then the right one's: the
-    // same pair for an even offset, the next for an odd one), its Y picked by the offset's
-    // parity. The width is even, so a pixel's column has the parity of its offset.
+  } else if constexpr (kPacked422<kFormat>) {
+    // Y0 Cb Y1 Cr (YUYV) or Cb Y0 Cr Y1 (UYVY): each pixel's pair read whole (the left pixel's,
+    // then the right one's: the same pair for an even offset, the next for an odd one), its Y
+    // picked by the offset's parity. The width is even, so a pixel's column has the parity of
+    // its offset.
     const std::uint32_t odd = offset & 1U;
     const std::uint8_t* base = image.pixels + static_cast<std::size_t>(offset & ~1U) * 2;
     const std::size_t next = 4 * odd;
     const auto pixel = [](const std::uint8_t* pair, std::uint32_t lumaShift) {
       std::uint32_t bytes = 0;
       std::memcpy(&bytes, pair, 4);
-      return ((bytes >> lumaShift) & 0xffU) | (bytes & 0xff00U) | ((bytes >> 8) & 0xff0000U);
+      if constexpr (kFormat == PixelFormat::kYuyv) {
+        return ((bytes >> lumaShift) & 0xffU) | (bytes & 0xff00U) | ((bytes >> 8) & 0xff0000U);
+      } else {
+        return ((bytes >> (lumaShift + 8)) & 0xffU) | ((bytes & 0xffU) << 8) | (bytes & 0xff0000U);
+      }
     };
     const std::uint32_t leftShift = 16 * odd;
     const std::uint32_t rightShift = 16 - leftShift;
@@ -213,6 +220,8 @@ inline std::uint32_t bilinear(const SampledImage& image, const LutTap& tap) {
   switch (image.format) {
     case PixelFormat::kYuyv:
       return bilinear<PixelFormat::kYuyv>(image, tap);
+    case PixelFormat::kUyvy:
+      return bilinear<PixelFormat::kUyvy>(image, tap);
     case PixelFormat::kNv12:
       return bilinear<PixelFormat::kNv12>(image, tap);
     case PixelFormat::kBgr:

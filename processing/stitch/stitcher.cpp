@@ -96,7 +96,7 @@ Stitcher::Stitcher(const PanoramaLut& lut, WorkPool& pool)
     : lut_(lut),
       pool_(pool),
       unseen_{blackPicture(PixelFormat::kBgr, {2, 2}), blackPicture(PixelFormat::kYuyv, {2, 2}),
-              blackPicture(PixelFormat::kNv12, {2, 2})} {
+              blackPicture(PixelFormat::kNv12, {2, 2}), blackPicture(PixelFormat::kUyvy, {2, 2})} {
   // Per row, the columns from the first to the last pixel a camera sees; outside them the row is
   // filled, not sampled (a quarter of the paper rig's panorama is above every camera's view).
   seenSpans_.reserve(static_cast<std::size_t>(lut_.size.height));
@@ -143,6 +143,8 @@ Stitcher::RowKernel Stitcher::rowsOf(PixelFormat format) {
   switch (format) {
     case PixelFormat::kYuyv:
       return &Stitcher::stitchRows<kPath, PixelFormat::kYuyv>;
+    case PixelFormat::kUyvy:
+      return &Stitcher::stitchRows<kPath, PixelFormat::kUyvy>;
     case PixelFormat::kNv12:
       return &Stitcher::stitchRows<kPath, PixelFormat::kNv12>;
     case PixelFormat::kBgr:

@@ -38,7 +38,8 @@ class Stitcher {
   // lacks throws std::invalid_argument.
   void stitch(std::span<const cv::Mat> frames, PixelFormat format, cv::Mat& panorama,
               KernelPath path = kNativeKernels);
-  void stitch(std::span<const cv::Mat> frames, cv::Mat& panorama, KernelPath path = kNativeKernels) {
+  void stitch(std::span<const cv::Mat> frames, cv::Mat& panorama,
+              KernelPath path = kNativeKernels) {
     stitch(frames, PixelFormat::kBgr, panorama, path);
   }
 
@@ -59,7 +60,7 @@ class Stitcher {
   // Indexed by a tap's camera byte as it is, kUnseen included: no bounds check per pixel.
   static constexpr std::size_t kCameraByteValues = std::size_t{1} << (8 * sizeof(LutTap::camera));
   std::array<SampledImage, kCameraByteValues> images_{};
-  std::array<cv::Mat, 3> unseen_;  // per PixelFormat
+  std::array<cv::Mat, kPixelFormats> unseen_;   // per PixelFormat
   std::vector<std::pair<int, int>> seenSpans_;  // per row: [begin, end) columns to sample
 };
 

@@ -55,7 +55,7 @@ TEST(BenchCli, StitchReportsTimingsAndAccuracyAsJson) {
   EXPECT_GT(top["rendered_ms"].as<double>(), 0);
   EXPECT_GT(top["psnr_db"].as<double>(), 30.0);
   // Both gathers from the frames held in each format a camera may hand over.
-  const std::array<std::string, 3> formats = {"BGR", "YUYV", "NV12"};
+  const std::array<std::string, 4> formats = {"BGR", "YUYV", "UYVY", "NV12"};
   ASSERT_EQ(top["held_formats"].size(), formats.size());
   for (std::size_t f = 0; f < formats.size(); ++f) {
     const YAML::Node held = top["held_formats"][f];
@@ -122,6 +122,17 @@ TEST(BenchCli, PipelineOnRawFramesSaysSoAndReportsTheConversion) {
   EXPECT_NEAR(input["ratio"].as<double>(),
               input["fps"].as<double>() / input["baseline_fps"].as<double>(), 1e-3);
 
+  // UYVY cameras, the panorama stitched by OpenGL (llvmpipe here): the report names both.
+  testing::ChildProcess gpu(
+      {SURROUND_BENCH, "pipeline", "--json", "--repeats", "1", "--size", "320x240", "--input",
+       "raw", "--raw-format", "uyvy", "--backend", "gpu", kRecording},
+      dir / "gpu-log.txt", {}, dir / "gpu.json");
+  ASSERT_EQ(gpu.wait(), 0) << gpu.output();
+  const YAML::Node onGpu = YAML::Load(gpu.standardOutput())["pipeline"];
+  EXPECT_EQ(onGpu["input"].as<std::string>(), "raw-uyvy");
+  EXPECT_THAT(onGpu["renderer"].as<std::string>(), HasSubstr("panorama stitched on the GPU"));
+  EXPECT_EQ(onGpu["inputs"][0]["frame_sets"].as<int>(), 30);
+
   // Two runs: the second reads the LUT the first cached, so the text gives a warm start-up too, and
   // each figure is printed beside its limit.
   testing::ChildProcess text({SURROUND_BENCH, "pipeline", "--repeats", "2", "--size", "320x240",
@@ -158,9 +169,11 @@ TEST(BenchCli, BadCommandLinesAreUsageErrors) {
                   "--size needs an even WIDTHxHEIGHT"},
         std::pair{std::vector<std::string>{"pipeline", "--input", "h264", kRecording},
                   "--input needs decode or raw"},
-        std::pair{std::vector<std::string>{"pipeline", "--input", "raw", "--raw-format", "uyvy",
+        std::pair{std::vector<std::string>{"pipeline", "--input", "raw", "--raw-format", "mjpeg",
                                            kRecording},
-                  "--raw-format needs yuyv or nv12"},
+                  "--raw-format needs yuyv, uyvy or nv12"},
+        std::pair{std::vector<std::string>{"pipeline", "--backend", "vulkan", kRecording},
+                  "--backend needs auto, cpu or gpu"},
         std::pair{std::vector<std::string>{"pipeline", "--raw-format", "nv12", kRecording},
                   "--raw-format goes with --input raw"},
         std::pair{std::vector<std::string>{"stitch", "--threads", "0", kRecording},

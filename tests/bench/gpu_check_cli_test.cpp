@@ -47,7 +47,7 @@ TEST(GpuCheckCli, MeasuresTheGpuPathOnTheKitGpuKitWrote) {
                                                    "[0-9.]+ ms, chain [0-9.]+ ms = [0-9.]+ fps")))
       << output;
   // Per format: mean / p99 / largest difference from the CPU panorama, then six timings.
-  for (const char* format : {"YUYV", "NV12", "BGR"}) {
+  for (const char* format : {"YUYV", "UYVY", "NV12", "BGR"}) {
     std::smatch row;
     ASSERT_TRUE(std::regex_search(
         output, row,

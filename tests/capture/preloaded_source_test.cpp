@@ -1,5 +1,5 @@
 // Recordings played from memory as a camera delivers them: the generator's recording, preloaded as
-// YUYV or NV12, gives the frames FileSource decodes (within what the camera format's chroma
+// YUYV, UYVY or NV12, gives the frames FileSource decodes (within what the camera format's chroma
 // subsampling and 8-bit YUV round trip lose) with the same timestamps; it loops, paces, and refuses
 // what does not fit its memory bound or its format, naming the camera and the file.
 
@@ -88,8 +88,9 @@ TEST_P(PreloadedFormat, FramesAreTheDecodedOnesThroughTheCameraFormat) {
   ASSERT_EQ(expected.images.size(), kFrames);
   EXPECT_EQ(got.timestamps, expected.timestamps);
   EXPECT_EQ(got.sequences, expected.sequences);
-  const double maxMean = format == PixelLayout::kYuyv ? 1.0 : 1.5;
-  const double minPsnr = format == PixelLayout::kYuyv ? 40.0 : 36.0;
+  const bool packed = format != PixelLayout::kNv12;  // YUYV, UYVY: 4:2:2 in one plane
+  const double maxMean = packed ? 1.0 : 1.5;
+  const double minPsnr = packed ? 40.0 : 36.0;
   JpegDecoder jpeg;
   for (std::size_t i = 0; i < kFrames; ++i) {
     cv::Mat difference;
@@ -109,26 +110,23 @@ TEST_P(PreloadedFormat, FramesAreTheDecodedOnesThroughTheCameraFormat) {
     // converted as a V4L2 camera's frames would be: the same bytes give the same picture.
     const auto data = preloaded.frameData(i);
     ASSERT_EQ(data.size(), preloadedFrameBytes(format, {320, 180}));
-    EXPECT_EQ(preloaded.pixelFormat(), format == PixelLayout::kYuyv ? PixelFormat::kYuyv
-                                                                    : PixelFormat::kNv12);
+    EXPECT_EQ(preloaded.pixelFormat(), heldFormat(format));
+    EXPECT_NE(preloaded.pixelFormat(), PixelFormat::kBgr);
     ASSERT_EQ(got.held[i].total() * got.held[i].elemSize(), data.size());
     EXPECT_TRUE(std::equal(data.begin(), data.end(), got.held[i].ptr<std::uint8_t>()))
         << "frame " << i;
     cv::Mat converted(180, 320, CV_8UC3);
     std::string error;
-    ASSERT_TRUE(convertToBgr(format, data, format == PixelLayout::kYuyv ? 640 : 320, jpeg,
-                             converted, error))
-        << error;
+    ASSERT_TRUE(convertToBgr(format, data, packed ? 640 : 320, jpeg, converted, error)) << error;
     EXPECT_EQ(cv::norm(converted, got.images[i], cv::NORM_INF), 0.0) << "frame " << i;
   }
-  // Limited range: luma (every byte of YUYV's even ones, NV12's first plane) within 16..235.
+  // Limited range: luma (YUYV's even bytes, UYVY's odd ones, NV12's first plane) within 16..235.
   const auto first = preloaded.frameData(0);
-  const std::size_t lumaBytes =
-      format == PixelLayout::kNv12 ? std::size_t{320} * 180 : first.size();
-  const std::size_t step = format == PixelLayout::kNv12 ? 1 : 2;
+  const std::size_t lumaBytes = packed ? first.size() : std::size_t{320} * 180;
+  const std::size_t step = packed ? 2 : 1;
   std::uint8_t low = 255;
   std::uint8_t high = 0;
-  for (std::size_t b = 0; b < lumaBytes; b += step) {
+  for (std::size_t b = format == PixelLayout::kUyvy ? 1 : 0; b < lumaBytes; b += step) {
     low = std::min(low, first[b]);
     high = std::max(high, first[b]);
   }
@@ -136,8 +134,9 @@ TEST_P(PreloadedFormat, FramesAreTheDecodedOnesThroughTheCameraFormat) {
   EXPECT_LE(high, 235);
 }
 
-INSTANTIATE_TEST_SUITE_P(YuyvAndNv12, PreloadedFormat,
-                         ::testing::Values(PixelLayout::kYuyv, PixelLayout::kNv12),
+INSTANTIATE_TEST_SUITE_P(YuyvUyvyAndNv12, PreloadedFormat,
+                         ::testing::Values(PixelLayout::kYuyv, PixelLayout::kUyvy,
+                                           PixelLayout::kNv12),
                          [](const ::testing::TestParamInfo<PixelLayout>& format) {
                            return std::string(toString(format.param));
                          });
@@ -221,7 +220,7 @@ TEST(PreloadedSource, AFormatOrSizeItCannotHoldIsRefused) {
   EXPECT_EQ(
       PreloadedSource("left", preload(dir / "odd_height.png", PixelLayout::kYuyv)).frameCount(),
       1u);
-  refused(video(), PixelLayout::kMjpeg, "cannot be preloaded as MJPEG: only as YUYV or NV12");
+  refused(video(), PixelLayout::kMjpeg, "cannot be preloaded as MJPEG: only as YUYV, UYVY or NV12");
   refused(dir / "missing.mkv", PixelLayout::kYuyv, "cannot open");
 }
 

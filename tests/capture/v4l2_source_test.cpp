@@ -72,9 +72,10 @@ cv::Mat bgrOf(const Frame& frame) {
   return bgr;
 }
 
-// YUYV and NV12 are held as the camera gave them; the others are converted to BGR.
+// YUYV, UYVY and NV12 are held as the camera gave them; the others are converted to BGR.
 PixelFormat heldAs(V4l2Format format) {
   if (format == V4l2Format::kYuyv) return PixelFormat::kYuyv;
+  if (format == V4l2Format::kUyvy) return PixelFormat::kUyvy;
   if (format == V4l2Format::kNv12) return PixelFormat::kNv12;
   return PixelFormat::kBgr;
 }
@@ -225,7 +226,7 @@ TEST(V4l2Source, UnpluggedItIsLostAndReopensOnceBack) {
   ASSERT_EQ(source.read(frame), ReadStatus::kFrame) << source.lastError();
   EXPECT_EQ(source.reopened(), 1u);
   EXPECT_GE(cv::PSNR(bgrOf(frame), surroundd::testing::syntheticPicture(
-                                      kSize, static_cast<int>(state->produced - 1))),
+                                       kSize, static_cast<int>(state->produced - 1))),
             28.0);
 }
 

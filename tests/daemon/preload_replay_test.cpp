@@ -39,9 +39,10 @@ TEST_F(ConfigTest, APreloadedFileIsHeldInTheFormatItNames) {
 }
 
 TEST_F(ConfigTest, PreloadMistakesAreNamedByTheirKey) {
-  expectOneError(
-      "source: {file: left.mkv}", "source: {file: left.mkv, preload: true, format: mjpeg}",
-      {where(10, 55), "rig.cameras[1].source.format: expected one of 'yuyv' 'nv12'", "'mjpeg'"});
+  expectOneError("source: {file: left.mkv}",
+                 "source: {file: left.mkv, preload: true, format: mjpeg}",
+                 {where(10, 55),
+                  "rig.cameras[1].source.format: expected one of 'yuyv' 'uyvy' 'nv12'", "'mjpeg'"});
   expectOneError("source: {file: left.mkv}", "source: {file: left.mkv, format: nv12}",
                  {"rig.cameras[1].source.format: expected only with 'preload: true'"});
   expectOneError("source: {file: left.mkv}", "source: {file: left.mkv, preload: yes please}",

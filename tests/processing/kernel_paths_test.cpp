@@ -49,13 +49,13 @@ class KernelPathsTest : public ::testing::Test {
     return held_[static_cast<std::size_t>(format)];
   }
 
-  static constexpr std::array kFormats = {PixelFormat::kBgr, PixelFormat::kYuyv,
+  static constexpr std::array kFormats = {PixelFormat::kBgr, PixelFormat::kYuyv, PixelFormat::kUyvy,
                                           PixelFormat::kNv12};
   WorkPool pool_{2};
   const bench::RecordingTruth& truth_;
   PanoramaLut lut_;
-  std::vector<cv::Mat> frames_;               // BGR, as decoded
-  std::array<std::vector<cv::Mat>, 3> held_;  // per PixelFormat
+  std::vector<cv::Mat> frames_;                           // BGR, as decoded
+  std::array<std::vector<cv::Mat>, kPixelFormats> held_;  // per PixelFormat
 };
 
 template <KernelPath kPath>
@@ -63,6 +63,8 @@ std::uint32_t sampleAs(const SampledImage& image, const LutTap& tap) {
   switch (image.format) {
     case PixelFormat::kYuyv:
       return bilinear<PixelFormat::kYuyv, kPath>(image, tap);
+    case PixelFormat::kUyvy:
+      return bilinear<PixelFormat::kUyvy, kPath>(image, tap);
     case PixelFormat::kNv12:
       return bilinear<PixelFormat::kNv12, kPath>(image, tap);
     case PixelFormat::kBgr:

@@ -66,7 +66,8 @@ void operator delete[](void* p, const std::nothrow_t& /*tag*/) noexcept { std::f
 namespace surroundd::render {
 namespace {
 
-constexpr std::array kFormats = {PixelFormat::kBgr, PixelFormat::kYuyv, PixelFormat::kNv12};
+constexpr std::array kFormats = {PixelFormat::kBgr, PixelFormat::kYuyv, PixelFormat::kUyvy,
+                                 PixelFormat::kNv12};
 
 class GpuStitcherTest : public ::testing::Test {
  protected:

@@ -64,7 +64,7 @@ constexpr std::string_view kUsage =
   --input I     pipeline: decode (each video decoded as it plays: replay figures; the default) |
                 raw (decoded once at start into memory as a camera's frames, handed over per
                 frame as a V4L2 camera's are, kept in their YUV: live-rig figures)
-  --raw-format F  pipeline, --input raw: yuyv | nv12 (default yuyv)
+  --raw-format F  pipeline, --input raw: yuyv | uyvy | nv12 (default yuyv)
   --backend B   pipeline: where the panorama is made, as processing.backend: auto | cpu | gpu
                 (default auto: the CPU on a software renderer such as llvmpipe)
   --pictures DIR  colour, CONFIG: also write the panoramas (none, gain, Poisson) and body masks
@@ -212,9 +212,10 @@ int main(int argc, char** argv) {
       pipeline.input = *input;
       ++i;
     } else if (command == "pipeline" && arg == "--raw-format") {
-      const auto format = parseWord<PixelLayout>(
-          value, {{"yuyv", PixelLayout::kYuyv}, {"nv12", PixelLayout::kNv12}});
-      if (!format) return usageError("--raw-format needs yuyv or nv12");
+      const auto format = parseWord<PixelLayout>(value, {{"yuyv", PixelLayout::kYuyv},
+                                                         {"uyvy", PixelLayout::kUyvy},
+                                                         {"nv12", PixelLayout::kNv12}});
+      if (!format) return usageError("--raw-format needs yuyv, uyvy or nv12");
       pipeline.rawFormat = *format;
       rawFormat = true;
       ++i;

@@ -173,11 +173,13 @@ constexpr std::array kStages{daemon::Stage::kSync,     daemon::Stage::kStitch,
                              daemon::Stage::kCorrect,  daemon::Stage::kRender,
                              daemon::Stage::kReadBack, daemon::Stage::kOutput};
 
-// The input's name in the report ("decode", "raw-yuyv", "raw-nv12") and what the capture threads
-// do per camera frame.
+// The input's name in the report ("decode", "raw-yuyv", "raw-uyvy", "raw-nv12") and what the
+// capture threads do per camera frame.
 std::string inputName(const PipelineBenchmarkOptions& options) {
   if (options.input == BenchInput::kDecode) return "decode";
-  return options.rawFormat == capture::PixelLayout::kNv12 ? "raw-nv12" : "raw-yuyv";
+  std::string format = capture::toString(options.rawFormat);
+  std::ranges::transform(format, format.begin(), [](unsigned char c) { return std::tolower(c); });
+  return "raw-" + format;
 }
 const char* captureWork(const PipelineBenchmarkOptions& options) {
   return options.input == BenchInput::kDecode ? "decode" : "convert";

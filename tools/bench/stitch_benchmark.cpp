@@ -146,7 +146,8 @@ TopViewTiming measureTopView(const processing::Rig& rig,
                                           repeats);
   timing.directMs = medians[0];
   timing.renderedMs = medians[1];
-  for (const PixelFormat format : {PixelFormat::kBgr, PixelFormat::kYuyv, PixelFormat::kNv12}) {
+  for (const PixelFormat format :
+       {PixelFormat::kBgr, PixelFormat::kYuyv, PixelFormat::kUyvy, PixelFormat::kNv12}) {
     std::vector<cv::Mat> held(images.size());
     for (std::size_t c = 0; c < images.size(); ++c) bgrToHeld(images[c], format, held[c]);
     const auto formatMedians =

@@ -4,8 +4,8 @@
 //
 //   surround-gpu-check [--frames N] [--view V] [--size WxH] KIT_FOLDER...
 //
-// Per kit and camera format (YUYV as carried, NV12 and BGR converted from it at start-up): how
-// far the GPU panorama is from the CPU Stitcher's (mean, 99th percentile, largest, in levels);
+// Per kit and camera format (YUYV as carried, UYVY, NV12 and BGR converted from it at start-up):
+// how far the GPU panorama is from the CPU Stitcher's (mean, 99th percentile, largest, in levels);
 // milliseconds per frame set of the upload (and its GB/s), the stitch pass, the view's draw with
 // its read-back, and the whole chain; and the CPU path's chain (Stitcher on every core, the
 // panorama uploaded, the same draw). Stage times are wall clock around glFinish, so they hold on
@@ -204,7 +204,8 @@ void checkKit(const std::filesystem::path& kit, const Options& options) {
 
   fmt::print("  {:<5} {:>22} {:>18} {:>9} {:>13} {:>9} {:>9} {:>9}\n", "GPU", "vs CPU mean/p99/max",
              "upload ms (GB/s)", "stitch ms", "draw+read ms", "chain ms", "chain fps", "vs CPU");
-  for (const PixelFormat format : {PixelFormat::kYuyv, PixelFormat::kNv12, PixelFormat::kBgr}) {
+  for (const PixelFormat format :
+       {PixelFormat::kYuyv, PixelFormat::kUyvy, PixelFormat::kNv12, PixelFormat::kBgr}) {
     std::vector<cv::Mat> held(yuyv.size());
     std::size_t bytes = 0;
     for (std::size_t camera = 0; camera < yuyv.size(); ++camera) {

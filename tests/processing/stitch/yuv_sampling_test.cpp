@@ -25,7 +25,7 @@
 namespace surroundd::processing {
 namespace {
 
-constexpr std::array kYuvFormats = {PixelFormat::kYuyv, PixelFormat::kNv12};
+constexpr std::array kYuvFormats = {PixelFormat::kYuyv, PixelFormat::kUyvy, PixelFormat::kNv12};
 
 // Every Y, Cb, Cr: a YUYV picture per luma level whose pairs hold each Cb (across) and Cr (down).
 TEST(YuvToBgr, IsCvtColorsConversionOfEveryYuv) {
