@@ -202,6 +202,51 @@ TEST_F(GpuStitcherTest, BothCorrectionFieldsAreAppliedAsTheCpuAppliesThem) {
   }
 }
 
+// Camera 2 lost (no frame for kLostAfterSets sets): the correction goes on with the three cameras
+// left, on a domain of their own, and the GPU applies the field it solves there as apply() does
+// (each pixel's source share stays: the cameras' roles do not change).
+TEST_F(GpuStitcherTest, AfterACameraIsLostTheFieldIsAppliedOnTheDomainOfThoseLeft) {
+  const auto& truth = processing::testing::smallRecording();
+  constexpr PixelFormat kFormat = PixelFormat::kYuyv;
+  std::vector<cv::Mat> frames(bgrFrames.size());
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    bgrToHeld(i == 1 ? cv::Mat(bgrFrames[i] * 0.75) : bgrFrames[i], kFormat, frames[i]);
+  }
+  processing::PoissonColourCorrection correction(truth.rig, processing::testing::settingsFor(truth),
+                                                 *lut, {}, *pool);
+  correction.update(frames, kFormat);
+  GpuStitcher gpu(*lut, kFormat, *pool);
+  gpu.correctWith(&correction);
+  gpu.upload(frames);
+  gpu.stitch();
+  const processing::CorrectionDomain& everyCamera = correction.domain();
+  const cv::Mat fieldOfEvery = correction.field().clone();
+
+  std::vector<cv::Mat> lost = frames;
+  lost[2] = cv::Mat();
+  std::vector<cv::Mat> shown = frames;  // a missing camera is stitched black
+  shown[2] = blackPicture(kFormat, lut->cameraSizes[2]);
+  for (int set = 0; set < processing::PoissonColourCorrection::kLostAfterSets; ++set) {
+    correction.update(lost, kFormat);
+  }
+  ASSERT_NE(&correction.domain(), &everyCamera);
+  EXPECT_EQ(correction.domain().share, everyCamera.share);
+  ASSERT_GT(cv::norm(correction.field(), fieldOfEvery, cv::NORM_INF), 5.0);  // a field of its own
+
+  cv::Mat cpu;
+  processing::Stitcher(*lut, *pool).stitch(shown, kFormat, cpu);
+  correction.apply(cpu);
+  gpu.upload(shown);
+  gpu.stitch();
+  cv::Mat corrected;
+  gpu.readPanorama(corrected);
+  cv::Mat difference;
+  cv::absdiff(corrected, cpu, difference);
+  const cv::Scalar mean = cv::mean(difference);
+  for (int c = 0; c < 3; ++c) EXPECT_LE(mean[c], 1.0) << "channel " << c;
+  EXPECT_LE(percentile(difference, 0.99), 4);
+}
+
 // The per-frame calls, the correction's field upload included, once the driver has seen them.
 TEST_F(GpuStitcherTest, UploadAndStitchAllocateNothing) {
   const auto& truth = processing::testing::smallRecording();
