@@ -203,11 +203,11 @@ TEST(KernelPaths, EveryPathWeighsAlike) {
     EXPECT_EQ(samples[p], samples[0]);
   }
   // All 255 stays 255 at every weight, all 0 stays 0.
-  constexpr std::size_t weights =
+  constexpr std::size_t kWeights =
       std::size_t{LutTap::kFractionOne + 1} * (LutTap::kFractionOne + 1);
-  for (std::size_t i = 0; i < weights; ++i) {
+  for (std::size_t i = 0; i < kWeights; ++i) {
     ASSERT_EQ(samples[0][i], 0u);
-    ASSERT_EQ(samples[0][weights + i], 0xffffffu);
+    ASSERT_EQ(samples[0][kWeights + i], 0xffffffu);
   }
 }
 
