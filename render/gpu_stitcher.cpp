@@ -99,23 +99,16 @@ vec3 texel{0}(ivec2 p) {{ return texelFetch(u_pixels{0}, p, 0).rgb * 255.0; }}
 )",
                          camera);
     case PixelFormat::kYuyv:
-      // Each texel is Y0 Cb Y1 Cr: a pixel takes its pair's chroma, as cvtColor does.
-      return fmt::format(R"(uniform sampler2D u_pixels{0};
-vec3 texel{0}(ivec2 p) {{
-  vec4 pair = texelFetch(u_pixels{0}, ivec2(p.x >> 1, p.y), 0) * 255.0;
-  return vec3((p.x & 1) == 0 ? pair.r : pair.b, pair.g, pair.a);
-}}
-)",
-                         camera);
     case PixelFormat::kUyvy:
-      // Each texel is Cb Y0 Cr Y1.
+      // Each texel is a pair, Y0 Cb Y1 Cr (YUYV) or Cb Y0 Cr Y1 (UYVY), swizzled to Y0 Y1 Cb Cr:
+      // a pixel takes its pair's chroma, as cvtColor does.
       return fmt::format(R"(uniform sampler2D u_pixels{0};
 vec3 texel{0}(ivec2 p) {{
-  vec4 pair = texelFetch(u_pixels{0}, ivec2(p.x >> 1, p.y), 0) * 255.0;
-  return vec3((p.x & 1) == 0 ? pair.g : pair.a, pair.r, pair.b);
+  vec4 pair = texelFetch(u_pixels{0}, ivec2(p.x >> 1, p.y), 0).{1} * 255.0;
+  return vec3((p.x & 1) == 0 ? pair.x : pair.y, pair.z, pair.w);
 }}
 )",
-                         camera);
+                         camera, format == PixelFormat::kYuyv ? "rbga" : "garb");
     case PixelFormat::kNv12:
       return fmt::format(R"(uniform sampler2D u_pixels{0};
 uniform sampler2D u_chroma{0};

@@ -131,20 +131,24 @@ int percentile(const cv::Mat& difference, double share) {
 // The bounds (20): mean difference at most a level, 99th percentile at most 4. Float
 // interpolation against Stitcher's 1/128-pixel fixed point with rounding at each step: measured
 // on llvmpipe, mean 0.2-0.3 of a level, 99th percentile 1-2.
+void expectWithinRounding(const cv::Mat& gpu, const cv::Mat& cpu) {
+  ASSERT_EQ(gpu.size(), cpu.size());
+  cv::Mat difference;
+  cv::absdiff(gpu, cpu, difference);
+  const cv::Scalar mean = cv::mean(difference);
+  for (int c = 0; c < 3; ++c) EXPECT_LE(mean[c], 1.0) << "channel " << c;
+  EXPECT_LE(percentile(difference, 0.99), 4);
+}
+
 TEST_F(GpuStitcherTest, ThePanoramaIsTheCpuStitchersForEveryFormat) {
   for (const PixelFormat format : kFormats) {
     SCOPED_TRACE(toString(format));
     GpuStitcher gpu(*lut, format, *pool);
     const auto frames = held(format);
     const Panoramas panoramas = stitchBoth(frames, format, gpu);
-    ASSERT_EQ(panoramas.gpu.size(), panoramas.cpu.size());
     // A panorama that shows the scene, so that agreeing is not agreeing on black.
     ASSERT_GT(cv::mean(panoramas.cpu)[1], 30.0);
-    cv::Mat difference;
-    cv::absdiff(panoramas.gpu, panoramas.cpu, difference);
-    const cv::Scalar mean = cv::mean(difference);
-    for (int c = 0; c < 3; ++c) EXPECT_LE(mean[c], 1.0) << "channel " << c;
-    EXPECT_LE(percentile(difference, 0.99), 4);
+    expectWithinRounding(panoramas.gpu, panoramas.cpu);
     // Where no camera sees, both are the unseen colour.
     const cv::Mat unseen = lut->validMask() == 0;
     if (cv::countNonZero(unseen) > 0) {
@@ -186,11 +190,7 @@ TEST_F(GpuStitcherTest, BothCorrectionFieldsAreAppliedAsTheCpuAppliesThem) {
       gpu.stitch();
       cv::Mat corrected;
       gpu.readPanorama(corrected);
-      cv::Mat difference;
-      cv::absdiff(corrected, cpu, difference);
-      const cv::Scalar mean = cv::mean(difference);
-      for (int c = 0; c < 3; ++c) EXPECT_LE(mean[c], 1.0) << "channel " << c;
-      EXPECT_LE(percentile(difference, 0.99), 4);
+      expectWithinRounding(corrected, cpu);
 
       gpu.correctWith(nullptr);  // and back to none
       gpu.stitch();
@@ -240,11 +240,7 @@ TEST_F(GpuStitcherTest, AfterACameraIsLostTheFieldIsAppliedOnTheDomainOfThoseLef
   gpu.stitch();
   cv::Mat corrected;
   gpu.readPanorama(corrected);
-  cv::Mat difference;
-  cv::absdiff(corrected, cpu, difference);
-  const cv::Scalar mean = cv::mean(difference);
-  for (int c = 0; c < 3; ++c) EXPECT_LE(mean[c], 1.0) << "channel " << c;
-  EXPECT_LE(percentile(difference, 0.99), 4);
+  expectWithinRounding(corrected, cpu);
 }
 
 // The per-frame calls, the correction's field upload included, once the driver has seen them.
