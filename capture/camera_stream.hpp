@@ -53,7 +53,8 @@ class CameraStream {
 
   const std::string& name() const { return name_; }
   cv::Size frameSize() const { return pool_.frameSize(); }
-  PixelFormat pixelFormat() const { return pool_.pixelFormat(); }  // the frames are held in
+  // What its frames are held in (as its source delivers them, or BGR).
+  PixelFormat pixelFormat() const { return pool_.pixelFormat(); }
   Timestamp nominalPeriod() const { return nominalPeriod_; }
   bool repeatsOnePicture() const { return repeatsOnePicture_; }  // see FrameSource
   CameraStreamStats stats() const;
