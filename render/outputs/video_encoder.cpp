@@ -145,10 +145,15 @@ void VideoEncoder::Impl::open() {
   frame->height = settings.size.height;
   if (const int error = av_frame_get_buffer(frame.get(), 0); error < 0)
     fail("out of memory", error);
+  // To 4:2:0, swscale's accurate rounding would take its generic scaler (2.7 ms a 1280x720
+  // picture, measured here) where its unscaled BGR -> YUV 4:2:0 conversion takes 0.7-0.9 ms, for
+  // at most a level of luma and a few of chroma, well under what H.264 itself changes.
+  const int accuracy = pictureFormat == AV_PIX_FMT_YUV420P || pictureFormat == AV_PIX_FMT_NV12
+                           ? 0
+                           : SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT;
   sws.reset(sws_getContext(settings.size.width, settings.size.height, AV_PIX_FMT_BGR24,
                            settings.size.width, settings.size.height, pictureFormat,
-                           SWS_BICUBIC | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT | SWS_BITEXACT,
-                           nullptr, nullptr, nullptr));
+                           SWS_BICUBIC | SWS_BITEXACT | accuracy, nullptr, nullptr, nullptr));
   if (!sws) fail("cannot set up the colour conversion");
   if (hwFrames) {
     hwFrame.reset(av_frame_alloc());
