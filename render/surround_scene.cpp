@@ -189,9 +189,9 @@ SurroundScene::StreamedTexture::StreamedTexture(cv::Size textureSize, GLint hori
 void SurroundScene::StreamedTexture::upload(const cv::Mat& bgr) {
   glBindBuffer(GL_PIXEL_UNPACK_BUFFER, buffers[next].name());
   next = (next + 1) % buffers.size();
-  auto* mapped = glMapBufferRange(GL_PIXEL_UNPACK_BUFFER, 0,
-                                  static_cast<GLsizeiptr>(size.area()) * 4,
-                                  GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT);
+  auto* mapped =
+      glMapBufferRange(GL_PIXEL_UNPACK_BUFFER, 0, static_cast<GLsizeiptr>(size.area()) * 4,
+                       GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT);
   if (mapped == nullptr) {
     glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
     gl::check("mapping a texture upload buffer");
