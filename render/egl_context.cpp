@@ -88,6 +88,15 @@ EGLDisplay surfacelessDisplay(std::string& why) {
 
 }  // namespace
 
+bool softwareRenderer() {
+  const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  if (name == nullptr) return false;
+  const std::string_view renderer(name);
+  return std::ranges::any_of(kSoftwareRenderers, [&](std::string_view software) {
+    return renderer.find(software) != std::string_view::npos;
+  });
+}
+
 const char* toString(EglPlatform platform) {
   switch (platform) {
     case EglPlatform::kAuto:
@@ -180,11 +189,9 @@ bool EglContext::open(EglPlatform platform, std::string& why) {
     return false;
   }
   platform_ = platform;
-  const std::string_view renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-  software_ = std::ranges::any_of(kSoftwareRenderers, [&](std::string_view name) {
-    return renderer.find(name) != std::string_view::npos;
-  });
-  description_ = fmt::format("{}: {}, {}", toString(platform), renderer,
+  software_ = softwareRenderer();
+  description_ = fmt::format("{}: {}, {}", toString(platform),
+                             reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
                              reinterpret_cast<const char*>(glGetString(GL_VERSION)));
   return true;
 }

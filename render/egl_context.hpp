@@ -44,4 +44,8 @@ class EglContext {
 
 const char* toString(EglPlatform platform);
 
+// Whether the renderer of the context current on this thread runs on the CPU (as
+// EglContext::software() says of its own).
+bool softwareRenderer();
+
 }  // namespace surroundd::render

@@ -7,6 +7,7 @@
 #include <fmt/core.h>
 #include <opencv2/imgproc.hpp>
 
+#include "render/egl_context.hpp"
 #include "render/render_error.hpp"
 
 namespace surroundd::render {
@@ -29,6 +30,7 @@ SurroundView::SurroundView(const SurroundScene& scene, cv::Size size, ViewKind v
       size_(size),
       view_(view),
       settings_(settings),
+      readAtCollect_(softwareRenderer()),
       from_(view),
       picture_(size, CV_8UC3) {
   if (size.width <= 0 || size.height <= 0 || size.width % 2 != 0 || size.height % 2 != 0) {
@@ -139,17 +141,32 @@ void SurroundView::draw(double timeS) {
     drawScene(view_, timeS, kPicture);
     glDisable(GL_BLEND);
   }
-  glBindBuffer(GL_PIXEL_PACK_BUFFER, readBuffer_.name());
-  glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  glReadPixels(0, 0, size_.width, size_.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
-  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  if (readAtCollect_) {
+    glFlush();
+  } else {
+    startReadBack();
+  }
+  readStarted_ = !readAtCollect_;
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   gl::check("drawing a surround view");
   pending_ = true;
 }
 
+void SurroundView::startReadBack() {
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, readBuffer_.name());
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(0, 0, size_.width, size_.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  readStarted_ = true;
+}
+
 const cv::Mat& SurroundView::collect() {
   if (!pending_) return picture_;
+  if (!readStarted_) {
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.name());
+    startReadBack();
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  }
   glBindBuffer(GL_PIXEL_PACK_BUFFER, readBuffer_.name());
   const void* mapped = glMapBufferRange(GL_PIXEL_PACK_BUFFER, 0,
                                         static_cast<GLsizeiptr>(size_.area()) * 4, GL_MAP_READ_BIT);
@@ -221,6 +238,8 @@ cv::Mat SurroundView::panoramaPositions(double timeS) const {
 
 const cv::Mat& SurroundView::guidelineLayer(double timeS) {
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.name());
+  // The pending picture leaves the framebuffer before the guidelines are drawn into it.
+  if (pending_ && !readStarted_) startReadBack();
   glClearColor(0, 0, 0, 1);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   // The 3D part of the view: all of it, or the split view's left half.

@@ -2,9 +2,9 @@
 // One rendered output of the surround scene: a framebuffer of the output's size, the view shown
 // in it (switchable at any time), and an asynchronous read-back through a pixel buffer object.
 //
-// Per frame: draw() renders and starts the read-back; the caller does other work (the next
-// frame's stitch) while the GPU finishes; collect() then waits for the pixels. Nothing is
-// allocated per frame.
+// Per frame: draw() renders and starts the read-back (on a renderer that runs on the CPU: starts
+// the rasterization); the caller does other work (the next frame's stitch) while the GPU
+// finishes; collect() then waits for the pixels. Nothing is allocated per frame.
 
 #include <chrono>
 #include <optional>
@@ -66,6 +66,8 @@ class SurroundView {
 
  private:
   void drawScene(ViewKind view, double timeS, SurroundScene::Pass pass) const;
+  // glReadPixels of this view's framebuffer (bound) into readBuffer_.
+  void startReadBack();
   // How far the switch of view has come at `timeS`, 0..1; 1 when none is under way (and it ends
   // there). Its start is the first draw after setView().
   double transitionProgress(double timeS);
@@ -78,8 +80,15 @@ class SurroundView {
   gl::Renderbuffer colour_;
   gl::Renderbuffer depth_;
   gl::Buffer readBuffer_;
-  bool pending_ = false;
-  ViewKind from_;  // the view a switch under way started from
+  // Where the read-back starts. A GPU copies into the pixel buffer on its own, so the copy is
+  // queued right after the draw. A renderer on the CPU (llvmpipe) rasterizes on its own threads
+  // once flushed, but its glReadPixels into a buffer waits for all of it (12-20 ms at 1280x720,
+  // measured here): there the draw is only flushed, rasterized while the next set is stitched,
+  // and read in collect().
+  bool readAtCollect_;
+  bool pending_ = false;      // drawn, not collected
+  bool readStarted_ = false;  // the pending picture is on its way into readBuffer_
+  ViewKind from_;             // the view a switch under way started from
   bool transitioning_ = false;
   std::optional<double> transitionStartS_;
   DrawnPicture drawn_;

@@ -413,6 +413,24 @@ TEST_F(SurroundViewTest, OrbitMovesWithTimeAndReadBackIsCollectedOnce) {
   EXPECT_GT(cv::norm(first, later, cv::NORM_L1) / static_cast<double>(first.total()), 10.0);
 }
 
+// On llvmpipe draw() only starts the rasterization and collect() reads the framebuffer: a guideline
+// layer drawn into that framebuffer in between must not become the pending picture.
+TEST_F(SurroundViewTest, APendingPictureOutlivesAGuidelineLayerDrawnBeforeItIsCollected) {
+  Rendering rendering(processing::MeshModel::kBowl, {320, 240}, ViewKind::kTop);
+  std::vector<GuidelineVertex> vertices;
+  guidelines(CarDimensions{}, GuidelineSettings{}, Travel::kReverse, 0, vertices);
+  rendering.scene.reserveGuidelines(vertices.size());
+  rendering.scene.setGuidelines(vertices);
+  const cv::Mat expected = rendering.draw();
+  rendering.surround.draw(0);
+  const cv::Mat layer = rendering.surround.guidelineLayer(0).clone();
+  EXPECT_GT(cv::countNonZero(layer.reshape(1)), 0) << "the layer shows the guidelines";
+  EXPECT_GT(cv::norm(layer, expected, cv::NORM_L1) / static_cast<double>(expected.total()), 10.0)
+      << "the layer differs from the picture";
+  ASSERT_TRUE(rendering.surround.pending());
+  EXPECT_EQ(cv::norm(rendering.surround.collect(), expected, cv::NORM_INF), 0.0);
+}
+
 TEST_F(SurroundViewTest, RefusesPicturesOfTheWrongSize) {
   Rendering rendering(processing::MeshModel::kBowl, {320, 240}, ViewKind::kTop);
   EXPECT_THROW(rendering.scene.uploadPanorama(cv::Mat(100, 200, CV_8UC3)), std::invalid_argument);
