@@ -226,7 +226,7 @@ TEST_F(SurroundViewTest, GuidelinesLandWhereTheSteeringModelPutsThem) {
   const CarDimensions car;
   std::vector<GuidelineVertex> vertices;
   // The middle of the pixels of `colour` in a 9 x 9 window about `at`; none if there are none.
-  const auto middleOf = [](const cv::Mat& picture, cv::Point2d at, cv::Vec3b colour) {
+  const auto middleOf = [](const cv::Mat& picture, cv::Point2d at, const cv::Vec3b& colour) {
     cv::Point2d sum(0, 0);
     int count = 0;
     for (int y = static_cast<int>(std::lround(at.y)) - 4; y <= std::lround(at.y) + 4; ++y) {
