@@ -141,12 +141,12 @@ void SurroundView::draw(double timeS) {
     drawScene(view_, timeS, kPicture);
     glDisable(GL_BLEND);
   }
+  readStarted_ = false;
   if (readAtCollect_) {
     glFlush();
   } else {
     startReadBack();
   }
-  readStarted_ = !readAtCollect_;
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   gl::check("drawing a surround view");
   pending_ = true;
