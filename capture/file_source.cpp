@@ -114,7 +114,6 @@ struct FileSource::Impl {
   bool setUpConverter(const AVFrame& frame);
   Timestamp timestampOf(const AVFrame& frame) const;
   ReadStatus fault(std::string message);
-  void pace(Timestamp timestamp) { pacer.waitFor(timestamp - firstTimestamp); }
   std::uint64_t countFrames(const AVStream& stream) const;
 };
 
@@ -336,11 +335,12 @@ bool isStillPicturePath(const std::filesystem::path& path) {
   return std::ranges::find(kPictures, extension) != kPictures.end();
 }
 
-FileSource::FileSource(std::string cameraName, FileSourceSettings settings)
+FileSource::FileSource(std::string cameraName, FileSourceSettings settings,
+                       std::shared_ptr<ReplayStart> start)
     : impl_(std::make_unique<Impl>()) {
   impl_->camera = std::move(cameraName);
   impl_->settings = std::move(settings);
-  impl_->pacer = ReplayPacer(impl_->settings.pacing);
+  impl_->pacer = ReplayPacer(impl_->settings.pacing, std::move(start));
   impl_->open();
 }
 
@@ -365,7 +365,7 @@ ReadStatus FileSource::read(Frame& out) {
     s.still.copyTo(out.image);
     out.timestamp = s.firstTimestamp + static_cast<std::int64_t>(s.framesRead) * s.period;
     out.sequence = s.framesRead++;
-    s.pace(out.timestamp);
+    s.pacer.waitFor(out.timestamp);
     return ReadStatus::kFrame;
   }
   if (!s.haveDecoded) {
@@ -393,7 +393,7 @@ ReadStatus FileSource::read(Frame& out) {
   s.lastTimestamp = std::max(s.lastTimestamp, fileTimestamp);
   out.timestamp = fileTimestamp + s.loopOffset;
   out.sequence = s.framesRead++;
-  s.pace(out.timestamp);
+  s.pacer.waitFor(out.timestamp);
   return ReadStatus::kFrame;
 }
 

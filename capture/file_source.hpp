@@ -40,8 +40,10 @@ class FileSource final : public FrameSource {
  public:
   // Opens the file and decodes its first frame, so that a file that cannot deliver one fails here.
   // Throws CaptureError naming the camera and the file when it is missing, unreadable, not a video,
-  // or has no decodable video stream.
-  FileSource(std::string cameraName, FileSourceSettings settings);
+  // or has no decodable video stream. `start`: where its real-time pacing counts from, shared with
+  // the rig's other replayed cameras (ReplayStart); none: its own first frame.
+  FileSource(std::string cameraName, FileSourceSettings settings,
+             std::shared_ptr<ReplayStart> start = nullptr);
   ~FileSource() override;
 
   cv::Size frameSize() const override;

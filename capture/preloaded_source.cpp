@@ -147,11 +147,12 @@ void PreloadedSource::Impl::load() {
   passShift = loopShift(first, last, period);
 }
 
-PreloadedSource::PreloadedSource(std::string cameraName, PreloadSettings settings)
+PreloadedSource::PreloadedSource(std::string cameraName, PreloadSettings settings,
+                                 std::shared_ptr<ReplayStart> start)
     : impl_(std::make_unique<Impl>()) {
   impl_->camera = std::move(cameraName);
   impl_->settings = std::move(settings);
-  impl_->pacer = ReplayPacer(impl_->settings.file.pacing);
+  impl_->pacer = ReplayPacer(impl_->settings.file.pacing, std::move(start));
   impl_->load();
 }
 
@@ -203,7 +204,7 @@ ReadStatus PreloadedSource::read(Frame& out) {
   if (out.concealedErrors) s.lastError = held.concealed;
   out.timestamp = held.timestamp + s.loopOffset;
   out.sequence = s.framesRead++;
-  s.pacer.waitFor(out.timestamp - s.frames.front().timestamp);
+  s.pacer.waitFor(out.timestamp);
   return ReadStatus::kFrame;
 }
 

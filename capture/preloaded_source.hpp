@@ -45,8 +45,9 @@ class PreloadedSource final : public FrameSource {
   // Decodes the whole file. Throws CaptureError naming the camera and the file: as FileSource's
   // constructor does, for a format other than YUYV, UYVY or NV12, for a size the format cannot
   // hold (YUYV, UYVY: even width; NV12: even width and height), when the frames would take more
-  // than maxBytes, or when no frame decodes.
-  PreloadedSource(std::string cameraName, PreloadSettings settings);
+  // than maxBytes, or when no frame decodes. `start`: as FileSource's.
+  PreloadedSource(std::string cameraName, PreloadSettings settings,
+                  std::shared_ptr<ReplayStart> start = nullptr);
   ~PreloadedSource() override;
 
   cv::Size frameSize() const override;

@@ -20,7 +20,8 @@ constexpr double kBytesPerMib = 1024.0 * 1024.0;
 // preloaded before it (`before`: their names and bytes).
 std::unique_ptr<capture::PreloadedSource> openPreloaded(
     const Config& config, const RigCamera& camera,
-    std::span<const std::pair<std::string, std::uint64_t>> before) {
+    std::span<const std::pair<std::string, std::uint64_t>> before,
+    std::shared_ptr<capture::ReplayStart> start) {
   capture::PreloadSettings settings;
   settings.file = *camera.source;
   settings.file.pacing = config.capture.pacing;
@@ -38,7 +39,8 @@ std::unique_ptr<capture::PreloadedSource> openPreloaded(
       "capture.preload_max_mb: {} for every preloaded camera together{}",
       config.capture.preloadMaxMb,
       holders.empty() ? "" : fmt::format(", less what the cameras before it hold: {}", holders));
-  return std::make_unique<capture::PreloadedSource>(camera.calibration.name, settings);
+  return std::make_unique<capture::PreloadedSource>(camera.calibration.name, settings,
+                                                    std::move(start));
 }
 
 }  // namespace
@@ -48,6 +50,8 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
   const auto poolFrames = static_cast<std::size_t>(config.capture.queueFrames) + 2;
   std::vector<std::unique_ptr<capture::CameraStream>> cameras;
   std::vector<std::pair<std::string, std::uint64_t>> preloadedBytes;  // per camera so far
+  // The replayed cameras play on one clock, as cameras triggered together would deliver.
+  const auto replayStart = std::make_shared<capture::ReplayStart>();
   for (const auto& camera : config.cameras) {
     const auto& name = camera.calibration.name;
     std::unique_ptr<capture::FrameSource> source;
@@ -61,7 +65,7 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
                            capture::toString(device->format()));
       source = std::move(device);
     } else if (camera.preload) {
-      auto preloaded = openPreloaded(config, camera, preloadedBytes);
+      auto preloaded = openPreloaded(config, camera, preloadedBytes, replayStart);
       origin = fmt::format("{} (preloaded as {}, {:.1f} MiB)", camera.source->path.string(),
                            capture::toString(*camera.preload),
                            static_cast<double>(preloaded->bytes()) / kBytesPerMib);
@@ -71,7 +75,7 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
       auto settings = *camera.source;
       settings.pacing = config.capture.pacing;
       origin = settings.path.string();
-      source = std::make_unique<capture::FileSource>(name, settings);
+      source = std::make_unique<capture::FileSource>(name, settings, replayStart);
     }
     const cv::Size calibrated = camera.calibration.intrinsics.imageSize;
     if (source->frameSize() != calibrated) {
