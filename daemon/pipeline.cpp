@@ -19,7 +19,8 @@ namespace surroundd::daemon {
 namespace {
 
 // Between checks of the stop flag while a camera has nothing to deliver. Live, the wait is short:
-// the other cameras' frames must not wait behind a late one past the set's deadline.
+// the other cameras' frames must not wait behind a late one past the set's deadline; and so it is
+// while a picture is being drawn, to hand it over once finished.
 constexpr std::chrono::milliseconds kCameraWait{200};
 constexpr std::chrono::milliseconds kLiveCameraWait{2};
 constexpr std::chrono::seconds kProgressInterval{10};
@@ -168,6 +169,8 @@ RunSummary Pipeline::run(const std::atomic<bool>& stop, PipelineObserver* observ
       }
     }
     if (summary.rebuild) break;
+    // No set to work on: what has been drawn meanwhile goes out now, not with the next set.
+    if (surround_ != nullptr) surround_->deliverFinished(outputs_, times_);
     logFirstPicture();
     const auto now = Clock::now();
     outputs_.retry(now);
@@ -248,7 +251,9 @@ void Pipeline::fillNeeds(const std::atomic<bool>& stop) {
   for (std::size_t c = 0; c < cameras_.size() && !stop; ++c) {
     if (!synchronizer_.needs(c)) continue;
     capture::FrameRef frame;
-    switch (cameras_[c]->next(frame, live_ ? kLiveCameraWait : kCameraWait)) {
+    // While a picture is being drawn, the waits are short too: it goes out once finished.
+    const bool briefly = live_ || (surround_ != nullptr && SurroundStage::drawing(outputs_));
+    switch (cameras_[c]->next(frame, briefly ? kLiveCameraWait : kCameraWait)) {
       case capture::CameraStream::Next::kFrame:
         synchronizer_.offer(c, std::move(frame));
         break;

@@ -16,4 +16,16 @@ void check(const char* what) {
   }
 }
 
+void Fence::place() {
+  glDeleteSync(sync_);
+  sync_ = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+  glFlush();
+}
+
+bool Fence::passed() const {
+  if (sync_ == nullptr) return true;
+  const GLenum state = glClientWaitSync(sync_, 0, 0);
+  return state == GL_ALREADY_SIGNALED || state == GL_CONDITION_SATISFIED;
+}
+
 }  // namespace surroundd::render::gl

@@ -50,6 +50,29 @@ struct VertexArrayKind {
   static void destroy(GLsizei n, const GLuint* names) { glDeleteVertexArrays(n, names); }
 };
 
+// A fence in the command stream: passed once every command issued before it has completed.
+class Fence {
+ public:
+  Fence() = default;
+  ~Fence() { glDeleteSync(sync_); }  // none placed: a null sync, which GL ignores
+  Fence(Fence&& other) noexcept : sync_(std::exchange(other.sync_, nullptr)) {}
+  Fence& operator=(Fence&& other) noexcept {
+    std::swap(sync_, other.sync_);
+    return *this;
+  }
+  Fence(const Fence&) = delete;
+  Fence& operator=(const Fence&) = delete;
+
+  // After the commands issued so far, in place of the last one; flushed, so that it passes
+  // without another GL call.
+  void place();
+  // Whether it has passed, without waiting; true where none was placed.
+  bool passed() const;
+
+ private:
+  GLsync sync_ = nullptr;
+};
+
 using Texture = Object<TextureKind>;
 using Buffer = Object<BufferKind>;
 using Framebuffer = Object<FramebufferKind>;

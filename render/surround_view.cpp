@@ -142,11 +142,8 @@ void SurroundView::draw(double timeS) {
     glDisable(GL_BLEND);
   }
   readStarted_ = false;
-  if (readAtCollect_) {
-    glFlush();
-  } else {
-    startReadBack();
-  }
+  if (!readAtCollect_) startReadBack();
+  drawnFence_.place();
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   gl::check("drawing a surround view");
   pending_ = true;

@@ -4,7 +4,8 @@
 //
 // Per frame: draw() renders and starts the read-back (on a renderer that runs on the CPU: starts
 // the rasterization); the caller does other work (the next frame's stitch) while the GPU
-// finishes; collect() then waits for the pixels. Nothing is allocated per frame.
+// finishes, or collects as soon as finished() says it would not wait; collect() waits for the
+// pixels. Nothing is allocated per frame.
 
 #include <chrono>
 #include <optional>
@@ -45,6 +46,8 @@ class SurroundView {
   // Renders the scene as it was last uploaded; `timeS` moves the orbiting eye.
   void draw(double timeS);
   bool pending() const { return pending_; }
+  // Whether the pending picture can be collected without waiting: drawn (and on a GPU, copied).
+  bool finished() const { return pending_ && drawnFence_.passed(); }
   // The last draw(): when, and whether the switch of view had ended by then.
   DrawnPicture drawn() const { return drawn_; }
   // The picture of the last draw(), 8-bit BGR; valid until the next collect().
@@ -86,6 +89,7 @@ class SurroundView {
   // measured here): there the draw is only flushed, rasterized while the next set is stitched,
   // and read in collect().
   bool readAtCollect_;
+  gl::Fence drawnFence_;      // after the last draw (and its read-back, where it starts there)
   bool pending_ = false;      // drawn, not collected
   bool readStarted_ = false;  // the pending picture is on its way into readBuffer_
   ViewKind from_;             // the view a switch under way started from

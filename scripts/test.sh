@@ -88,11 +88,12 @@ if [ "$sanitizers" = yes ]; then
   # locks, which TSan cannot see, so every hand-over (a source given to the server's main loop, a
   # buffer to its pipeline) is reported as a race inside GLib; what the RTSP sink itself shares
   # is under one mutex or atomic (rtsp_stream_sink.cpp).
-  tsan_tests="work_pool_test synchronizer_test file_source_test preloaded_source_test
-    v4l2_source_test camera_health_test queued_sink_test http_stream_sink_test replay_test
-    preload_replay_test processing_backend_test fault_replay_test fault_isolation_test
-    output_retry_test output_files_test recording_test still_rig_test pipeline_report_test
-    control_server_test service_notifier_test service_test end_to_end_test"
+  tsan_tests="work_pool_test synchronizer_test replay_clock_test file_source_test
+    preloaded_source_test v4l2_source_test camera_health_test queued_sink_test
+    http_stream_sink_test replay_test preload_replay_test
+    processing_backend_test fault_replay_test fault_isolation_test output_retry_test
+    output_files_test recording_test still_rig_test pipeline_report_test control_server_test
+    service_notifier_test service_test end_to_end_test"
   begin "tsan build"
   # Only these tests and the programs they run are built; their recordings are made by the ci
   # build's generator too, so it need not be built a third time.

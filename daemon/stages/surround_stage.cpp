@@ -264,9 +264,16 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
   times.lap(Stage::kOutput);
 }
 
-void SurroundStage::deliver(PipelineOutputs& outputs, StageTimes* times) {
+bool SurroundStage::drawing(const PipelineOutputs& outputs) {
+  return std::ranges::any_of(outputs.pictures(), [](const auto& output) {
+    return output.view && output.sink && output.view->pending();
+  });
+}
+
+void SurroundStage::deliver(PipelineOutputs& outputs, StageTimes* times, Pending which) {
   for (auto& output : outputs.pictures()) {
     if (!output.view || !output.view->pending()) continue;
+    if (which == Pending::kFinished && !output.view->finished()) continue;
     if (times != nullptr) times->skip();
     cv::Mat picture;
     outputs.guarded(output, [&] { picture = output.view->collect(); });

@@ -1,8 +1,9 @@
 #pragma once
 // The surround views: the panorama textured onto the bowl / flat / 360 mesh around the car model
 // (render/surround_scene.hpp), drawn with OpenGL ES into each surround output's own view. A view's
-// read-back is collected while the next set is stitched, so each output gets its picture one set
-// later (and the last one when the run ends).
+// picture is drawn while the next set is stitched and collected when that set comes, so each
+// output gets it one set later; or sooner, when the pipeline has no set to work on and the picture
+// is finished (deliverFinished()). The last one goes out when the run ends.
 //
 // Views that do not move (top, 360, and orbit and split with a still eye; render.view_lut) are
 // not drawn per set: the first time an output shows one, the renderer maps where each of its
@@ -64,6 +65,13 @@ class SurroundStage final : public PipelineStage {
 
   void process(FrameWork& work, StageTimes& times) override;
   void finish(PipelineOutputs& outputs) override;
+  // Whether a working output's view has a picture drawn and not yet handed over.
+  static bool drawing(const PipelineOutputs& outputs);
+  // Hands over the pictures whose drawing has finished: for when no set is waiting, so that a
+  // picture goes out as soon as it is drawn rather than when the next set comes.
+  void deliverFinished(PipelineOutputs& outputs, StageTimes& times) {
+    deliver(outputs, &times, Pending::kFinished);
+  }
   // The view of the last set, drawn again for an output that writes it at the end.
   cv::Mat redraw(PipelineOutputs::PictureOutput& output);
 
@@ -79,8 +87,9 @@ class SurroundStage final : public PipelineStage {
   void setVehicleSignals(const vehicle::VehicleSignals& signals);
 
  private:
-  // Hands each view's pending picture (the previous set's) to its output.
-  void deliver(PipelineOutputs& outputs, StageTimes* times);
+  enum class Pending { kAll, kFinished };
+  // Hands each view's pending picture (the previous set's; or only those finished) to its output.
+  void deliver(PipelineOutputs& outputs, StageTimes* times, Pending which = Pending::kAll);
 
   // A fixed view's picture, and the renderer's car and background to lay over it.
   struct FixedView {

@@ -5,6 +5,7 @@
 #include "render/surround_view.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include <numbers>
 #include <numeric>
 #include <optional>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -429,6 +431,24 @@ TEST_F(SurroundViewTest, APendingPictureOutlivesAGuidelineLayerDrawnBeforeItIsCo
       << "the layer differs from the picture";
   ASSERT_TRUE(rendering.surround.pending());
   EXPECT_EQ(cv::norm(rendering.surround.collect(), expected, cv::NORM_INF), 0.0);
+}
+
+// finished() says when collect() would not wait: never before a draw or after the collection,
+// and once the drawing is done (polled, as the pipeline does while it waits for frames), with
+// the picture the draw made.
+TEST_F(SurroundViewTest, APictureIsFinishedOnceDrawnAndNotOnceCollected) {
+  Rendering rendering(processing::MeshModel::kBowl, {320, 240}, ViewKind::kTop);
+  EXPECT_FALSE(rendering.surround.finished());
+  const cv::Mat expected = rendering.draw();
+  EXPECT_FALSE(rendering.surround.finished());
+  rendering.surround.draw(0);
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!rendering.surround.finished() && std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_TRUE(rendering.surround.finished());
+  EXPECT_EQ(cv::norm(rendering.surround.collect(), expected, cv::NORM_INF), 0.0);
+  EXPECT_FALSE(rendering.surround.finished());
 }
 
 TEST_F(SurroundViewTest, RefusesPicturesOfTheWrongSize) {
