@@ -22,8 +22,10 @@
 namespace surroundd::daemon {
 namespace {
 
-const std::filesystem::path kRecording =
-    std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
+// A function: a static path's construction could throw before main (cert-err58-cpp).
+std::filesystem::path recording() {
+  return std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
+}
 constexpr std::uint64_t kSets = 60;  // two seconds at the pictures' 30 fps
 
 // Stops the run after kSets frame sets, noting each camera's health then.
@@ -50,10 +52,10 @@ class StillRigTest : public ::testing::Test {
   // the first camera.
   std::filesystem::path writeStillRig(const std::string& extra = "",
                                       std::optional<double> fps = std::nullopt) {
-    YAML::Node rig = YAML::LoadFile((kRecording / "rig.yaml").string());
+    YAML::Node rig = YAML::LoadFile((recording() / "rig.yaml").string());
     for (std::size_t c = 0; c < rig["cameras"].size(); ++c) {
       YAML::Node camera = rig["cameras"][c];
-      const auto video = kRecording / camera["source"]["file"].as<std::string>();
+      const auto video = recording() / camera["source"]["file"].as<std::string>();
       capture::FileSource source("check", {video, 30.0, false, capture::Pacing::kAsFastAsPossible});
       capture::Frame frame;
       frame.image.create(source.frameSize(), CV_8UC3);
