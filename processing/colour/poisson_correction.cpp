@@ -79,8 +79,8 @@ PoissonColourCorrection::PoissonColourCorrection(const Rig& rig, const PanoramaS
   full_ = &configurationFor(activeCameras_);
   active_ = full_;
   const CorrectionDomain& domain = full_->domain;
-  field_.create(domain.grid, CV_32FC3);
-  field_.setTo(cv::Scalar::all(0));
+  fieldStorage_.assign(static_cast<std::size_t>(domain.grid.area()) * 3 + 1, 0.0F);
+  field_ = cv::Mat(domain.grid, CV_32FC3, fieldStorage_.data());
   for (int r = 0; r < domain.block; ++r) {
     const double t = (r + 0.5) / domain.block - 0.5;
     phaseWeights_.push_back(catmullRom(t - std::floor(t)));
@@ -392,22 +392,35 @@ PoissonColourCorrection::ViewSamples PoissonColourCorrection::viewSamples(
   return samples;
 }
 
-void PoissonColourCorrection::applyAt(const ViewSamples& samples, cv::Mat& picture) {
+void PoissonColourCorrection::applyAt(const ViewSamples& samples, cv::Mat& picture,
+                                      KernelPath path) {
   if (picture.type() != CV_8UC3 || picture.size() != samples.size) {
     throw std::invalid_argument(
         fmt::format("colour correction: expected an 8-bit BGR picture of {}x{}", samples.size.width,
                     samples.size.height));
   }
-  const auto rows = settings_.field == CorrectionField::kMultiplicative
-                        ? &PoissonColourCorrection::applyAtRows<CorrectionField::kMultiplicative>
-                        : &PoissonColourCorrection::applyAtRows<CorrectionField::kAdditive>;
+  if (!kernelPathBuilt(path)) {
+    throw std::invalid_argument(
+        fmt::format("colour correction: this build has no {} kernels", kernelPathName(path)));
+  }
+  const bool multiplicative = settings_.field == CorrectionField::kMultiplicative;
+  auto rows =
+      multiplicative
+          ? &PoissonColourCorrection::applyAtRows<CorrectionField::kMultiplicative, kNativeKernels>
+          : &PoissonColourCorrection::applyAtRows<CorrectionField::kAdditive, kNativeKernels>;
+  if (path == KernelPath::kPortable) {
+    rows = multiplicative ? &PoissonColourCorrection::applyAtRows<CorrectionField::kMultiplicative,
+                                                                  KernelPath::kPortable>
+                          : &PoissonColourCorrection::applyAtRows<CorrectionField::kAdditive,
+                                                                  KernelPath::kPortable>;
+  }
   pool_.parallelFor(
       samples.size.height,
       [&](int first, int last) { (this->*rows)(first, last, samples, picture); },
       pool_.threads() * 4);
 }
 
-template <CorrectionField kField>
+template <CorrectionField kField, KernelPath kPath>
 void PoissonColourCorrection::applyAtRows(int first, int last, const ViewSamples& samples,
                                           cv::Mat& picture) const {
   const auto* field = field_.ptr<float>();
@@ -423,12 +436,27 @@ void PoissonColourCorrection::applyAtRows(int first, int last, const ViewSamples
       const float* bottomRight = bottomLeft + static_cast<std::ptrdiff_t>(tap.right) * 3;
       const float weight = tap.share * (1.0f / 256);
       const bool whole = tap.share == 256;
-      for (int c = 0; c < 3; ++c) {
-        const float upper = topLeft[c] + tap.fx * (topRight[c] - topLeft[c]);
-        const float lower = bottomLeft[c] + tap.fx * (bottomRight[c] - bottomLeft[c]);
-        const float value = upper + tap.fy * (lower - upper);
-        pixel[c] = roundedLevel(
-            correctedLevel<kField>(static_cast<float>(pixel[c]), value, weight, whole));
+      if constexpr (kPath == KernelPath::kPortable) {
+        for (int c = 0; c < 3; ++c) {
+          const float upper = topLeft[c] + tap.fx * (topRight[c] - topLeft[c]);
+          const float lower = bottomLeft[c] + tap.fx * (bottomRight[c] - bottomLeft[c]);
+          const float value = upper + tap.fy * (lower - upper);
+          pixel[c] = roundedLevel(
+              correctedLevel<kField>(static_cast<float>(pixel[c]), value, weight, whole));
+        }
+      } else {
+        // The same operations on the three channels as lanes of one vector; lane 3 reads the next
+        // block's first channel (fieldStorage_ has a float to spare at its end) and is dropped.
+        const FloatLanes topLeftLanes = loadLanes(topLeft);
+        const FloatLanes bottomLeftLanes = loadLanes(bottomLeft);
+        const FloatLanes upper = topLeftLanes + tap.fx * (loadLanes(topRight) - topLeftLanes);
+        const FloatLanes lower =
+            bottomLeftLanes + tap.fx * (loadLanes(bottomRight) - bottomLeftLanes);
+        const FloatLanes value = upper + tap.fy * (lower - upper);
+        const FloatLanes level = {static_cast<float>(pixel[0]), static_cast<float>(pixel[1]),
+                                  static_cast<float>(pixel[2]), 0};
+        const IntLanes rounded = roundedLevel(correctedLevel<kField>(level, value, weight, whole));
+        for (int c = 0; c < 3; ++c) pixel[c] = static_cast<std::uint8_t>(rounded[c]);
       }
     }
   }

@@ -132,8 +132,8 @@ class PoissonColourCorrection {
   // Adds the fields to a picture of samples.size made from the same frames as the last update().
   // The fields are sampled bilinearly from the block grid, where apply() upsamples them
   // bicubically: they are smooth, so the two differ by a fraction of a level, at a quarter of the
-  // taps.
-  void applyAt(const ViewSamples& samples, cv::Mat& picture);
+  // taps. `path`: as apply()'s.
+  void applyAt(const ViewSamples& samples, cv::Mat& picture, KernelPath path = kNativeKernels);
 
   const std::vector<SeamReport>& seams() const { return seamReports_; }
 
@@ -156,7 +156,7 @@ class PoissonColourCorrection {
   void noteOnce(std::vector<std::uint8_t>& said, std::size_t seam, std::string note);
   template <CorrectionField kField, KernelPath kPath>
   void applyRows(int first, int last, cv::Mat& panorama, std::vector<float>& columnBuffer) const;
-  template <CorrectionField kField>
+  template <CorrectionField kField, KernelPath kPath>
   void applyAtRows(int first, int last, const ViewSamples& samples, cv::Mat& picture) const;
 
   const PanoramaLut& lut_;
@@ -176,6 +176,9 @@ class PoissonColourCorrection {
   std::vector<float> window_;          // running median along a seam
   std::vector<std::uint8_t> resolve_;  // per region
   std::vector<float> stepScratch_;     // per block of a seam: its step without and with the field
+  // CV_32FC3 over fieldStorage_, which has one float past the last block: the vector applies read
+  // four floats for a block's three channels.
+  std::vector<float> fieldStorage_;
   cv::Mat field_;
   // Upsampling: bicubic weights for each sub-block phase (Catmull-Rom), each pixel column's first
   // tap (in blocks, -2..width), the rows that have anything to correct, and one row buffer per

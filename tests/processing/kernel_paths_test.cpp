@@ -7,12 +7,14 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <span>
 #include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "common/work_pool.hpp"
 #include "processing/colour/poisson_correction.hpp"
@@ -156,6 +158,49 @@ TEST_F(KernelPathsTest, EveryPathAppliesTheSameCorrection) {
       cv::Mat panorama = raw.clone();
       poisson.apply(panorama, path);
       EXPECT_EQ(cv::norm(panorama, portable, cv::NORM_INF), 0.0);
+    }
+  }
+}
+
+// The same for a picture that samples the panorama elsewhere (a fixed view): a 320x200 view that
+// looks at the whole panorama from sub-pixel positions, with a band that shows none of it; the
+// picture the panorama resized to it.
+TEST_F(KernelPathsTest, EveryPathAppliesTheSameCorrectionToAView) {
+  Stitcher stitcher(lut_, pool_);
+  cv::Mat raw;
+  stitcher.stitch(frames_, raw);
+  const cv::Size view(320, 200);
+  const float across = static_cast<float>(lut_.size.width) / static_cast<float>(view.width);
+  const float down = static_cast<float>(lut_.size.height - 1) / static_cast<float>(view.height);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  cv::Mat positions(view, CV_32FC2);
+  for (int v = 0; v < view.height; ++v) {
+    for (int u = 0; u < view.width; ++u) {
+      const bool shown = v < 90 || v >= 110;
+      positions.at<cv::Vec2f>(v, u) = shown ? cv::Vec2f((static_cast<float>(u) + 0.37F) * across,
+                                                        (static_cast<float>(v) + 0.61F) * down)
+                                            : cv::Vec2f(nan, nan);
+    }
+  }
+  cv::Mat picture;
+  cv::resize(raw, picture, view, 0, 0, cv::INTER_AREA);
+  for (const CorrectionField field :
+       {CorrectionField::kMultiplicative, CorrectionField::kAdditive}) {
+    SCOPED_TRACE(correctionFieldName(field));
+    ColourCorrectionSettings correction;
+    correction.field = field;
+    PoissonColourCorrection poisson(truth_.rig, testing::settingsFor(truth_), lut_, correction,
+                                    pool_);
+    poisson.update(frames_);
+    const auto samples = poisson.viewSamples(positions);
+    cv::Mat portable = picture.clone();
+    poisson.applyAt(samples, portable, KernelPath::kPortable);
+    ASSERT_GT(cv::norm(portable, picture, cv::NORM_L1), 1000.0);  // a field that changes it
+    for (const KernelPath path : kKernelPaths) {
+      SCOPED_TRACE(kernelPathName(path));
+      cv::Mat corrected = picture.clone();
+      poisson.applyAt(samples, corrected, path);
+      EXPECT_EQ(cv::norm(corrected, portable, cv::NORM_INF), 0.0);
     }
   }
 }
