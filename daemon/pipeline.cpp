@@ -123,7 +123,11 @@ void Pipeline::setVehicleSignals(const vehicle::VehicleSignals& signals) {
 
 PipelineReport Pipeline::report() const {
   PipelineReport report;
-  report.elapsed = Clock::now() - start_;
+  const auto now = Clock::now();
+  report.elapsed = now - start_;
+  if (firstSetAt_) {
+    report.setSpan = std::max(now, lastSetAt_ + cameras_.front()->nominalPeriod()) - *firstSetAt_;
+  }
   report.frameSets = frameSets_;
   report.staleDropped = staleDropped_;
   report.sync = synchronizer_.stats();
@@ -268,6 +272,8 @@ void Pipeline::fillNeeds(const std::atomic<bool>& stop) {
 
 void Pipeline::process(const capture::FrameSet& set) {
   times_.skip();
+  lastSetAt_ = Clock::now();
+  if (!firstSetAt_) firstSetAt_ = lastSetAt_;
   if (!firstTimestamp_) firstTimestamp_ = set.timestamp;
   lastStreamTime_ = set.timestamp - *firstTimestamp_;
   FrameWork work{.set = set,

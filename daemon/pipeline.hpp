@@ -26,6 +26,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -147,6 +148,8 @@ class Pipeline {
   std::uint64_t frameSets_ = 0;
   std::uint64_t staleDropped_ = 0;
   Clock::time_point start_{};
+  std::optional<Clock::time_point> firstSetAt_;  // when the pipeline began each: the first set
+  Clock::time_point lastSetAt_{};                // and the last
   Clock::time_point nextPageStatus_{};
   std::uint64_t failedSets_ = 0;
   int failedInARow_ = 0;

@@ -121,7 +121,7 @@ std::string statusText(const PipelineReport& report) {
                    "stage {:<9} p50 {:7.2f} ms  p99 {:7.2f} ms  ({} sets, {:.1f}/s)\n",
                    toString(static_cast<Stage>(s)), milliseconds(stage.quantile(0.5)),
                    milliseconds(stage.quantile(0.99)), stage.count(),
-                   static_cast<double>(stage.count()) / std::max(report.elapsed.count(), 1e-9));
+                   static_cast<double>(stage.count()) / std::max(report.setSpan.count(), 1e-9));
   }
   fmt::format_to(std::back_inserter(out), "frame rate: {}\n",
                  frameRateWithLimit(report.framesPerSecond()));

@@ -61,6 +61,11 @@ struct ViewSwitchTime {
 
 struct PipelineReport {
   std::chrono::duration<double> elapsed{0};
+  // From the first frame set to one nominal frame period after the last, or to now if that is
+  // later: the time the sets so far took, so that a rig delivering exactly its frame rate is
+  // measured at it (from the run's start, or to now, it would read a little under). 0 before the
+  // first set.
+  std::chrono::duration<double> setSpan{0};
   std::uint64_t frameSets = 0;
   std::uint64_t staleDropped = 0;  // live: complete sets skipped because a newer one was ready
   capture::SyncStats sync;
@@ -79,7 +84,7 @@ struct PipelineReport {
   std::string renderer;
 
   double framesPerSecond() const {
-    return elapsed.count() > 0 ? static_cast<double>(frameSets) / elapsed.count() : 0.0;
+    return setSpan.count() > 0 ? static_cast<double>(frameSets) / setSpan.count() : 0.0;
   }
 };
 

@@ -59,7 +59,8 @@ TEST(DurationHistogram, EdgesAndOutOfRangeDurations) {
 
 PipelineReport sampleReport() {
   PipelineReport report;
-  report.elapsed = std::chrono::seconds(10);
+  report.elapsed = std::chrono::seconds(11);
+  report.setSpan = std::chrono::seconds(10);  // the frame rate counts from the first set
   report.frameSets = 300;
   report.staleDropped = 4;
   report.sync.unmatchedDropped[1] = 2;
