@@ -259,22 +259,27 @@ int PoissonColourCorrection::update(std::span<const cv::Mat> frames, PixelFormat
   return iterations;
 }
 
-void PoissonColourCorrection::apply(cv::Mat& panorama, KernelPath path) {
+template <typename Instance>
+auto PoissonColourCorrection::kernelFor(KernelPath path, Instance instance) const {
   if (!kernelPathBuilt(path)) {
     throw std::invalid_argument(
         fmt::format("colour correction: this build has no {} kernels", kernelPathName(path)));
   }
-  const bool multiplicative = settings_.field == CorrectionField::kMultiplicative;
-  auto rows =
-      multiplicative
-          ? &PoissonColourCorrection::applyRows<CorrectionField::kMultiplicative, kNativeKernels>
-          : &PoissonColourCorrection::applyRows<CorrectionField::kAdditive, kNativeKernels>;
+  constexpr auto kMultiplicative = CorrectionField::kMultiplicative;
+  constexpr auto kAdditive = CorrectionField::kAdditive;
+  const bool multiplicative = settings_.field == kMultiplicative;
   if (path == KernelPath::kPortable) {
-    rows = multiplicative ? &PoissonColourCorrection::applyRows<CorrectionField::kMultiplicative,
-                                                                KernelPath::kPortable>
-                          : &PoissonColourCorrection::applyRows<CorrectionField::kAdditive,
-                                                                KernelPath::kPortable>;
+    return multiplicative ? instance.template operator()<kMultiplicative, KernelPath::kPortable>()
+                          : instance.template operator()<kAdditive, KernelPath::kPortable>();
   }
+  return multiplicative ? instance.template operator()<kMultiplicative, kNativeKernels>()
+                        : instance.template operator()<kAdditive, kNativeKernels>();
+}
+
+void PoissonColourCorrection::apply(cv::Mat& panorama, KernelPath path) {
+  const auto rows = kernelFor(path, []<CorrectionField kField, KernelPath kPath>() {
+    return &PoissonColourCorrection::applyRows<kField, kPath>;
+  });
   const int chunks = static_cast<int>(rowBuffers_.size());
   pool_.parallelFor(
       chunks,
@@ -399,21 +404,9 @@ void PoissonColourCorrection::applyAt(const ViewSamples& samples, cv::Mat& pictu
         fmt::format("colour correction: expected an 8-bit BGR picture of {}x{}", samples.size.width,
                     samples.size.height));
   }
-  if (!kernelPathBuilt(path)) {
-    throw std::invalid_argument(
-        fmt::format("colour correction: this build has no {} kernels", kernelPathName(path)));
-  }
-  const bool multiplicative = settings_.field == CorrectionField::kMultiplicative;
-  auto rows =
-      multiplicative
-          ? &PoissonColourCorrection::applyAtRows<CorrectionField::kMultiplicative, kNativeKernels>
-          : &PoissonColourCorrection::applyAtRows<CorrectionField::kAdditive, kNativeKernels>;
-  if (path == KernelPath::kPortable) {
-    rows = multiplicative ? &PoissonColourCorrection::applyAtRows<CorrectionField::kMultiplicative,
-                                                                  KernelPath::kPortable>
-                          : &PoissonColourCorrection::applyAtRows<CorrectionField::kAdditive,
-                                                                  KernelPath::kPortable>;
-  }
+  const auto rows = kernelFor(path, []<CorrectionField kField, KernelPath kPath>() {
+    return &PoissonColourCorrection::applyAtRows<kField, kPath>;
+  });
   pool_.parallelFor(
       samples.size.height,
       [&](int first, int last) { (this->*rows)(first, last, samples, picture); },

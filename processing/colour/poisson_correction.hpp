@@ -154,6 +154,10 @@ class PoissonColourCorrection {
   // Drops the data of seams the solved field makes worse; true when any was dropped.
   bool dropWorseningSeams();
   void noteOnce(std::vector<std::uint8_t>& said, std::size_t seam, std::string note);
+  // `instance.template operator()<kField, kPath>()` for this correction's field and `path`
+  // (a row kernel's instance); throws std::invalid_argument for a path this build lacks.
+  template <typename Instance>
+  auto kernelFor(KernelPath path, Instance instance) const;
   template <CorrectionField kField, KernelPath kPath>
   void applyRows(int first, int last, cv::Mat& panorama, std::vector<float>& columnBuffer) const;
   template <CorrectionField kField, KernelPath kPath>

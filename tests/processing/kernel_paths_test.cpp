@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <random>
 #include <span>
@@ -49,6 +50,30 @@ class KernelPathsTest : public ::testing::Test {
   }
   const std::vector<cv::Mat>& held(PixelFormat format) const {
     return held_[static_cast<std::size_t>(format)];
+  }
+  // For both fields: a correction fitted to the frames, applied to `picture` by `correct` on each
+  // path, gives the portable path's bytes, and changes the picture.
+  void expectEveryPathCorrectsAlike(
+      const cv::Mat& picture,
+      const std::function<void(PoissonColourCorrection&, cv::Mat&, KernelPath)>& correct) {
+    for (const CorrectionField field :
+         {CorrectionField::kMultiplicative, CorrectionField::kAdditive}) {
+      SCOPED_TRACE(correctionFieldName(field));
+      ColourCorrectionSettings correction;
+      correction.field = field;
+      PoissonColourCorrection poisson(truth_.rig, testing::settingsFor(truth_), lut_, correction,
+                                      pool_);
+      poisson.update(frames_);
+      cv::Mat portable = picture.clone();
+      correct(poisson, portable, KernelPath::kPortable);
+      ASSERT_GT(cv::norm(portable, picture, cv::NORM_L1), 1000.0);  // a field that changes it
+      for (const KernelPath path : kKernelPaths) {
+        SCOPED_TRACE(kernelPathName(path));
+        cv::Mat corrected = picture.clone();
+        correct(poisson, corrected, path);
+        EXPECT_EQ(cv::norm(corrected, portable, cv::NORM_INF), 0.0);
+      }
+    }
   }
 
   static constexpr std::array kFormats = {PixelFormat::kBgr, PixelFormat::kYuyv, PixelFormat::kUyvy,
@@ -142,24 +167,8 @@ TEST_F(KernelPathsTest, EveryPathAppliesTheSameCorrection) {
   Stitcher stitcher(lut_, pool_);
   cv::Mat raw;
   stitcher.stitch(frames_, raw);
-  for (const CorrectionField field :
-       {CorrectionField::kMultiplicative, CorrectionField::kAdditive}) {
-    SCOPED_TRACE(correctionFieldName(field));
-    ColourCorrectionSettings correction;
-    correction.field = field;
-    PoissonColourCorrection poisson(truth_.rig, testing::settingsFor(truth_), lut_, correction,
-                                    pool_);
-    poisson.update(frames_);
-    cv::Mat portable = raw.clone();
-    poisson.apply(portable, KernelPath::kPortable);
-    ASSERT_GT(cv::norm(portable, raw, cv::NORM_L1), 1000.0);  // a field that changes the picture
-    for (const KernelPath path : kKernelPaths) {
-      SCOPED_TRACE(kernelPathName(path));
-      cv::Mat panorama = raw.clone();
-      poisson.apply(panorama, path);
-      EXPECT_EQ(cv::norm(panorama, portable, cv::NORM_INF), 0.0);
-    }
-  }
+  expectEveryPathCorrectsAlike(raw, [](PoissonColourCorrection& poisson, cv::Mat& picture,
+                                       KernelPath path) { poisson.apply(picture, path); });
 }
 
 // The same for a picture that samples the panorama elsewhere (a fixed view): a 320x200 view that
@@ -184,25 +193,10 @@ TEST_F(KernelPathsTest, EveryPathAppliesTheSameCorrectionToAView) {
   }
   cv::Mat picture;
   cv::resize(raw, picture, view, 0, 0, cv::INTER_AREA);
-  for (const CorrectionField field :
-       {CorrectionField::kMultiplicative, CorrectionField::kAdditive}) {
-    SCOPED_TRACE(correctionFieldName(field));
-    ColourCorrectionSettings correction;
-    correction.field = field;
-    PoissonColourCorrection poisson(truth_.rig, testing::settingsFor(truth_), lut_, correction,
-                                    pool_);
-    poisson.update(frames_);
-    const auto samples = poisson.viewSamples(positions);
-    cv::Mat portable = picture.clone();
-    poisson.applyAt(samples, portable, KernelPath::kPortable);
-    ASSERT_GT(cv::norm(portable, picture, cv::NORM_L1), 1000.0);  // a field that changes it
-    for (const KernelPath path : kKernelPaths) {
-      SCOPED_TRACE(kernelPathName(path));
-      cv::Mat corrected = picture.clone();
-      poisson.applyAt(samples, corrected, path);
-      EXPECT_EQ(cv::norm(corrected, portable, cv::NORM_INF), 0.0);
-    }
-  }
+  expectEveryPathCorrectsAlike(
+      picture, [&](PoissonColourCorrection& poisson, cv::Mat& corrected, KernelPath path) {
+        poisson.applyAt(poisson.viewSamples(positions), corrected, path);
+      });
 }
 
 // Every weight pair (0..128 each) on 2x2 pictures of random bytes, of all 0 and of all 255 (the
