@@ -121,7 +121,7 @@ TEST_F(StillRigTest, AnAskedForFrozenCheckStillFindsTheStillFrozen) {
 // after kPacedSets sets.
 class HandedBeforeEachSet final : public PipelineObserver {
  public:
-  static constexpr std::uint64_t kPacedSets = 10;
+  static constexpr std::uint64_t kPacedSets = 12;
   explicit HandedBeforeEachSet(std::atomic<bool>& stop) : stop_(stop) {}
   void onLoop(Pipeline& /*pipeline*/, std::chrono::steady_clock::time_point /*now*/,
               std::uint64_t frameSets) override {
@@ -151,14 +151,15 @@ TEST_F(StillRigTest, ADrawnPictureGoesOutBeforeTheNextSetComes) {
   std::atomic<bool> stop{false};
   HandedBeforeEachSet observer(stop);
   pipeline.run(stop, &observer);
-  ASSERT_GE(observer.handed.size(), HandedBeforeEachSet::kPacedSets);
+  const std::size_t sets = observer.handed.size();
+  ASSERT_GE(sets, HandedBeforeEachSet::kPacedSets);
+  for (std::size_t k = 1; k < sets; ++k) EXPECT_LE(observer.handed[k], k) << k;
+  // Once running: the first sets may take longer than a period (shaders compiled, the encoder
+  // started; four of them under ThreadSanitizer). A 320x180 view is drawn in a few milliseconds;
+  // one of the last six sets may meet a stalled machine.
   std::size_t early = 0;
-  for (std::size_t k = 1; k < observer.handed.size(); ++k) {
-    EXPECT_LE(observer.handed[k], k) << k;
-    if (observer.handed[k] == k) ++early;
-  }
-  // A 320x180 view is drawn in a few milliseconds; one set of the nine may meet a stalled machine.
-  EXPECT_GE(early, observer.handed.size() - 2);
+  for (std::size_t k = sets / 2; k < sets; ++k) early += observer.handed[k] == k ? 1 : 0;
+  EXPECT_GE(early, sets - sets / 2 - 1);
 }
 
 }  // namespace
