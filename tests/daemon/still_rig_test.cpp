@@ -4,6 +4,7 @@
 // Paced, the pipeline waits for each set, and a surround view's picture goes out once drawn.
 
 #include <atomic>
+#include <chrono>
 #include <fstream>
 #include <optional>
 #include <vector>
@@ -117,29 +118,38 @@ TEST_F(StillRigTest, AnAskedForFrozenCheckStillFindsTheStillFrozen) {
   EXPECT_EQ(summary.healthChanges[0].to, capture::CameraHealth::kFrozen);
 }
 
-// Before each set's stages: how many pictures the outputs had been handed by then. Stops the run
-// after kPacedSets sets.
+// Before each set's stages: how many pictures the outputs had been handed by then, and how long
+// the pipeline had sat idle since the previous set's stages (zero when it went straight on). Stops
+// the run after kPacedSets sets.
 class HandedBeforeEachSet final : public PipelineObserver {
  public:
+  using Clock = std::chrono::steady_clock;
   static constexpr std::uint64_t kPacedSets = 12;
+  struct Arrival {
+    std::uint64_t handed = 0;
+    Clock::duration idle{};
+  };
   explicit HandedBeforeEachSet(std::atomic<bool>& stop) : stop_(stop) {}
-  void onLoop(Pipeline& /*pipeline*/, std::chrono::steady_clock::time_point /*now*/,
-              std::uint64_t frameSets) override {
+  void onLoop(Pipeline& /*pipeline*/, Clock::time_point now, std::uint64_t frameSets) override {
     if (frameSets >= kPacedSets) stop_ = true;
+    if (!idleFrom_ && frameSets > 0) idleFrom_ = now;
   }
   void onStopping() override {}
   void onFrameSet(Pipeline& pipeline, const capture::FrameSet& /*set*/) override {
-    handed.push_back(pipeline.report().latency.count());
+    arrivals.push_back({pipeline.report().latency.count(),
+                        idleFrom_ ? Clock::now() - *idleFrom_ : Clock::duration::zero()});
+    idleFrom_.reset();
   }
-  std::vector<std::uint64_t> handed;
+  std::vector<Arrival> arrivals;
 
  private:
   std::atomic<bool>& stop_;
+  std::optional<Clock::time_point> idleFrom_;  // the first loop's end after a set's stages
 };
 
-// At 5 frames a second the pipeline waits 200 ms for each set: an orbit view's picture (its eye
-// moves, so OpenGL draws it each set) goes out once drawn, while the pipeline waits, rather than
-// with the next set. Collected with the next set, set k would find k - 1 pictures out.
+// At 5 frames a second the pipeline waits up to 200 ms for each set: an orbit view's picture (its
+// eye moves, so OpenGL draws it each set) goes out once drawn, while the pipeline waits, rather
+// than with the next set. Collected with the next set, set k would find k - 1 pictures out.
 TEST_F(StillRigTest, ADrawnPictureGoesOutBeforeTheNextSetComes) {
   OutputConfig orbit = videoOutputAt(dir_ / "orbit.mkv");
   orbit.stream = OutputStream::kSurround;
@@ -151,15 +161,26 @@ TEST_F(StillRigTest, ADrawnPictureGoesOutBeforeTheNextSetComes) {
   std::atomic<bool> stop{false};
   HandedBeforeEachSet observer(stop);
   pipeline.run(stop, &observer);
-  const std::size_t sets = observer.handed.size();
-  ASSERT_GE(sets, HandedBeforeEachSet::kPacedSets);
-  for (std::size_t k = 1; k < sets; ++k) EXPECT_LE(observer.handed[k], k) << k;
-  // Once running: the first sets may take longer than a period (shaders compiled, the encoder
-  // started; four of them under ThreadSanitizer). A 320x180 view is drawn in a few milliseconds;
-  // one of the last six sets may meet a stalled machine.
+  const auto& arrivals = observer.arrivals;
+  ASSERT_GE(arrivals.size(), HandedBeforeEachSet::kPacedSets);
+  for (std::size_t k = 1; k < arrivals.size(); ++k) EXPECT_LE(arrivals[k].handed, k) << k;
+  // Judged where the pipeline had sat idle long enough to draw a 320x180 view (a few ms) many
+  // times over: where a set's own stages outlast the period (the first sets: shaders compiled,
+  // the encoder started; all of them under ThreadSanitizer on a busy machine) the next set is
+  // waiting and collects the picture. One judged set may meet a stalled machine.
+  constexpr auto kIdleEnough = std::chrono::milliseconds(60);
+  std::size_t judged = 0;
   std::size_t early = 0;
-  for (std::size_t k = sets / 2; k < sets; ++k) early += observer.handed[k] == k ? 1 : 0;
-  EXPECT_GE(early, sets - sets / 2 - 1);
+  for (std::size_t k = 1; k < arrivals.size(); ++k) {
+    if (arrivals[k].idle < kIdleEnough) continue;
+    ++judged;
+    early += arrivals[k].handed == k ? 1 : 0;
+  }
+  if (judged < 3) {
+    GTEST_SKIP() << "only " << judged << " of " << arrivals.size() - 1
+                 << " sets found the pipeline idle for 60 ms: too slow to judge";
+  }
+  EXPECT_GE(early, judged - 1) << "of " << judged << " sets after an idle pipeline";
 }
 
 }  // namespace
