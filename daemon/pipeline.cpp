@@ -145,7 +145,11 @@ PipelineReport Pipeline::report() const {
   report.failedOutputs = outputs_.failures();
   report.failedSets = failedSets_;
   report.outputDropped = outputs_.dropped();
-  if (surround_ != nullptr) report.renderer = surround_->description();
+  if (surround_ != nullptr) {
+    report.renderer = surround_->description();
+    report.gpuTimed = surround_->gpuTimed();
+    report.gpuSteps = surround_->gpuTimes();
+  }
   return report;
 }
 

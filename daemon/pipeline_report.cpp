@@ -123,6 +123,17 @@ std::string statusText(const PipelineReport& report) {
                    milliseconds(stage.quantile(0.99)), stage.count(),
                    static_cast<double>(stage.count()) / std::max(report.setSpan.count(), 1e-9));
   }
+  if (!report.renderer.empty() && !report.gpuTimed) {
+    out += "gpu steps not timed: the renderer has no GL_EXT_disjoint_timer_query\n";
+  }
+  for (std::size_t s = 0; s < render::kGpuSteps && report.gpuTimed; ++s) {
+    const auto& step = report.gpuSteps[s];
+    if (step.count() == 0) continue;
+    fmt::format_to(
+        std::back_inserter(out), "gpu {:<11} p50 {:7.2f} ms  p99 {:7.2f} ms  ({} runs)\n",
+        render::toString(static_cast<render::GpuStep>(s)), milliseconds(step.quantile(0.5)),
+        milliseconds(step.quantile(0.99)), step.count());
+  }
   fmt::format_to(std::back_inserter(out), "frame rate: {}\n",
                  frameRateWithLimit(report.framesPerSecond()));
   if (report.latency.count() > 0) {
@@ -188,6 +199,16 @@ std::string prometheusText(const PipelineReport& report) {
   for (std::size_t s = 0; s < kStageCount; ++s) {
     summary(out, "stage_seconds", fmt::format("stage=\"{}\"", toString(static_cast<Stage>(s))),
             report.stages[s]);
+  }
+  if (report.gpuTimed) {
+    family(out, "gpu_step_seconds", "summary",
+           "The GPU's own time of each run of its steps (GL_EXT_disjoint_timer_query): the frames' "
+           "or panorama's upload, the stitch pass, a view's draw, its read-back.");
+    for (std::size_t s = 0; s < render::kGpuSteps; ++s) {
+      summary(out, "gpu_step_seconds",
+              fmt::format("step=\"{}\"", render::toString(static_cast<render::GpuStep>(s))),
+              report.gpuSteps[s]);
+    }
   }
   family(out, "latency_seconds", "summary",
          fmt::format("From a frame set's capture (its oldest frame) to its picture handed to an "

@@ -14,6 +14,7 @@
 #include "capture/camera_stream.hpp"
 #include "capture/synchronizer.hpp"
 #include "daemon/duration_histogram.hpp"
+#include "render/gpu_timer.hpp"
 
 namespace surroundd::daemon {
 
@@ -82,6 +83,10 @@ struct PipelineReport {
   std::uint64_t failedSets = 0;     // frame sets a stage failed on (dropped)
   std::uint64_t outputDropped = 0;  // pictures outputs dropped because they fell behind
   std::string renderer;
+  // The GPU's own time of each run of its steps (upload, stitch, draw, read-back), where the
+  // renderer can time them (GL_EXT_disjoint_timer_query): `gpuTimed`.
+  bool gpuTimed = false;
+  std::array<DurationHistogram, render::kGpuSteps> gpuSteps;
 
   double framesPerSecond() const {
     return setSpan.count() > 0 ? static_cast<double>(frameSets) / setSpan.count() : 0.0;

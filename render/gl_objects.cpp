@@ -6,6 +6,16 @@
 
 namespace surroundd::render::gl {
 
+bool hasExtension(std::string_view name) {
+  GLint count = 0;
+  glGetIntegerv(GL_NUM_EXTENSIONS, &count);
+  for (GLint i = 0; i < count; ++i) {
+    const auto* extension = reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, i));
+    if (extension != nullptr && name == extension) return true;
+  }
+  return false;
+}
+
 void check(const char* what) {
   const GLenum error = glGetError();
   if (error != GL_NO_ERROR) {

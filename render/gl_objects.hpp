@@ -2,6 +2,7 @@
 // Owning handles for OpenGL ES objects: made on construction, deleted on destruction, movable and
 // not copyable. They must live and die on the thread where the EglContext is current.
 
+#include <string_view>
 #include <utility>
 
 #include <GLES3/gl3.h>
@@ -78,6 +79,9 @@ using Buffer = Object<BufferKind>;
 using Framebuffer = Object<FramebufferKind>;
 using Renderbuffer = Object<RenderbufferKind>;
 using VertexArray = Object<VertexArrayKind>;
+
+// Whether the current context's driver has the extension `name` ("GL_EXT_color_buffer_float").
+bool hasExtension(std::string_view name);
 
 // Throws RenderError naming `what` if GL has recorded an error since the last check.
 void check(const char* what);

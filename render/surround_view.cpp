@@ -2,7 +2,6 @@
 
 #include <limits>
 #include <stdexcept>
-#include <string_view>
 
 #include <fmt/core.h>
 #include <opencv2/imgproc.hpp>
@@ -25,11 +24,12 @@ cv::Rect letterbox(cv::Size picture, const cv::Rect& area) {
 }  // namespace
 
 SurroundView::SurroundView(const SurroundScene& scene, cv::Size size, ViewKind view,
-                           ViewSettings settings)
+                           ViewSettings settings, GpuTimer* timer)
     : scene_(scene),
       size_(size),
       view_(view),
       settings_(settings),
+      timer_(timer),
       readAtCollect_(softwareRenderer()),
       from_(view),
       picture_(size, CV_8UC3) {
@@ -119,6 +119,17 @@ void SurroundView::drawScene(ViewKind view, double timeS, SurroundScene::Pass pa
 
 void SurroundView::draw(double timeS) {
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.name());
+  drawPicture(timeS);
+  readStarted_ = false;
+  if (!readAtCollect_) startReadBack();
+  drawnFence_.place();
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  gl::check("drawing a surround view");
+  pending_ = true;
+}
+
+void SurroundView::drawPicture(double timeS) {
+  const GpuTimer::Scope timed(timer_, GpuStep::kDraw);
   glClearColor(0.08F, 0.08F, 0.08F, 1.0F);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   constexpr auto kPicture = SurroundScene::Pass::kPicture;
@@ -141,15 +152,10 @@ void SurroundView::draw(double timeS) {
     drawScene(view_, timeS, kPicture);
     glDisable(GL_BLEND);
   }
-  readStarted_ = false;
-  if (!readAtCollect_) startReadBack();
-  drawnFence_.place();
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  gl::check("drawing a surround view");
-  pending_ = true;
 }
 
 void SurroundView::startReadBack() {
+  const GpuTimer::Scope timed(timer_, GpuStep::kReadBack);
   glBindBuffer(GL_PIXEL_PACK_BUFFER, readBuffer_.name());
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
   glReadPixels(0, 0, size_.width, size_.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
@@ -182,9 +188,7 @@ const cv::Mat& SurroundView::collect() {
 }
 
 cv::Mat SurroundView::panoramaPositions(double timeS) const {
-  const auto* extensions = reinterpret_cast<const char*>(glGetString(GL_EXTENSIONS));
-  if (extensions == nullptr ||
-      std::string_view(extensions).find("GL_EXT_color_buffer_float") == std::string_view::npos) {
+  if (!gl::hasExtension("GL_EXT_color_buffer_float")) {
     throw RenderError(
         "mapping a view onto the panorama needs float render targets "
         "(GL_EXT_color_buffer_float), which this OpenGL ES driver lacks");

@@ -13,6 +13,7 @@
 #include <opencv2/core.hpp>
 
 #include "render/gl_objects.hpp"
+#include "render/gpu_timer.hpp"
 #include "render/surround_scene.hpp"
 #include "render/view_camera.hpp"
 
@@ -27,8 +28,10 @@ struct DrawnPicture {
 
 class SurroundView {
  public:
-  // `size`: even width and height. The scene must outlive the view.
-  SurroundView(const SurroundScene& scene, cv::Size size, ViewKind view, ViewSettings settings);
+  // `size`: even width and height. The scene must outlive the view, and `timer` (may be null)
+  // too: it times the draws and read-backs on the GPU.
+  SurroundView(const SurroundScene& scene, cv::Size size, ViewKind view, ViewSettings settings,
+               GpuTimer* timer = nullptr);
 
   // Shows `view` from the next draw() on: moving there over settings.transitionS of stream time
   // (the eye's pose in between for top and orbit; the two pictures faded for the others), or at
@@ -69,6 +72,8 @@ class SurroundView {
 
  private:
   void drawScene(ViewKind view, double timeS, SurroundScene::Pass pass) const;
+  // The picture into this view's framebuffer (bound), the switch of view blended in.
+  void drawPicture(double timeS);
   // glReadPixels of this view's framebuffer (bound) into readBuffer_.
   void startReadBack();
   // How far the switch of view has come at `timeS`, 0..1; 1 when none is under way (and it ends
@@ -79,6 +84,7 @@ class SurroundView {
   cv::Size size_;
   ViewKind view_;
   ViewSettings settings_;
+  GpuTimer* timer_;
   gl::Framebuffer framebuffer_;
   gl::Renderbuffer colour_;
   gl::Renderbuffer depth_;

@@ -81,8 +81,10 @@ SurroundStage::SurroundStage(const Config& config, PanoramaStage& panorama,
                mesh.indices.size() / 3, names[splitCamera_]);
 }
 
-std::unique_ptr<render::SurroundView> SurroundStage::makeView(cv::Size size, ViewKind view) const {
-  return std::make_unique<render::SurroundView>(*scene_, size, view, views_);
+std::unique_ptr<render::SurroundView> SurroundStage::makeView(cv::Size size, ViewKind view) {
+  // The views go before the stage (the pipeline destroys its outputs first): they may borrow the
+  // timer.
+  return std::make_unique<render::SurroundView>(*scene_, size, view, views_, &gpuTimer_);
 }
 
 SurroundStage::FixedView* SurroundStage::fixedView(render::SurroundView& view) {
@@ -137,16 +139,29 @@ void SurroundStage::stitchOnGpu() {
         std::make_unique<render::GpuStitcher>(panoramaStage_.lut(), format, panoramaStage_.pool());
     gpu_->correctWith(panoramaStage_.poisson());
   }
-  gpu_->upload(panoramaStage_.frames());
-  gpu_->stitch();
+  {
+    const render::GpuTimer::Scope timed(&gpuTimer_, render::GpuStep::kUpload);
+    gpu_->upload(panoramaStage_.frames());
+  }
+  {
+    const render::GpuTimer::Scope timed(&gpuTimer_, render::GpuStep::kStitch);
+    gpu_->stitch();
+  }
   scene_->samplePanoramaFrom(gpu_->panorama());
   panoramaOnGpu_ = true;
 }
 
 void SurroundStage::uploadPanorama() {
   scene_->samplePanoramaFrom(0);
+  const render::GpuTimer::Scope timed(&gpuTimer_, render::GpuStep::kUpload);
   scene_->uploadPanorama(panorama_);
   panoramaOnGpu_ = false;
+}
+
+void SurroundStage::collectGpuTimes() {
+  for (const auto& reading : gpuTimer_.collect()) {
+    gpuTimes_[static_cast<std::size_t>(reading.step)].record(reading.time);
+  }
 }
 
 bool SurroundStage::needsPanorama(const FrameWork& work) {
@@ -199,6 +214,7 @@ void SurroundStage::layGuidelines(render::SurroundView& view, FixedView& fixed) 
 
 void SurroundStage::process(FrameWork& work, StageTimes& times) {
   deliver(work.outputs, &times);
+  collectGpuTimes();
   lastStreamTime_ = work.streamTime;
   // Drawn views or not, as the CPU's panorama is made for them: the run's end may draw one again.
   bool panoramaUploaded = false;
@@ -286,7 +302,10 @@ void SurroundStage::deliver(PipelineOutputs& outputs, StageTimes* times, Pending
   }
 }
 
-void SurroundStage::finish(PipelineOutputs& outputs) { deliver(outputs, nullptr); }
+void SurroundStage::finish(PipelineOutputs& outputs) {
+  deliver(outputs, nullptr);
+  collectGpuTimes();
+}
 
 cv::Mat SurroundStage::redraw(PipelineOutputs::PictureOutput& output) {
   const auto fixed = fixedViews_.find({output.view.get(), output.view->view()});

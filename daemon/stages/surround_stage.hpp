@@ -21,6 +21,7 @@
 // Threads: the EGL context is made current on the thread that constructs the stage, which must be
 // the one that runs it.
 
+#include <array>
 #include <chrono>
 #include <map>
 #include <memory>
@@ -32,10 +33,12 @@
 #include <opencv2/core.hpp>
 
 #include "daemon/config.hpp"
+#include "daemon/duration_histogram.hpp"
 #include "daemon/pipeline_stage.hpp"
 #include "daemon/stages/panorama_stage.hpp"
 #include "render/egl_context.hpp"
 #include "render/gpu_stitcher.hpp"
+#include "render/gpu_timer.hpp"
 #include "render/surround_scene.hpp"
 #include "render/surround_view.hpp"
 #include "vehicle/vehicle_signals.hpp"
@@ -51,7 +54,7 @@ class SurroundStage final : public PipelineStage {
   SurroundStage(const Config& config, PanoramaStage& panorama, PixelFormat cameraFormat);
 
   // A view for an output of `size` (even sides), first showing `view`.
-  std::unique_ptr<render::SurroundView> makeView(cv::Size size, ViewKind view) const;
+  std::unique_ptr<render::SurroundView> makeView(cv::Size size, ViewKind view);
 
   // Maps each output's first view ahead of the first set when it does not move: composing its
   // view table takes tenths of a second, which belong to start-up, not to a set's frame time.
@@ -81,6 +84,10 @@ class SurroundStage final : public PipelineStage {
   }
   // Whether the GPU stitches the panorama (processing.backend as it came out on this renderer).
   bool stitchesOnGpu() const { return gpu_ != nullptr; }
+  // The GPU's own time of each run of its steps so far (render/gpu_timer.hpp), read a set or two
+  // after the run; none where the driver cannot time them (gpuTimed() false).
+  const std::array<DurationHistogram, render::kGpuSteps>& gpuTimes() const { return gpuTimes_; }
+  bool gpuTimed() const { return gpuTimer_.available(); }
 
   // The vehicle's signals as they are now: the guidelines follow its gear and steering (drawn
   // again only when they change by a tenth of a degree or more).
@@ -115,11 +122,15 @@ class SurroundStage final : public PipelineStage {
   // uploaded.
   void stitchOnGpu();
   void uploadPanorama();
+  // The GPU times of the runs finished since the last call into gpuTimes_.
+  void collectGpuTimes();
 
   render::ViewSettings views_;
   // The context first, so that it outlives the GL objects of the scene (and of the outputs' views,
   // which the pipeline destroys before its stages).
   render::EglContext gl_;
+  render::GpuTimer gpuTimer_;  // borrowed by the outputs' views
+  std::array<DurationHistogram, render::kGpuSteps> gpuTimes_{};
   std::unique_ptr<render::SurroundScene> scene_;
   PanoramaStage& panoramaStage_;
   const cv::Mat& panorama_;

@@ -3,10 +3,12 @@
 // CPU path shows: every view within PSNR 40 dB, for frames decoded (BGR) or preloaded as YUYV and
 // NV12. A set with a faulty camera is made on the CPU, its part marked as the CPU path marks it.
 // auto keeps a software renderer on the CPU, gain compensation stays there, and each choice is
-// logged with its reason.
+// logged with its reason. The report has the GPU's own time of each step it ran.
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "daemon/pipeline.hpp"
+#include "daemon/pipeline_report.hpp"
 #include "tests/daemon/config_test_support.hpp"
 #include "tests/daemon/replay_config.hpp"
 #include "tests/support/log_capture.hpp"
@@ -24,6 +27,7 @@
 namespace surroundd::daemon {
 namespace {
 
+using std::chrono::nanoseconds;
 using ::testing::AllOf;
 using ::testing::Contains;
 using ::testing::HasSubstr;
@@ -170,6 +174,50 @@ TEST_F(ProcessingBackendTest, AutoAndGainCompensationKeepTheCpuAndSayWhy) {
       gains.log,
       Contains(HasSubstr("processing: cpu (gain compensation is applied on the CPU only)")));
   EXPECT_THAT(gains.summary.renderer, Not(HasSubstr("GPU")));
+}
+
+// The GPU's own time of each step it ran, in the report and the status: on the GPU backend the
+// frames' upload, the stitch pass, the view's draw and read-back; on the CPU backend the
+// panorama's upload, the draw and read-back, no stitch. An orbit video draws every set.
+TEST_F(ProcessingBackendTest, TheReportHasTheGpusOwnTimeOfEachStepItRan) {
+  Config config = replayOf("synth_small", true);
+  for (auto& camera : config.cameras) camera.preload = capture::PixelLayout::kYuyv;
+  OutputConfig orbit = videoOutputAt(dir_ / "orbit.mkv");
+  orbit.stream = OutputStream::kSurround;
+  orbit.view = ViewKind::kOrbit;
+  config.outputs = {orbit};
+  for (const auto backend : {ProcessingBackend::kGpu, ProcessingBackend::kCpu}) {
+    const bool gpu = backend == ProcessingBackend::kGpu;
+    SCOPED_TRACE(gpu ? "gpu" : "cpu");
+    config.processing.backend = backend;
+    std::filesystem::remove(dir_ / "orbit.mkv");
+    Pipeline pipeline(config);
+    const std::atomic<bool> stop{false};
+    const RunSummary summary = pipeline.run(stop);
+    const PipelineReport& report = summary.report;
+    if (!report.gpuTimed) GTEST_SKIP() << "the renderer has no GL_EXT_disjoint_timer_query";
+    ASSERT_GT(summary.frameSets, 20u);
+    const auto runs = [&](render::GpuStep step) {
+      return report.gpuSteps[static_cast<std::size_t>(step)].count();
+    };
+    // Read a set or two after each run, a few of the last ones after the end: most of them.
+    const std::uint64_t most = summary.frameSets - render::GpuTimer::kQueriesPerStep;
+    for (const auto step :
+         {render::GpuStep::kUpload, render::GpuStep::kDraw, render::GpuStep::kReadBack}) {
+      EXPECT_GE(runs(step), most) << render::toString(step);
+      EXPECT_LE(runs(step), summary.frameSets + 1) << render::toString(step);  // + the last redraw
+      EXPECT_GT(report.gpuSteps[static_cast<std::size_t>(step)].quantile(0.5), nanoseconds(0));
+    }
+    const std::string status = statusText(report);
+    EXPECT_THAT(status, ::testing::ContainsRegex("gpu read-back +p50 +[0-9.]+ ms"));
+    if (gpu) {
+      EXPECT_GE(runs(render::GpuStep::kStitch), most);
+      EXPECT_THAT(status, HasSubstr("gpu stitch "));
+    } else {
+      EXPECT_EQ(runs(render::GpuStep::kStitch), 0u);
+      EXPECT_THAT(status, Not(HasSubstr("gpu stitch ")));
+    }
+  }
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 #include "processing/stitch/stitcher.hpp"
 #include "processing/surround_mesh.hpp"
 #include "render/egl_context.hpp"
+#include "render/gpu_timer.hpp"
 #include "render/surround_view.hpp"
 #include "tests/processing/panorama_test_support.hpp"
 
@@ -243,7 +244,8 @@ TEST_F(GpuStitcherTest, AfterACameraIsLostTheFieldIsAppliedOnTheDomainOfThoseLef
   expectWithinRounding(corrected, cpu);
 }
 
-// The per-frame calls, the correction's field upload included, once the driver has seen them.
+// The per-frame calls, the correction's field upload included, once the driver has seen them;
+// timed on the GPU as the pipeline times them, their times read back.
 TEST_F(GpuStitcherTest, UploadAndStitchAllocateNothing) {
   const auto& truth = processing::testing::smallRecording();
   const auto frames = held(PixelFormat::kNv12);
@@ -252,17 +254,25 @@ TEST_F(GpuStitcherTest, UploadAndStitchAllocateNothing) {
   correction.update(frames, PixelFormat::kNv12);
   GpuStitcher gpu(*lut, PixelFormat::kNv12, *pool);
   gpu.correctWith(&correction);
+  GpuTimer timer;
+  const auto frameSet = [&] {
+    {
+      const GpuTimer::Scope timed(&timer, GpuStep::kUpload);
+      gpu.upload(frames);
+    }
+    {
+      const GpuTimer::Scope timed(&timer, GpuStep::kStitch);
+      gpu.stitch();
+    }
+    return timer.collect().size();
+  };
   for (int round = 0; round < 2; ++round) {
-    gpu.upload(frames);
-    gpu.stitch();
+    frameSet();
     glFinish();
   }
   allocations = 0;
   countAllocations = true;
-  for (int round = 0; round < 3; ++round) {
-    gpu.upload(frames);
-    gpu.stitch();
-  }
+  for (int round = 0; round < 3; ++round) frameSet();
   countAllocations = false;
   glFinish();
   EXPECT_EQ(allocations, 0);

@@ -17,6 +17,7 @@
 #include "daemon/logging.hpp"
 #include "daemon/pipeline.hpp"
 #include "daemon/rig_yaml.hpp"
+#include "render/gpu_timer.hpp"
 #include "tools/bench/recording_truth.hpp"
 
 namespace surroundd::bench {
@@ -165,6 +166,37 @@ double stageMs(const RunFigures& run, daemon::Stage stage) {
          sets;
 }
 
+// The median GPU time of a run of `step` (the GPU's own clock); none when it had no run.
+std::optional<double> gpuMs(const RunFigures& run, render::GpuStep step) {
+  const auto& times = run.summary.report.gpuSteps[static_cast<std::size_t>(step)];
+  if (times.count() == 0) return std::nullopt;
+  return std::chrono::duration<double, std::milli>(times.quantile(0.5)).count();
+}
+
+constexpr std::array kGpuSteps{render::GpuStep::kUpload, render::GpuStep::kStitch,
+                               render::GpuStep::kDraw, render::GpuStep::kReadBack};
+
+void printGpuSteps(const std::vector<RecordingFigures>& all) {
+  if (!all.front().full.summary.report.gpuTimed) {
+    fmt::print("\nGPU steps not timed: the renderer has no GL_EXT_disjoint_timer_query\n");
+    return;
+  }
+  fmt::print(
+      "\nGPU milliseconds per run of each step (the GPU's own clock, GL_EXT_disjoint_timer_query; "
+      "median; '-': no run)\n{:<8}",
+      "input");
+  for (const auto step : kGpuSteps) fmt::print(" {:>9}", render::toString(step));
+  fmt::print("\n");
+  for (const auto& r : all) {
+    fmt::print("{:<8}", r.name);
+    for (const auto step : kGpuSteps) {
+      const auto ms = gpuMs(r.full, step);
+      fmt::print(" {:>9}", ms ? fmt::format("{:.2f}", *ms) : "-");
+    }
+    fmt::print("\n");
+  }
+}
+
 double cpuPercent(const RunFigures& run, int cores) {
   return 100 * run.cpuSeconds / run.summary.wallTime.count() / cores;
 }
@@ -250,6 +282,7 @@ void printText(const std::vector<RecordingFigures>& all, const PipelineBenchmark
     for (const auto stage : kStages) fmt::print(" {:>9.2f}", stageMs(r.full, stage));
     fmt::print("\n");
   }
+  printGpuSteps(all);
   printAgainstLimits(all, options);
   fmt::print(
       "\n'ratio' is the full pipeline's frame rate over the {}+sync-only replay of the "
@@ -284,6 +317,15 @@ void printJson(const std::vector<RecordingFigures>& all, const PipelineBenchmark
         captureWork(options), r.decodeMs);
     for (const auto stage : kStages) {
       fmt::print(", \"{}\": {:.3f}", daemon::toString(stage), stageMs(r.full, stage));
+    }
+    // The GPU's own time per run of each step that ran and could be timed.
+    fmt::print("}}, \"gpu_ms\": {{");
+    const char* separator = "";
+    for (const auto step : kGpuSteps) {
+      if (const auto ms = gpuMs(r.full, step)) {
+        fmt::print("{}\"{}\": {:.3f}", separator, render::toString(step), *ms);
+        separator = ", ";
+      }
     }
     fmt::print("}}}}");
   }

@@ -37,6 +37,7 @@
 #include "processing/surround_mesh.hpp"
 #include "render/egl_context.hpp"
 #include "render/gpu_stitcher.hpp"
+#include "render/gpu_timer.hpp"
 #include "render/surround_view.hpp"
 
 namespace {
@@ -89,46 +90,25 @@ std::vector<cv::Mat> readFrames(const std::filesystem::path& kit,
   return frames;
 }
 
-// GPU time of one step through GL_EXT_disjoint_timer_query (GL_TIME_ELAPSED_EXT with ES 3's
-// query calls), where the driver has it.
-class GpuTimer {
- public:
-  GpuTimer() {
-    const auto* extensions = reinterpret_cast<const char*>(glGetString(GL_EXTENSIONS));
-    available_ =
-        extensions != nullptr &&
-        std::string_view(extensions).find("GL_EXT_disjoint_timer_query") != std::string_view::npos;
-    if (available_) glGenQueries(1, &query_);
-  }
-  ~GpuTimer() {
-    if (available_) glDeleteQueries(1, &query_);
-  }
-  GpuTimer(const GpuTimer&) = delete;
-  GpuTimer& operator=(const GpuTimer&) = delete;
-
-  bool available() const { return available_; }
-
-  // The median GPU milliseconds of `step` over `frames` runs (waiting for each).
-  template <typename Step>
-  double medianMs(int frames, Step&& step) {
-    constexpr GLenum kTimeElapsed = 0x88BF;  // GL_TIME_ELAPSED_EXT
-    std::vector<double> ms;
-    for (int i = 0; i < frames; ++i) {
-      glBeginQuery(kTimeElapsed, query_);
+// The median GPU milliseconds of `step` over `frames` runs, each waited for (render::GpuTimer,
+// GL_EXT_disjoint_timer_query).
+template <typename Step>
+double medianGpuMs(render::GpuTimer& timer, render::GpuStep as, int frames, Step&& step) {
+  std::vector<double> ms;
+  for (int i = 0; i < frames; ++i) {
+    {
+      const render::GpuTimer::Scope timed(&timer, as);
       step(i);
-      glEndQuery(kTimeElapsed);
-      GLuint nanoseconds = 0;
-      glGetQueryObjectuiv(query_, GL_QUERY_RESULT, &nanoseconds);
-      ms.push_back(nanoseconds / 1e6);
     }
-    std::nth_element(ms.begin(), ms.begin() + static_cast<std::ptrdiff_t>(ms.size() / 2), ms.end());
-    return ms[ms.size() / 2];
+    glFinish();
+    for (const auto& reading : timer.collect()) {
+      ms.push_back(std::chrono::duration<double, std::milli>(reading.time).count());
+    }
   }
-
- private:
-  bool available_ = false;
-  GLuint query_ = 0;
-};
+  if (ms.empty()) return 0;
+  std::nth_element(ms.begin(), ms.begin() + static_cast<std::ptrdiff_t>(ms.size() / 2), ms.end());
+  return ms[ms.size() / 2];
+}
 
 struct Agreement {
   double mean = 0;
@@ -180,7 +160,7 @@ void checkKit(const std::filesystem::path& kit, const Options& options) {
     view.draw(i / 30.0);
     view.collect();
   };
-  GpuTimer gpuTimer;
+  render::GpuTimer gpuTimer;
 
   fmt::print("{}: {} cameras of {}x{}, panorama {}x{}, {} view {}x{}, {} frame sets a figure\n",
              kit.filename().string(), lut.cameraSizes.size(), lut.cameraSizes.front().width,
@@ -242,10 +222,11 @@ void checkKit(const std::filesystem::path& kit, const Options& options) {
     });
     std::string gpuTimes = "no GL_EXT_disjoint_timer_query";
     if (gpuTimer.available()) {
-      gpuTimes = fmt::format("upload {:.3f} ms, stitch {:.3f} ms, draw+read {:.3f} ms",
-                             gpuTimer.medianMs(frames, [&](int) { gpu.upload(held); }),
-                             gpuTimer.medianMs(frames, [&](int) { gpu.stitch(); }),
-                             gpuTimer.medianMs(frames, drawAndCollect));
+      gpuTimes = fmt::format(
+          "upload {:.3f} ms, stitch {:.3f} ms, draw+read {:.3f} ms",
+          medianGpuMs(gpuTimer, render::GpuStep::kUpload, frames, [&](int) { gpu.upload(held); }),
+          medianGpuMs(gpuTimer, render::GpuStep::kStitch, frames, [&](int) { gpu.stitch(); }),
+          medianGpuMs(gpuTimer, render::GpuStep::kDraw, frames, drawAndCollect));
     }
     scene.samplePanoramaFrom(0);
     fmt::print(
