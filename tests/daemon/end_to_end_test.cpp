@@ -26,6 +26,7 @@ namespace surroundd {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 std::filesystem::path recording() {
   return std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
@@ -406,6 +407,10 @@ outputs:
   EXPECT_THAT(surroundd.output(),
               HasSubstr("camera 'front': /dev/v4l/by-id/usb-surroundd-test-front: cannot open: No "
                         "such file or directory"));
+  // None is there, and all are tried at once: the first in the rig is the one named.
+  for (const char* other : {"right", "back", "left"}) {
+    EXPECT_THAT(surroundd.output(), Not(HasSubstr(std::string("usb-surroundd-test-") + other)));
+  }
   EXPECT_FALSE(std::filesystem::exists(dir / "out/mosaic.mp4"));
 }
 

@@ -178,5 +178,21 @@ TEST_F(ReplayTest, AVideoOfAnotherSizeThanItsCalibrationIsRefused) {
   }
 }
 
+// The cameras open all at once (each file's decoder set up on a thread of its own): when several
+// cannot, the one named is the first in the rig, every time, as when they opened in turn.
+TEST_F(ReplayTest, OfCamerasThatCannotOpenTheFirstInTheRigIsNamed) {
+  config_.cameras[1].source->path = "/nonexistent/right.mkv";
+  config_.cameras[3].source->path = "/nonexistent/left.mkv";
+  for (int attempt = 0; attempt < 5; ++attempt) {
+    try {
+      Pipeline pipeline(config_);
+      FAIL() << "a rig with two missing videos was opened";
+    } catch (const std::exception& e) {
+      EXPECT_THAT(e.what(), ::testing::HasSubstr("/nonexistent/right.mkv"));
+      EXPECT_THAT(e.what(), ::testing::Not(::testing::HasSubstr("left.mkv")));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace surroundd::daemon
