@@ -17,8 +17,10 @@
 namespace surroundd::daemon {
 namespace {
 
-const std::filesystem::path kRecording =
-    std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_drop";
+// A function: a static path's construction could throw before main (cert-err58-cpp).
+std::filesystem::path recording() {
+  return std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_drop";
+}
 
 std::vector<capture::Timestamp> timestampsOf(const std::filesystem::path& file) {
   capture::FileSource source("check", {file, 30.0, false, capture::Pacing::kAsFastAsPossible});
@@ -32,7 +34,7 @@ std::vector<capture::Timestamp> timestampsOf(const std::filesystem::path& file) 
 class ReplayTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    config_.cameras = loadRigFile(kRecording / "rig.yaml");
+    config_.cameras = loadRigFile(recording() / "rig.yaml");
     for (const auto& camera : config_.cameras)
       timestamps_.push_back(timestampsOf(camera.source->path));
     const auto fewest =

@@ -29,14 +29,16 @@ namespace {
 using ::testing::HasSubstr;
 using namespace std::chrono_literals;
 
-const std::filesystem::path kRecording =
-    std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
+// A function: a static path's construction could throw before main (cert-err58-cpp).
+std::filesystem::path recording() {
+  return std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
+}
 
 class ServiceTest : public ::testing::Test {
  protected:
   void SetUp() override {
     // The recording's rig, looping: the daemon runs until it is told to stop.
-    auto cameras = loadRigFile(kRecording / "rig.yaml");
+    auto cameras = loadRigFile(recording() / "rig.yaml");
     for (auto& camera : cameras) camera.source->loop = true;
     writeRigFile(dir_ / "rig.yaml", cameras, "looping replay");
     std::filesystem::remove_all(socket_.parent_path());
