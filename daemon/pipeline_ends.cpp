@@ -60,10 +60,12 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
   // preloaded file opens in turn, allowed what the cameras before it left of the preload budget;
   // libcamera cameras open in turn too (one camera manager for all, and its configuration from
   // several threads is untried here).
-  std::vector<std::future<Opened>> opening;
   std::vector<std::pair<std::string, std::uint64_t>> preloadedBytes;  // per camera so far
   // The replayed cameras play on one clock, as cameras triggered together would deliver.
   const auto replayStart = std::make_shared<capture::ReplayStart>();
+  // After what the threads use: should one camera fail, the others' futures wait for their
+  // threads as they go, before the rest of this function's locals.
+  std::vector<std::future<Opened>> opening;
   const auto inTurn = [](auto open) {
     std::promise<Opened> opened;
     try {
@@ -81,7 +83,7 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
                       fmt::format("libcamera {}", camera.libcamera->camera)};
       }));
     } else if (camera.device) {
-      opening.push_back(std::async(std::launch::async, [&] {
+      opening.push_back(std::async(std::launch::async, [&camera, &name] {
         auto device = std::make_unique<capture::V4l2Source>(name, *camera.device);
         std::string origin = fmt::format("{} ({})", camera.device->device.string(),
                                          capture::toString(device->format()));
@@ -98,7 +100,7 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
         return Opened{std::move(preloaded), std::move(origin)};
       }));
     } else {
-      opening.push_back(std::async(std::launch::async, [&] {
+      opening.push_back(std::async(std::launch::async, [&camera, &config, &name, replayStart] {
         auto settings = *camera.source;
         settings.pacing = config.capture.pacing;
         std::string origin = settings.path.string();
