@@ -19,8 +19,9 @@ using namespace surroundd;
 constexpr std::string_view kUsage = R"(usage: surroundctl [--socket PATH] COMMAND
 
 commands:
-  status            frame rate, per-stage p50/p99 milliseconds, latency, time to the first
-                    picture (each beside its limit), each camera's health
+  status            frame rate, per-stage p50/p99 milliseconds, the GPU's own milliseconds per
+                    step where the driver can time them, latency, time to the first picture
+                    (each beside its limit), each camera's health
   metrics           the same and more in Prometheus text format
   view NAME         switch the surround outputs to top, 360, orbit, split or rear
   signal NAME=VALUE...  the vehicle's signals, for vehicles whose signals come from other
