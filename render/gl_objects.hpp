@@ -80,7 +80,7 @@ using Framebuffer = Object<FramebufferKind>;
 using Renderbuffer = Object<RenderbufferKind>;
 using VertexArray = Object<VertexArrayKind>;
 
-// Whether the current context's driver has the extension `name` ("GL_EXT_color_buffer_float").
+// Whether the current context's driver has the extension `name` ("GL_EXT_disjoint_timer_query").
 bool hasExtension(std::string_view name);
 
 // Throws RenderError naming `what` if GL has recorded an error since the last check.

@@ -28,7 +28,7 @@ in vec2 v_uv;
 out vec4 o_colour;
 void main() {
 #ifdef PANORAMA_POSITIONS
-  o_colour = vec4(v_uv, 1.0, 1.0);
+  o_colour = panoramaPosition(v_uv);
 #else
   o_colour = vec4(texture(u_panorama, v_uv).rgb, 1.0);
 #endif
@@ -58,7 +58,7 @@ in vec2 v_uv;
 out vec4 o_colour;
 void main() {
 #ifdef PANORAMA_POSITIONS
-  o_colour = vec4(0.0, 0.0, 0.0, 1.0);
+  o_colour = vec4(0.0);
 #else
   o_colour = vec4(v_colour * texture(u_texture, v_uv).rgb, 1.0);
 #endif
@@ -110,7 +110,7 @@ void main() {
   vec2 uv = vec2(fract((azimuth + PI) / (2.0 * PI)), (u_panoramaTop - elevation) / u_panoramaSpan);
   bool outside = uv.y < 0.0 || uv.y > 1.0;
 #ifdef PANORAMA_POSITIONS
-  o_colour = outside ? vec4(0.0, 0.0, 0.0, 1.0) : vec4(uv, 1.0, 1.0);
+  o_colour = outside ? vec4(0.0) : panoramaPosition(uv);
 #else
   o_colour = outside ? vec4(0.0, 0.0, 0.0, 1.0) : vec4(texture(u_panorama, uv).rgb, 1.0);
 #endif
@@ -125,12 +125,24 @@ void main() {
   o_colour = vec4(texture(u_picture, vec2(v_picture.x + 1.0, 1.0 - v_picture.y) * 0.5).rgb, 1.0);
 })";
 
-// A fragment shader's source with PANORAMA_POSITIONS defined (after its #version line, which
-// must come first).
+// Where a fragment samples the panorama (texture coordinates), packed into an 8-bit RGBA target
+// (read back fast where a float one is slow, and drawn where float targets are missing): u in 16
+// bits (red, green; it wraps), v in 15 (blue's low 7, alpha), blue's top bit set where the panorama
+// is shown. SurroundView::panoramaPositions() unpacks it.
+constexpr const char* kPackPanoramaPosition = R"(
+highp vec4 panoramaPosition(highp vec2 uv) {
+  highp float u = mod(floor(fract(uv.x) * 65536.0 + 0.5), 65536.0);
+  highp float v = floor(clamp(uv.y, 0.0, 1.0) * 32767.0 + 0.5);
+  return vec4(floor(u / 256.0), mod(u, 256.0), 128.0 + floor(v / 256.0), mod(v, 256.0)) / 255.0;
+}
+)";
+
+// A fragment shader's source with PANORAMA_POSITIONS defined and panoramaPosition() (after its
+// #version line, which must come first).
 std::string withPanoramaPositions(std::string_view fragment) {
   const std::size_t body = fragment.find('\n') + 1;
-  return fmt::format("{}#define PANORAMA_POSITIONS\n{}", fragment.substr(0, body),
-                     fragment.substr(body));
+  return fmt::format("{}#define PANORAMA_POSITIONS\n{}{}", fragment.substr(0, body),
+                     kPackPanoramaPosition, fragment.substr(body));
 }
 
 void attribute(GLuint index, GLint components, GLsizei stride, std::size_t offset) {

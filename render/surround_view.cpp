@@ -21,6 +21,9 @@ cv::Rect letterbox(cv::Size picture, const cv::Rect& area) {
   return {area.x + (area.width - w) / 2, area.y + (area.height - h) / 2, w, h};
 }
 
+// The grey behind the scene, where no mesh is.
+constexpr float kBackground = 0.08F;
+
 }  // namespace
 
 SurroundView::SurroundView(const SurroundScene& scene, cv::Size size, ViewKind view,
@@ -65,9 +68,8 @@ void SurroundView::setView(ViewKind view) {
   transitionStartS_.reset();
 }
 
-bool SurroundView::moves() const {
-  return transitioning_ ||
-         ((view_ == ViewKind::kOrbit || view_ == ViewKind::kSplit) && orbitMoves(settings_));
+bool SurroundView::settlesStill() const {
+  return (view_ != ViewKind::kOrbit && view_ != ViewKind::kSplit) || !orbitMoves(settings_);
 }
 
 double SurroundView::transitionProgress(double timeS) {
@@ -130,7 +132,7 @@ void SurroundView::draw(double timeS) {
 
 void SurroundView::drawPicture(double timeS) {
   const GpuTimer::Scope timed(timer_, GpuStep::kDraw);
-  glClearColor(0.08F, 0.08F, 0.08F, 1.0F);
+  glClearColor(kBackground, kBackground, kBackground, 1.0F);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   constexpr auto kPicture = SurroundScene::Pass::kPicture;
   const double progress = transitionProgress(timeS);
@@ -187,51 +189,67 @@ const cv::Mat& SurroundView::collect() {
   return picture_;
 }
 
-cv::Mat SurroundView::panoramaPositions(double timeS) const {
-  if (!gl::hasExtension("GL_EXT_color_buffer_float")) {
-    throw RenderError(
-        "mapping a view onto the panorama needs float render targets "
-        "(GL_EXT_color_buffer_float), which this OpenGL ES driver lacks");
-  }
-  // Texture coordinates need more than 8 bits: a 2048-pixel panorama is 1/2048 per pixel.
-  gl::Renderbuffer positions;
-  glBindRenderbuffer(GL_RENDERBUFFER, positions.name());
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, size_.width, size_.height);
+cv::Mat SurroundView::drawAlone(SurroundScene::Pass pass, double timeS) const {
+  gl::Renderbuffer colour;
+  glBindRenderbuffer(GL_RENDERBUFFER, colour.name());
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, size_.width, size_.height);
+  gl::Renderbuffer depth;
+  glBindRenderbuffer(GL_RENDERBUFFER, depth.name());
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, size_.width, size_.height);
   gl::Framebuffer framebuffer;
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.name());
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
-                            positions.name());
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_.name());
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour.name());
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth.name());
   const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE) {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    throw RenderError(fmt::format("panorama positions {}x{}: framebuffer incomplete (0x{:04x})",
-                                  size_.width, size_.height, status));
+    throw RenderError(fmt::format("the {} view {}x{} alone: framebuffer incomplete (0x{:04x})",
+                                  toString(view_), size_.width, size_.height, status));
   }
-  glClearColor(0, 0, 0, 0);
+  if (pass == SurroundScene::Pass::kPicture) {
+    glClearColor(kBackground, kBackground, kBackground, 1.0F);
+  } else {
+    glClearColor(0, 0, 0, 0);  // no panorama shown
+  }
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  drawScene(view_, timeS, SurroundScene::Pass::kPanoramaPositions);
-  cv::Mat read(size_, CV_32FC4);
+  drawScene(view_, timeS, pass);
+  cv::Mat rgba(size_, CV_8UC4);
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  glReadPixels(0, 0, size_.width, size_.height, GL_RGBA, GL_FLOAT, read.data);
+  glReadPixels(0, 0, size_.width, size_.height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  gl::check("mapping a view onto the panorama");
+  gl::check("drawing a view alone");
+  return rgba;
+}
 
-  const cv::Size panorama = scene_.panoramaSize();
+cv::Mat SurroundView::stillPicture(double timeS) const {
+  cv::Mat picture;
+  cv::cvtColor(drawAlone(SurroundScene::Pass::kPicture, timeS), picture, cv::COLOR_RGBA2BGR);
+  return picture;
+}
+
+cv::Mat SurroundView::panoramaPositions(double timeS) const {
+  const cv::Mat packed = drawAlone(SurroundScene::Pass::kPanoramaPositions, timeS);
+  // Unpacked as the positions pass packs them (render/surround_scene.cpp, panoramaPosition()).
   // A plain loop, not cv::Mat::forEach: OpenCV's TBB threads hand the picture back through
   // synchronisation that ThreadSanitizer cannot see, and the view LUT reads it on the work pool.
   // Once per view switch, so the single thread costs nothing that matters.
   constexpr float kNone = std::numeric_limits<float>::quiet_NaN();
-  const auto scale =
-      cv::Vec2f(static_cast<float>(panorama.width), static_cast<float>(panorama.height));
+  const cv::Size panorama = scene_.panoramaSize();
+  const float uScale = static_cast<float>(panorama.width) / 65536.0F;
+  const float vScale = static_cast<float>(panorama.height) / 32767.0F;
   cv::Mat result(size_, CV_32FC2);
   for (int y = 0; y < size_.height; ++y) {
-    const auto* texel = read.ptr<cv::Vec4f>(y);
+    const auto* texel = packed.ptr<cv::Vec4b>(y);
     auto* position = result.ptr<cv::Vec2f>(y);
     for (int x = 0; x < size_.width; ++x) {
-      position[x] = texel[x][2] < 0.5F
-                        ? cv::Vec2f(kNone, kNone)
-                        : cv::Vec2f(texel[x][0] * scale[0] - 0.5F, texel[x][1] * scale[1] - 0.5F);
+      const cv::Vec4b t = texel[x];
+      if ((t[2] & 0x80U) == 0) {
+        position[x] = cv::Vec2f(kNone, kNone);
+        continue;
+      }
+      const auto u = static_cast<float>((t[0] << 8U) | t[1]);
+      const auto v = static_cast<float>(((t[2] & 0x7FU) << 8U) | t[3]);
+      position[x] = cv::Vec2f(u * uScale - 0.5F, v * vScale - 0.5F);
     }
   }
   return result;

@@ -41,7 +41,10 @@ class SurroundView {
   cv::Size size() const { return size_; }
   // Whether its picture changes with stream time for the same panorama: the orbiting eye of the
   // orbit and split views (ViewSettings::orbitPeriodS), and a switch of view under way.
-  bool moves() const;
+  bool moves() const { return transitioning_ || !settlesStill(); }
+  // Whether the view it shows (or is switching to) stands still once there: all but the orbiting
+  // eye.
+  bool settlesStill() const;
   // Where the split view shows its camera's own picture, letterboxed in the right half; none for
   // the other views.
   std::optional<cv::Rect> cameraArea() const;
@@ -59,9 +62,9 @@ class SurroundView {
   // Where each pixel of the view (as it is now, its eye at `timeS`) samples the panorama, in
   // panorama pixels (centres at integers, as PanoramaGeometry): CV_32FC2, NaN where it shows no
   // panorama (the car, the background, the split view's camera half). Rendered with the same
-  // geometry and interpolation as draw(), into a float target: needs EXT_color_buffer_float
-  // (RenderError without it). For setting up a view that does not move; it allocates, and
-  // waits for the GPU.
+  // geometry and interpolation as draw(), to 1/65536 of the panorama's width and 1/32767 of its
+  // height (1/32 of a pixel of a 2048 x 1024 panorama). For setting up a view that does not
+  // move; it allocates, and waits for the GPU.
   cv::Mat panoramaPositions(double timeS) const;
   // The scene's guidelines alone as this view shows them now (black elsewhere; none in the 360
   // view), 8-bit BGR, read back at once: for a view whose picture is gathered rather than drawn.
@@ -69,9 +72,16 @@ class SurroundView {
   const cv::Mat& guidelineLayer(double timeS);
   // Where such positions show the panorama: CV_8U, 255 there, 0 elsewhere.
   static cv::Mat panoramaShown(const cv::Mat& panoramaPositions);
+  // The view's picture as it shows once settled (the switch under way, if any, ended), 8-bit BGR,
+  // drawn into a target of its own: the pending picture stays. For the car and background of a
+  // view that does not move; it allocates, and waits for the GPU.
+  cv::Mat stillPicture(double timeS) const;
 
  private:
   void drawScene(ViewKind view, double timeS, SurroundScene::Pass pass) const;
+  // `pass` of the view as it shows settled, drawn into an 8-bit RGBA target of its own and read
+  // back at once.
+  cv::Mat drawAlone(SurroundScene::Pass pass, double timeS) const;
   // The picture into this view's framebuffer (bound), the switch of view blended in.
   void drawPicture(double timeS);
   // glReadPixels of this view's framebuffer (bound) into readBuffer_.
