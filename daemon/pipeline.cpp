@@ -88,7 +88,9 @@ Pipeline::Pipeline(const Config& config, RunStart start)
   }
   stages_.push_back(std::make_unique<StreamOutputStage>());
   openOutputs(config, mosaicStage, panorama);
-  if (surround_ != nullptr) surround_->prepare(outputs_);
+  if (surround_ != nullptr) {
+    surround_->prepare(outputs_, config.capture.pacing == capture::Pacing::kAsFastAsPossible);
+  }
 }
 
 void Pipeline::openOutputs(const Config& config, const MosaicStage& mosaic,

@@ -61,7 +61,7 @@ PixelFormat PanoramaStage::gatherFrames(FrameWork& work) {
   const PixelFormat format = shared.value_or(PixelFormat::kBgr);
   for (std::size_t c = 0; c < work.set.cameraCount; ++c) {
     const capture::Frame* frame = work.set.frame(c);
-    const cv::Mat* image = frame == nullptr                 ? nullptr
+    const cv::Mat* image = frame == nullptr              ? nullptr
                            : format == PixelFormat::kBgr ? work.bgr(c)
                                                          : &frame->image;
     // A faulty camera's picture would pull its neighbours' colours: correction goes without it.
@@ -96,11 +96,27 @@ void PanoramaStage::process(FrameWork& work, StageTimes& times) {
 }
 
 PanoramaStage::ViewPicture::ViewPicture(const PanoramaStage& stage,
-                                        const cv::Mat& panoramaPositions)
-    : lut_(processing::composeViewLut(stage.lut_, panoramaPositions, stage.pool_)),
+                                        const cv::Mat& panoramaPositions, WorkPool& pool)
+    : lut_(processing::composeViewLut(stage.lut_, panoramaPositions, pool)),
       stitcher_(lut_, stage.pool_),
       ownership_(lut_) {
   if (stage.poisson_) fieldSamples_ = stage.poisson_->viewSamples(panoramaPositions);
+}
+
+std::future<std::unique_ptr<PanoramaStage::ViewPicture>> PanoramaStage::buildView(
+    cv::Mat panoramaPositions) {
+  // One core: the other goes on with the sets. The positions are this thread's alone from here.
+  std::packaged_task<std::unique_ptr<ViewPicture>()> build(
+      [this, positions = std::move(panoramaPositions)] {
+        const auto start = std::chrono::steady_clock::now();
+        WorkPool caller(1);
+        auto view = std::make_unique<ViewPicture>(*this, positions, caller);
+        view->composedIn_ = std::chrono::steady_clock::now() - start;
+        return view;
+      });
+  auto built = build.get_future();
+  viewBuilds_.emplace_back(std::move(build));
+  return built;
 }
 
 void PanoramaStage::draw(ViewPicture& view, const FrameWork& work, cv::Mat& picture) {

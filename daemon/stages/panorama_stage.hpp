@@ -5,8 +5,11 @@
 // the pictures over time.
 
 #include <array>
+#include <chrono>
 #include <functional>
+#include <future>
 #include <memory>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -52,12 +55,15 @@ class PanoramaStage final : public PipelineStage {
 
   // A view that does not move, made the way the panorama is made but through the view's own LUT
   // (processing/stitch/view_lut.hpp): gathered from the set's frames straight into the view's
-  // picture, colour-corrected and each faulty camera's part marked. Built on the pool from where
-  // each of the view's pixels samples the panorama (SurroundView::panoramaPositions()).
+  // picture, colour-corrected and each faulty camera's part marked. Built by buildView().
   class ViewPicture {
    public:
-    ViewPicture(const PanoramaStage& stage, const cv::Mat& panoramaPositions);
+    // From where each of the view's pixels samples the panorama (SurroundView::
+    // panoramaPositions()), composed on `pool`; it gathers on the stage's pool.
+    ViewPicture(const PanoramaStage& stage, const cv::Mat& panoramaPositions, WorkPool& pool);
     cv::Size size() const { return lut_.size; }
+    // How long its composition took.
+    std::chrono::duration<double> composedIn() const { return composedIn_; }
 
    private:
     friend class PanoramaStage;
@@ -65,7 +71,12 @@ class PanoramaStage final : public PipelineStage {
     processing::Stitcher stitcher_;  // borrows lut_
     processing::PanoramaOwnership ownership_;
     processing::PoissonColourCorrection::ViewSamples fieldSamples_;  // colour_correction: poisson
+    std::chrono::duration<double> composedIn_{0};
   };
+  // Builds a view's picture on a thread of its own, from the LUT and the colour correction's
+  // set-up only (process() may run meanwhile): composing it takes tenths of a second, which no
+  // set should wait for. The stage waits for the builds under way when it goes.
+  std::future<std::unique_ptr<ViewPicture>> buildView(cv::Mat panoramaPositions);
   // The view's picture of the set process() was last given: 8-bit BGR of its size.
   void draw(ViewPicture& view, const FrameWork& work, cv::Mat& picture);
 
@@ -89,6 +100,8 @@ class PanoramaStage final : public PipelineStage {
   std::array<std::vector<cv::Mat>, kPixelFormats> blackFrames_;  // per PixelFormat, per camera
   cv::Mat panorama_;
   std::function<bool(FrameWork&)> wanted_;
+  // buildView()'s threads; last, so that they are joined before what they read goes.
+  std::vector<std::jthread> viewBuilds_;
 };
 
 }  // namespace surroundd::daemon

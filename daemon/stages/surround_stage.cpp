@@ -88,40 +88,69 @@ std::unique_ptr<render::SurroundView> SurroundStage::makeView(cv::Size size, Vie
 }
 
 SurroundStage::FixedView* SurroundStage::fixedView(render::SurroundView& view) {
+  if (!viewLut_ || gpu_ || !view.settlesStill()) return nullptr;
   const ViewKind kind = view.view();
-  if (!viewLut_ || gpu_ || view.moves()) return nullptr;
   const auto key = std::pair{static_cast<const render::SurroundView*>(&view), kind};
-  if (const auto known = fixedViews_.find(key); known != fixedViews_.end()) {
-    return known->second.view ? &known->second : nullptr;
+  const auto known = fixedViews_.find(key);
+  if (known == fixedViews_.end()) {
+    startFixedView(view, fixedViews_[key]);
+    return nullptr;
   }
-  FixedView& fixed = fixedViews_[key];
+  FixedView& fixed = known->second;
+  if (fixed.building.valid()) {
+    if (fixed.building.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+      return nullptr;
+    }
+    try {
+      fixed.view = fixed.building.get();
+      // Drawn now, not with the map: each takes its own set's time.
+      fixed.overlay = view.stillPicture(0);
+      fixed.picture = fixed.overlay.clone();
+      spdlog::info(
+          "render: the {} view {}x{} is gathered from the camera frames through its own "
+          "look-up table (made in {:.2f} s: {:.2f} s mapping it with OpenGL, {:.2f} s composing "
+          "it beside the sets)",
+          toString(kind), view.size().width, view.size().height,
+          (fixed.mappedIn + fixed.view->composedIn()).count(), fixed.mappedIn.count(),
+          fixed.view->composedIn().count());
+    } catch (const std::exception& e) {
+      fixed.view.reset();
+      spdlog::warn("render: the {} view is drawn by OpenGL: {}", toString(kind), e.what());
+    }
+  }
+  // Until a switch to it has ended, the renderer draws the way there.
+  return fixed.view && !view.moves() ? &fixed : nullptr;
+}
+
+void SurroundStage::startFixedView(render::SurroundView& view, FixedView& fixed) {
+  // The map here, on the context's thread (a tenth of a second on llvmpipe the first time); the
+  // composition on a thread of its own, while OpenGL draws the view (and the switch to it); the
+  // car and background when it is taken into use.
   const auto start = std::chrono::steady_clock::now();
   try {
     const cv::Mat positions = view.panoramaPositions(0);
-    fixed.view = std::make_unique<PanoramaStage::ViewPicture>(panoramaStage_, positions);
-    view.draw(0);
-    fixed.overlay = view.collect().clone();
     cv::bitwise_not(render::SurroundView::panoramaShown(positions), fixed.overlayMask);
     // The split view's camera half is the camera's own picture, scaled in each set.
     if (const auto camera = view.cameraArea()) fixed.overlayMask(*camera).setTo(0);
-    fixed.picture = fixed.overlay.clone();
+    fixed.mappedIn = std::chrono::steady_clock::now() - start;
+    fixed.building = panoramaStage_.buildView(positions);
   } catch (const render::RenderError& e) {
-    spdlog::warn("render: the {} view is drawn by OpenGL: {}", toString(kind), e.what());
-    fixed.view.reset();
-    return nullptr;
+    spdlog::warn("render: the {} view is drawn by OpenGL: {}", toString(view.view()), e.what());
   }
-  spdlog::info(
-      "render: the {} view {}x{} is gathered from the camera frames through its own "
-      "look-up table (made in {:.2f} s)",
-      toString(kind), view.size().width, view.size().height,
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  return &fixed;
 }
 
-void SurroundStage::prepare(PipelineOutputs& outputs) {
-  for (auto& output : outputs.pictures()) {
-    if (output.view && output.sink) (void)fixedView(*output.view);
+void SurroundStage::prepare(PipelineOutputs& outputs, bool waitForTables) {
+  const auto eachFirstView = [&] {
+    for (auto& output : outputs.pictures()) {
+      if (output.view && output.sink) (void)fixedView(*output.view);
+    }
+  };
+  eachFirstView();  // starts the tables
+  if (!waitForTables) return;
+  for (auto& [key, fixed] : fixedViews_) {
+    if (fixed.building.valid()) fixed.building.wait();
   }
+  eachFirstView();  // takes them into use
 }
 
 bool SurroundStage::gpuStitches(const FrameWork& work) const {

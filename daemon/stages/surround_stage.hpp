@@ -6,11 +6,13 @@
 // is finished (deliverFinished()). The last one goes out when the run ends.
 //
 // Views that do not move (top, 360, and orbit and split with a still eye; render.view_lut) are
-// not drawn per set: the first time an output shows one, the renderer maps where each of its
-// pixels samples the panorama and draws the car and background once; from then on the panorama
-// stage gathers its picture from the camera frames (PanoramaStage::ViewPicture), the car and
-// background are laid over it, and the split view's camera picture is scaled into its half. The
-// output gets it in the same set. Kept for when the output shows that view again.
+// not drawn per set: the first time an output shows one (or a switch to it begins), the renderer
+// maps where each of its pixels samples the panorama and draws the car and background once, and
+// the panorama stage composes the view's table from that on a thread of its own, while the
+// renderer draws the view as it draws those that move. From then on the panorama stage gathers
+// its picture from the camera frames (PanoramaStage::ViewPicture), the car and background are
+// laid over it, and the split view's camera picture is scaled into its half. The output gets it
+// in the same set. Kept for when the output shows that view again.
 //
 // With processing.backend gpu (or auto on a hardware renderer) the panorama the views sample is
 // stitched and colour-corrected on the GPU (render/gpu_stitcher.hpp) from the set's frames in
@@ -23,6 +25,7 @@
 
 #include <array>
 #include <chrono>
+#include <future>
 #include <map>
 #include <memory>
 #include <optional>
@@ -56,14 +59,16 @@ class SurroundStage final : public PipelineStage {
   // A view for an output of `size` (even sides), first showing `view`.
   std::unique_ptr<render::SurroundView> makeView(cv::Size size, ViewKind view);
 
-  // Maps each output's first view ahead of the first set when it does not move: composing its
-  // view table takes tenths of a second, which belong to start-up, not to a set's frame time.
-  void prepare(PipelineOutputs& outputs);
+  // Starts mapping each output's first view ahead of the first set when it does not move;
+  // `waitForTables`: until they are made (a replay as fast as possible, whose pictures are all
+  // to come the same way), else the renderer draws the first sets meanwhile (a live rig's first
+  // picture sooner).
+  void prepare(PipelineOutputs& outputs, bool waitForTables);
 
   // Whether this set needs the CPU's panorama: an output shows it, or a view drawn from it (on
-  // the CPU backend, or in a set the GPU does not stitch). Each output's view that does not move
-  // is mapped here the first time it is shown (a view switched to; so that one the renderer
-  // cannot map is drawn from the panorama too). For PanoramaStage::setWanted().
+  // the CPU backend, in a set the GPU does not stitch, or while its table is made). Each output's
+  // view that does not move starts being mapped here the first time it is shown (a view switched
+  // to, as the switch begins). For PanoramaStage::setWanted().
   bool needsPanorama(const FrameWork& work);
 
   void process(FrameWork& work, StageTimes& times) override;
@@ -100,7 +105,11 @@ class SurroundStage final : public PipelineStage {
 
   // A fixed view's picture, and the renderer's car and background to lay over it.
   struct FixedView {
+    // None while its table is being made, or where that failed.
     std::unique_ptr<PanoramaStage::ViewPicture> view;
+    // Its table being made, until taken into `view`; and how long OpenGL's part of that took.
+    std::future<std::unique_ptr<PanoramaStage::ViewPicture>> building;
+    std::chrono::duration<double> mappedIn{0};
     cv::Mat overlay;                       // 8-bit BGR, the renderer's picture of the view
     cv::Mat overlayMask;                   // CV_8U: where it shows no panorama
     cv::Mat picture;                       // the last drawn
@@ -113,9 +122,12 @@ class SurroundStage final : public PipelineStage {
   };
   // Lays the guidelines over a fixed view's picture, drawing them again when they have changed.
   void layGuidelines(render::SurroundView& view, FixedView& fixed);
-  // The output's fixed view, built the first time it shows it; null for a view that moves, with
-  // render.view_lut off, on the GPU backend, or where the renderer cannot map views (said once).
+  // The output's fixed view, its building started the first time it shows it; null until built
+  // and the switch to it has ended, for a view that moves, with render.view_lut off, on the GPU
+  // backend, or where the renderer cannot map views (said once).
   FixedView* fixedView(render::SurroundView& view);
+  // Maps the view onto the panorama (OpenGL, here), then has the panorama stage build its table.
+  void startFixedView(render::SurroundView& view, FixedView& fixed);
   // Whether the GPU stitches this set: the GPU backend, and no camera faulty.
   bool gpuStitches(const FrameWork& work) const;
   // The set's panorama into the texture the scene samples: stitched on the GPU, or the CPU's
