@@ -50,6 +50,7 @@ TEST(BenchCli, StitchReportsTimingsAndAccuracyAsJson) {
   // why not the same bytes), with both timed.
   const YAML::Node top = report["top_view"];
   EXPECT_EQ(top["size"][0].as<int>(), 1280);
+  EXPECT_GT(top["map_ms"].as<double>(), 0);
   EXPECT_GT(top["compose_s"].as<double>(), 0);
   EXPECT_GT(top["view_lut_ms"].as<double>(), 0);
   EXPECT_GT(top["rendered_ms"].as<double>(), 0);
