@@ -335,6 +335,16 @@ bool isStillPicturePath(const std::filesystem::path& path) {
   return std::ranges::find(kPictures, extension) != kPictures.end();
 }
 
+cv::Mat readPicture(const std::filesystem::path& path) {
+  FileSource source(path.filename().string(), {path, 30.0, false, Pacing::kAsFastAsPossible});
+  Frame frame;
+  frame.image.create(source.frameSize(), CV_8UC3);
+  if (source.read(frame) != ReadStatus::kFrame) {
+    throw CaptureError(fmt::format("{}: no picture in it: {}", path.string(), source.lastError()));
+  }
+  return frame.image;
+}
+
 FileSource::FileSource(std::string cameraName, FileSourceSettings settings,
                        std::shared_ptr<ReplayStart> start)
     : impl_(std::make_unique<Impl>()) {

@@ -36,6 +36,11 @@ struct FileSourceSettings {
 // itself goes by what FFmpeg finds in the file.
 bool isStillPicturePath(const std::filesystem::path& path);
 
+// The (first) picture in `path` as a FileSource decodes it (PNG, JPEG, ...: what FFmpeg reads),
+// 8-bit BGR: for a picture a config names besides its cameras (a body mask). Throws CaptureError
+// naming the file.
+cv::Mat readPicture(const std::filesystem::path& path);
+
 class FileSource final : public FrameSource {
  public:
   // Opens the file and decodes its first frame, so that a file that cannot deliver one fails here.

@@ -110,7 +110,13 @@ void ControlServer::run() {
         return c.phase == Client::Phase::kWaiting && c.ticket == id;
       });
       if (client == clients.end()) continue;  // it gave up or left
-      if (answer.encode) answer.reply.body = answer.encode();
+      if (answer.encode) {
+        try {
+          answer.reply.body = answer.encode();
+        } catch (const std::exception& e) {
+          answer.reply = ControlReply::failure(e.what());
+        }
+      }
       client->answer(answer.reply, now);
     }
     if (stopping) {

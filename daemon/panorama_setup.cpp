@@ -4,11 +4,11 @@
 #include <cstdlib>
 #include <numbers>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
 #include "daemon/rig_yaml.hpp"
+#include "daemon/vehicle_yaml.hpp"
 #include "processing/stitch/panorama_lut_cache.hpp"
 
 namespace surroundd::daemon {
@@ -38,7 +38,7 @@ cv::Mat bodyMaskOf(const Config& config, std::size_t index, WorkPool& pool) {
   if (camera.bodyMask) {
     const auto& own = *camera.bodyMask;
     if (!own.file.empty()) {
-      const cv::Mat picture = cv::imread(own.file.string(), cv::IMREAD_GRAYSCALE);
+      const cv::Mat picture = bodyMaskPicture(own.file);
       if (picture.empty() || picture.size() != size) {
         throw std::runtime_error(fmt::format(
             "{}: camera '{}': body_mask.file {}: expected a {}x{} picture (white = body), got {}",

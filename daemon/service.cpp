@@ -5,10 +5,10 @@
 #include <thread>
 
 #include <malloc.h>
-#include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
 #include "daemon/view_rules.hpp"
+#include "render/outputs/image_file.hpp"
 #include "render/view_camera.hpp"
 
 namespace surroundd::daemon {
@@ -247,8 +247,7 @@ ControlAnswer Service::answer(Pipeline& pipeline, const ControlRequest& request)
       // A copy here (the pipeline's buffer changes with the next set); the PNG is encoded on the
       // control server's thread, not this one.
       return {ControlReply::success({}), [copy = picture.clone()] {
-                std::vector<uchar> png;
-                cv::imencode(".png", copy, png);
+                const std::vector<std::uint8_t> png = render::encodePng(copy);
                 return std::string(png.begin(), png.end());
               }};
     }

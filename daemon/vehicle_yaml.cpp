@@ -4,8 +4,9 @@
 #include <cmath>
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
+#include "capture/file_source.hpp"
 #include "render/gltf_car.hpp"
 
 namespace surroundd::daemon {
@@ -136,6 +137,16 @@ VehicleConfig readVehicle(YamlObject& v) {
   return c;
 }
 
+cv::Mat bodyMaskPicture(const std::filesystem::path& file) {
+  cv::Mat grey;
+  try {
+    cv::cvtColor(capture::readPicture(file), grey, cv::COLOR_BGR2GRAY);
+  } catch (const capture::CaptureError&) {
+    grey.release();  // the caller names the file and what it expected
+  }
+  return grey;
+}
+
 BodyMaskConfig readBodyMask(YamlObject& m, cv::Size lensSize) {
   BodyMaskConfig c;
   c.mode =
@@ -143,7 +154,7 @@ BodyMaskConfig readBodyMask(YamlObject& m, cv::Size lensSize) {
                {{"add", BodyMaskConfig::Mode::kAdd}, {"replace", BodyMaskConfig::Mode::kReplace}});
   if (m.has("file")) c.file = m.existingFile("file").value_or("");
   if (!c.file.empty()) {
-    const cv::Mat picture = cv::imread(c.file.string(), cv::IMREAD_GRAYSCALE);
+    const cv::Mat picture = bodyMaskPicture(c.file);
     if (picture.size() != lensSize) {
       m.error("file",
               fmt::format("expected a {}x{} picture (the lens's size; white = body), got {}",

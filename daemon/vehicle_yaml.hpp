@@ -57,6 +57,9 @@ const ConfigKeys<VehicleConfig>& vehicleKeys();
 VehicleConfig readVehicle(YamlObject& vehicle);
 // A camera's `body_mask:`; its picture must be of the lens's size.
 BodyMaskConfig readBodyMask(YamlObject& mask, cv::Size lensSize);
+// A body mask's picture in grey levels (white = body); empty where the file holds none that can
+// be read.
+cv::Mat bodyMaskPicture(const std::filesystem::path& file);
 
 void emitVehicle(YAML::Emitter& out, const VehicleConfig& vehicle);
 

@@ -26,7 +26,7 @@ using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
-const cv::Size kSize(160, 120);
+const cv::Size kSize(160, 120);    // NOLINT(cert-err58-cpp): two ints, nothing to throw
 constexpr int kMaxReads = 10'000;  // bounds every read loop: a source that never ends fails
 
 cv::Mat picture(int index) { return testing::syntheticPicture(kSize, index); }
@@ -55,7 +55,7 @@ std::vector<microseconds> writeClip(const std::filesystem::path& path, int frame
   std::vector<microseconds> timestamps;
   for (int i = 0; i < frames; ++i) {
     if (std::find(gaps.begin(), gaps.end(), i) != gaps.end()) continue;
-    timestamps.push_back(microseconds(i * 100'000 / 3));
+    timestamps.emplace_back(i * 100'000 / 3);
     encoder.write(picture(i), timestamps.back());
   }
   encoder.close();
@@ -178,10 +178,10 @@ TEST_F(FileSourceVideo, CamerasWithJitteredLastFramesLoopByTheSameOffset) {
     };
     const auto early = timestampsOf("early");
     const auto late = timestampsOf("late");
-    for (int pass = 1; pass < 5; ++pass) {
+    for (std::size_t pass = 1; pass < 5; ++pass) {
       EXPECT_EQ(early[pass * 10] - early[0], late[pass * 10] - late[0]) << "pass " << pass;
       EXPECT_NEAR(std::chrono::duration<double>(early[pass * 10] - early[0]).count(),
-                  pass * 10 / 30.0, 1e-3);
+                  static_cast<double>(pass) * 10 / 30.0, 1e-3);
     }
   });
 }
@@ -318,6 +318,24 @@ TEST(FileSource, ATooWideSequenceNumberIsRefused) {
       },
       ThrowsMessage<CaptureError>(
           AllOf(HasSubstr("camera 'front'"), HasSubstr("wider than 32 digits"))));
+}
+
+// A picture a config names besides its cameras (a body mask) is read as a camera would read it:
+// a PNG's pixels exactly, a grey one in all three channels; a file with no picture is named.
+TEST(FileSource, APictureIsReadAsItsPixels) {
+  const testing::TempDir dir;
+  cv::imwrite((dir / "colour.png").string(), picture(3));
+  EXPECT_EQ(cv::norm(readPicture(dir / "colour.png"), picture(3), cv::NORM_INF), 0.0);
+  cv::Mat grey;
+  cv::cvtColor(picture(3), grey, cv::COLOR_BGR2GRAY);
+  cv::imwrite((dir / "grey.png").string(), grey);
+  std::vector<cv::Mat> channels;
+  cv::split(readPicture(dir / "grey.png"), channels);
+  ASSERT_EQ(channels.size(), 3U);
+  for (const cv::Mat& channel : channels) EXPECT_EQ(cv::norm(channel, grey, cv::NORM_INF), 0.0);
+  std::ofstream(dir / "text.png") << "not a picture\n";
+  EXPECT_THAT([&] { (void)readPicture(dir / "text.png"); },
+              ThrowsMessage<CaptureError>(HasSubstr("text.png")));
 }
 
 // A still picture as a camera: played at sequence_fps, looped with timestamps one period apart.
