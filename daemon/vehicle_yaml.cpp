@@ -142,7 +142,7 @@ cv::Mat bodyMaskPicture(const std::filesystem::path& file) {
   try {
     cv::cvtColor(capture::readPicture(file), grey, cv::COLOR_BGR2GRAY);
   } catch (const capture::CaptureError&) {
-    grey.release();  // the caller names the file and what it expected
+    return {};  // the caller names the file and what it expected
   }
   return grey;
 }
