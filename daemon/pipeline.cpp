@@ -48,6 +48,8 @@ double nominalFpsOf(const std::vector<std::unique_ptr<capture::CameraStream>>& c
 
 Pipeline::Pipeline(const Config& config, RunStart start)
     : runStart_(start),
+      renderer_(configured(config, OutputStream::kSurround) ? openSurroundRenderer(config)
+                                                            : decltype(renderer_)()),
       cameras_(openCameras(config)),
       synchronizer_(cameras_.size(),
                     std::chrono::duration_cast<capture::Timestamp>(
@@ -77,7 +79,8 @@ Pipeline::Pipeline(const Config& config, RunStart start)
     stages_.push_back(std::move(watch));
   }
   if (configured(config, OutputStream::kSurround)) {
-    auto stage = std::make_unique<SurroundStage>(config, *panorama, cameraFormatOf(cameras_));
+    auto stage = std::make_unique<SurroundStage>(config, std::move(*renderer_.get()), *panorama,
+                                                 cameraFormatOf(cameras_));
     surround_ = stage.get();
     stages_.push_back(std::move(stage));
     panorama->setWanted(

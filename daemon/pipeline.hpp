@@ -7,8 +7,9 @@
 //   capture   one thread per camera (CameraStream), a queue of capture.queue_frames each;
 //   sync .. render  this thread: synchronizes, composes the mosaic, stitches and colour-corrects
 //             the panorama (split over the work pool of pipeline.threads, only when an output shows
-//             it), renders the surround views (OpenGL ES; the EGL context is current on the thread
-//             that constructs the pipeline, which must be the one that runs it). A view's read-back
+//             it), renders the surround views (OpenGL ES; the EGL context, opened on a thread
+//             of its own while the cameras open, is then current on the thread that constructs
+//             the pipeline, which must be the one that runs it). A view's read-back
 //             is collected while the next frame set is stitched, so its output gets each picture
 //             one frame set later;
 //   outputs   one thread per output that may block (QueuedSink): a video encoder (3 pictures
@@ -25,6 +26,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <future>
 #include <memory>
 #include <optional>
 #include <string>
@@ -46,6 +48,7 @@ class CameraHealthStage;
 class MosaicStage;
 class PanoramaStage;
 class SurroundStage;
+class SurroundRenderer;
 
 struct RunSummary {
   std::uint64_t frameSets = 0;
@@ -130,6 +133,10 @@ class Pipeline {
 
   RunStart runStart_;  // first: it is taken before the cameras open
   bool firstPictureLogged_ = false;
+  // Opened beside the cameras and the panorama stage, taken by the surround stage; before the
+  // cameras, so that a camera that cannot open leaves it to finish and go.
+  // (Held by pointer: the renderer is declared in the surround stage's header, not this one.)
+  std::future<std::unique_ptr<SurroundRenderer>> renderer_;
   std::vector<std::unique_ptr<capture::CameraStream>> cameras_;
   capture::Synchronizer synchronizer_;
   bool live_;        // V4L2 cameras: sets go without a late camera

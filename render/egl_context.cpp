@@ -196,6 +196,16 @@ bool EglContext::open(EglPlatform platform, std::string& why) {
   return true;
 }
 
+void EglContext::release() {
+  eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+}
+
+void EglContext::makeCurrent() {
+  if (eglMakeCurrent(display_, surface_, surface_, context_) != EGL_TRUE) {
+    throw RenderError(eglErrorText("eglMakeCurrent"));
+  }
+}
+
 void EglContext::close() {
   if (display_ == EGL_NO_DISPLAY) return;
   eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);

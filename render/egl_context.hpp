@@ -4,8 +4,9 @@
 //   device       EGL_EXT_platform_device on a hardware device (NVIDIA's driver, or a DRM node);
 //   surfaceless  EGL_MESA_platform_surfaceless (Mesa: a GPU, or llvmpipe on the CPU);
 //   default      the default display with a 1x1 pbuffer, for drivers with neither.
-// The context is current on the thread that made it and stays so; GL objects must be made and
-// used on that thread, and destroyed before the context.
+// The context is current on the thread that made it until release() hands it on, and then on
+// the one that calls makeCurrent(): EGL binds a context to one thread at a time, so GL objects are
+// made and used on the thread that has it, and destroyed before the context.
 
 #include <string>
 
@@ -25,6 +26,11 @@ class EglContext {
 
   // "surfaceless: llvmpipe (LLVM 15.0.6, 256 bits), OpenGL ES 3.2 Mesa 22.3.6"
   const std::string& description() const { return description_; }
+  // Current on no thread from now on (called on the thread that has it), so that another can
+  // take it.
+  void release();
+  // Current on the calling thread; no other may have it. Throws RenderError.
+  void makeCurrent();
   EglPlatform platform() const { return platform_; }
   // Whether the renderer runs on the CPU (Mesa's llvmpipe, softpipe or swrast; SwiftShader):
   // there, pixel work is faster in the CPU path than through OpenGL.

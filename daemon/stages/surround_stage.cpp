@@ -31,37 +31,75 @@ std::pair<bool, std::string_view> gpuBackendOf(const Config& config, const rende
                               : "processing.backend: gpu"};
 }
 
+// The camera the split view shows beside the surround: render.split_camera, else the first.
+std::size_t splitCameraOf(const Config& config) {
+  const auto names = cameraNames(config);
+  const auto split = std::ranges::find(names, config.render.splitCamera);
+  return split == names.end() ? 0 : static_cast<std::size_t>(split - names.begin());
+}
+
+std::unique_ptr<render::EglContext> madeCurrent(std::unique_ptr<render::EglContext> gl) {
+  gl->makeCurrent();
+  return gl;
+}
+
 }  // namespace
 
-SurroundStage::SurroundStage(const Config& config, PanoramaStage& panorama,
-                             PixelFormat cameraFormat)
+SurroundRenderer::SurroundRenderer(std::unique_ptr<render::EglContext> context,
+                                   std::unique_ptr<render::SurroundScene> built,
+                                   std::size_t triangles)
+    : gl(std::move(context)), scene(std::move(built)), meshTriangles(triangles) {}
+
+SurroundRenderer::~SurroundRenderer() {
+  if (!scene || !gl) return;
+  try {
+    gl->makeCurrent();
+  } catch (const render::RenderError& e) {
+    spdlog::warn("render: the scene is left to its context's end: {}", e.what());
+  }
+}
+
+std::future<std::unique_ptr<SurroundRenderer>> openSurroundRenderer(const Config& config) {
+  return std::async(std::launch::async, [&config] {
+    auto gl = std::make_unique<render::EglContext>(config.render.platform);
+    spdlog::info("render: {}", gl->description());
+    const processing::PanoramaSettings settings = panoramaSettings(config);
+    processing::SurroundMesh mesh;
+    try {
+      mesh = processing::buildSurroundMesh(meshSettings(config), settings.geometry);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(fmt::format("{}: {}", config.file.string(), e.what()));
+    }
+    const cv::Size splitCamera =
+        config.cameras.at(splitCameraOf(config)).calibration.intrinsics.imageSize;
+    auto renderer = std::make_unique<SurroundRenderer>(
+        std::move(gl),
+        std::make_unique<render::SurroundScene>(mesh, settings.geometry, config.render.car,
+                                                splitCamera),
+        mesh.indices.size() / 3);
+    renderer->gl->release();
+    return renderer;
+  });
+}
+
+SurroundStage::SurroundStage(const Config& config, SurroundRenderer renderer,
+                             PanoramaStage& panorama, PixelFormat cameraFormat)
     : views_(config.render.views),
-      gl_(config.render.platform),
+      gl_(madeCurrent(std::move(renderer.gl))),
+      scene_(std::move(renderer.scene)),
       panoramaStage_(panorama),
       panorama_(panorama.picture()),
       viewLut_(config.render.viewLut),
       guidelineMode_(config.render.guidelines),
       guide_(config.render.guide),
-      car_(config.render.car) {
-  spdlog::info("render: {}", gl_.description());
-  const processing::PanoramaSettings settings = panoramaSettings(config);
-  processing::SurroundMesh mesh;
-  try {
-    mesh = processing::buildSurroundMesh(meshSettings(config), settings.geometry);
-  } catch (const std::invalid_argument& e) {
-    throw std::runtime_error(fmt::format("{}: {}", config.file.string(), e.what()));
-  }
-  const auto names = cameraNames(config);
-  const auto split = std::ranges::find(names, config.render.splitCamera);
-  splitCamera_ = split == names.end() ? 0 : static_cast<std::size_t>(split - names.begin());
-  scene_ = std::make_unique<render::SurroundScene>(mesh, settings.geometry, config.render.car,
-                                                   panorama.lut().cameraSizes.at(splitCamera_));
+      car_(config.render.car),
+      splitCamera_(splitCameraOf(config)) {
   if (guidelineMode_ != GuidelineMode::kOff) {
     const std::size_t vertices = render::maxGuidelineVertices(guide_);
     guideVertices_.reserve(vertices);
     scene_->reserveGuidelines(vertices);
   }
-  auto [gpu, why] = gpuBackendOf(config, gl_);
+  auto [gpu, why] = gpuBackendOf(config, *gl_);
   if (gpu) {
     try {
       gpu_ = std::make_unique<render::GpuStitcher>(panorama.lut(), cameraFormat, panorama.pool());
@@ -78,7 +116,7 @@ SurroundStage::SurroundStage(const Config& config, PanoramaStage& panorama,
                config.mesh.model == MeshModel::kBowl   ? "bowl"
                : config.mesh.model == MeshModel::kFlat ? "flat"
                                                        : "sphere360",
-               mesh.indices.size() / 3, names[splitCamera_]);
+               renderer.meshTriangles, cameraNames(config)[splitCamera_]);
 }
 
 std::unique_ptr<render::SurroundView> SurroundStage::makeView(cv::Size size, ViewKind view) {
@@ -93,7 +131,7 @@ SurroundStage::FixedView* SurroundStage::fixedView(render::SurroundView& view) {
   const auto key = std::pair{static_cast<const render::SurroundView*>(&view), kind};
   const auto known = fixedViews_.find(key);
   if (known == fixedViews_.end()) {
-    startFixedView(view, fixedViews_[key]);
+    if (!tablesAfterFirstPicture_) startFixedView(view, fixedViews_[key]);
     return nullptr;
   }
   FixedView& fixed = known->second;
@@ -140,6 +178,11 @@ void SurroundStage::startFixedView(render::SurroundView& view, FixedView& fixed)
 }
 
 void SurroundStage::prepare(PipelineOutputs& outputs, bool waitForTables) {
+  if (!waitForTables) {
+    // Mapping a view and composing its table take the cores that the first picture needs.
+    tablesAfterFirstPicture_ = true;
+    return;
+  }
   const auto eachFirstView = [&] {
     for (auto& output : outputs.pictures()) {
       if (output.view && output.sink) (void)fixedView(*output.view);
@@ -326,6 +369,7 @@ void SurroundStage::deliver(PipelineOutputs& outputs, StageTimes* times, Pending
     if (!picture.empty()) {
       outputs.handOver(output, picture, output.pendingTime, output.pendingOrigin,
                        output.view->drawn());
+      tablesAfterFirstPicture_ = false;
     }
     if (times != nullptr) times->lap(Stage::kOutput);
   }

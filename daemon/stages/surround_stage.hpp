@@ -6,10 +6,11 @@
 // is finished (deliverFinished()). The last one goes out when the run ends.
 //
 // Views that do not move (top, 360, and orbit and split with a still eye; render.view_lut) are
-// not drawn per set: the first time an output shows one (or a switch to it begins), the renderer
-// maps where each of its pixels samples the panorama and draws the car and background once, and
-// the panorama stage composes the view's table from that on a thread of its own, while the
-// renderer draws the view as it draws those that move. From then on the panorama stage gathers
+// not drawn per set: the first time an output shows one (on a paced or live rig, once the first
+// picture has gone out), or as a switch to it begins, the renderer maps where each of its pixels
+// samples the panorama and draws the car and background once, and the panorama stage composes
+// the view's table from that on a thread of its own, while the renderer draws the view as it
+// draws those that move. From then on the panorama stage gathers
 // its picture from the camera frames (PanoramaStage::ViewPicture), the car and background are
 // laid over it, and the split view's camera picture is scaled into its half. The output gets it
 // in the same set. Kept for when the output shows that view again.
@@ -20,8 +21,10 @@
 // than the CPU gathers it). The CPU's panorama is then made only when something needs it: an
 // output of the panorama, or a set with a faulty camera (whose part the CPU marks).
 //
-// Threads: the EGL context is made current on the thread that constructs the stage, which must be
-// the one that runs it.
+// Threads: the renderer (its EGL context and scene) is opened on a thread of its own
+// (openSurroundRenderer()) while the cameras open and the panorama's table is read, and handed to
+// the stage with its context current on no thread; the stage makes it current on the thread that
+// constructs it, which must be the one that runs it.
 
 #include <array>
 #include <chrono>
@@ -48,21 +51,47 @@
 
 namespace surroundd::daemon {
 
+// What the surround views are drawn with: the EGL context and the scene (mesh, car, shaders).
+// Opening it is most of the start-up's fixed cost on llvmpipe (0.4 s: the driver's start and the
+// shaders' compiling) and needs nothing the cameras or the panorama's table give, so it runs beside
+// them. Its context is current on no thread while it is handed over.
+class SurroundRenderer {
+ public:
+  SurroundRenderer(std::unique_ptr<render::EglContext> context,
+                   std::unique_ptr<render::SurroundScene> built, std::size_t triangles);
+  // Never taken by a stage (the start-up failed elsewhere): the scene's GL objects are deleted
+  // with its context current on this thread.
+  ~SurroundRenderer();
+  SurroundRenderer(SurroundRenderer&&) = default;
+  SurroundRenderer& operator=(SurroundRenderer&&) = default;
+
+  // The context first, so that it outlives the GL objects of the scene.
+  std::unique_ptr<render::EglContext> gl;
+  std::unique_ptr<render::SurroundScene> scene;
+  std::size_t meshTriangles = 0;
+};
+
+// Opens the renderer for `config`'s surround views on a thread of its own; `config` must outlive
+// the future's result. Its get() throws RenderError, or std::runtime_error naming the config for
+// a mesh that cannot be built.
+std::future<std::unique_ptr<SurroundRenderer>> openSurroundRenderer(const Config& config);
+
 class SurroundStage final : public PipelineStage {
  public:
-  // Opens the EGL context and builds the scene; `panorama` must outlive the stage. The GPU
-  // stitch, where processing.backend chooses it, is built for frames held in `cameraFormat` (and
-  // built again should a set's frames come in another). Throws RenderError, or
-  // std::runtime_error naming the config for a mesh that cannot be built.
-  SurroundStage(const Config& config, PanoramaStage& panorama, PixelFormat cameraFormat);
+  // Draws with `renderer` (openSurroundRenderer(config)), its context made current here;
+  // `panorama` must outlive the stage. The GPU stitch, where processing.backend chooses it, is
+  // built for frames held in `cameraFormat` (and built again should a set's frames come in
+  // another). Throws RenderError.
+  SurroundStage(const Config& config, SurroundRenderer renderer, PanoramaStage& panorama,
+                PixelFormat cameraFormat);
 
   // A view for an output of `size` (even sides), first showing `view`.
   std::unique_ptr<render::SurroundView> makeView(cv::Size size, ViewKind view);
 
-  // Starts mapping each output's first view ahead of the first set when it does not move;
-  // `waitForTables`: until they are made (a replay as fast as possible, whose pictures are all
-  // to come the same way), else the renderer draws the first sets meanwhile (a live rig's first
-  // picture sooner).
+  // `waitForTables` (a replay as fast as possible, whose pictures are all to come the same way):
+  // maps each output's first view that does not move and waits for its table, ahead of the first
+  // set. Else (a paced or live rig) the renderer draws the first picture, and the tables are
+  // started once it has gone out: the first picture sooner.
   void prepare(PipelineOutputs& outputs, bool waitForTables);
 
   // Whether this set needs the CPU's panorama: an output shows it, or a view drawn from it (on
@@ -85,7 +114,7 @@ class SurroundStage final : public PipelineStage {
 
   // The renderer, and where the panorama is stitched when that is the GPU.
   std::string description() const {
-    return gpu_ ? gl_.description() + "; panorama stitched on the GPU" : gl_.description();
+    return gpu_ ? gl_->description() + "; panorama stitched on the GPU" : gl_->description();
   }
   // Whether the GPU stitches the panorama (processing.backend as it came out on this renderer).
   bool stitchesOnGpu() const { return gpu_ != nullptr; }
@@ -140,10 +169,10 @@ class SurroundStage final : public PipelineStage {
   render::ViewSettings views_;
   // The context first, so that it outlives the GL objects of the scene (and of the outputs' views,
   // which the pipeline destroys before its stages).
-  render::EglContext gl_;
+  std::unique_ptr<render::EglContext> gl_;
+  std::unique_ptr<render::SurroundScene> scene_;
   render::GpuTimer gpuTimer_;  // borrowed by the outputs' views
   std::array<DurationHistogram, render::kGpuSteps> gpuTimes_{};
-  std::unique_ptr<render::SurroundScene> scene_;
   PanoramaStage& panoramaStage_;
   const cv::Mat& panorama_;
   std::unique_ptr<render::GpuStitcher> gpu_;  // processing.backend: gpu
@@ -156,7 +185,8 @@ class SurroundStage final : public PipelineStage {
   // What the guidelines show now (travel, steering in tenths of a degree); none: not shown.
   std::optional<std::pair<render::Travel, long>> guidesShown_;
   int guidesVersion_ = 0;
-  bool panoramaSkipped_ = false;  // this set: needsPanorama() said no
+  bool panoramaSkipped_ = false;          // this set: needsPanorama() said no
+  bool tablesAfterFirstPicture_ = false;  // prepare() without waiting: no table started yet
   // Per output's view (its address; each lives as long as the pipeline) and the kind it shows.
   std::map<std::pair<const render::SurroundView*, ViewKind>, FixedView> fixedViews_;
   std::size_t splitCamera_ = 0;

@@ -8,6 +8,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "capture/file_source.hpp"
 #include "daemon/pipeline.hpp"
@@ -194,6 +195,37 @@ TEST_F(ReplayTest, OfCamerasThatCannotOpenTheFirstInTheRigIsNamed) {
       EXPECT_THAT(e.what(), ::testing::Not(::testing::HasSubstr("left.mkv")));
     }
   }
+}
+
+// The renderer opens on a thread of its own while the cameras open. When a camera cannot, the
+// error is the camera's, and the renderer opened meanwhile goes with the failed start (its scene's
+// GL objects deleted in its own context); a pipeline made next on the same thread draws its view.
+TEST_F(ReplayTest, ARendererOpenedBesideACameraThatCannotOpenGoesWithIt) {
+  const testing::TempDir dir;
+  config_.capture.pacing = capture::Pacing::kAsFastAsPossible;
+  config_.render.widthPx = 320;
+  config_.render.heightPx = 180;
+  OutputConfig snapshot;
+  snapshot.kind = OutputKind::kSnapshot;
+  snapshot.stream = OutputStream::kSurround;
+  snapshot.path = dir / "last.png";
+  snapshot.atSeconds = 1e6;
+  config_.outputs = {snapshot};
+  Config broken = config_;
+  broken.cameras[2].source->path = "/nonexistent/back.mkv";
+  try {
+    const Pipeline pipeline(broken);
+    FAIL() << "a rig with a missing video was opened";
+  } catch (const std::exception& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("/nonexistent/back.mkv"));
+  }
+
+  Pipeline pipeline(config_);
+  const std::atomic<bool> stop{false};
+  EXPECT_GT(pipeline.run(stop).frameSets, 10u);
+  const cv::Mat last = cv::imread((dir / "last.png").string());
+  ASSERT_EQ(last.size(), cv::Size(320, 180));
+  EXPECT_GT(cv::mean(last)[1], 20.0);  // the ground, not an empty picture
 }
 
 }  // namespace
