@@ -273,6 +273,12 @@ TEST_F(ServiceTest, GuidelinesFollowTheGearAndTheSteering) {
   auto surroundd =
       start(writeConfig("  - {type: video, stream: surround, view: top, path: out/top.mp4}"));
   waitForSets(*surroundd, 5);
+  // Paced as a live rig: the first picture drawn by OpenGL, the top view's table made after it
+  // and then taken into use.
+  const std::string gathered = "the top view 320x240 is gathered from the camera frames";
+  waitForLog(*surroundd, gathered);
+  const std::string log = surroundd->output();
+  EXPECT_LT(log.find("first picture out"), log.find(gathered));
   cv::Mat last;
   const auto amberPixels = [&] {
     waitForSets(*surroundd, frameSets(*surroundd) + 3);
