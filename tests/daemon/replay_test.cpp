@@ -44,6 +44,19 @@ class ReplayTest : public ::testing::Test {
     dropping_ = static_cast<std::size_t>(fewest - timestamps_.begin());
   }
 
+  // Replayed as fast as possible, with one output: `stream`'s last picture (320x180) into `file`.
+  void replayIntoLastPicture(const std::filesystem::path& file, OutputStream stream) {
+    config_.capture.pacing = capture::Pacing::kAsFastAsPossible;
+    config_.render.widthPx = 320;
+    config_.render.heightPx = 180;
+    OutputConfig snapshot;
+    snapshot.kind = OutputKind::kSnapshot;
+    snapshot.stream = stream;
+    snapshot.path = file;
+    snapshot.atSeconds = 1e6;
+    config_.outputs = {snapshot};
+  }
+
   Config config_;
   std::vector<std::vector<capture::Timestamp>> timestamps_;
   std::size_t dropping_ = 0;
@@ -80,14 +93,7 @@ TEST_F(ReplayTest, TimestampsAreTheRecordedOnes) {
 
 TEST_F(ReplayTest, PipelineLosesOnlyTheSetsOfTheDroppedFrames) {
   const testing::TempDir dir;
-  config_.capture.pacing = capture::Pacing::kAsFastAsPossible;
-  config_.render.widthPx = 320;
-  config_.render.heightPx = 180;
-  OutputConfig snapshot;
-  snapshot.kind = OutputKind::kSnapshot;
-  snapshot.path = dir / "last.png";
-  snapshot.atSeconds = 1e6;
-  config_.outputs = {snapshot};
+  replayIntoLastPicture(dir / "last.png", OutputStream::kMosaic);
 
   Pipeline pipeline(config_);
   const std::atomic<bool> stop{false};
@@ -202,15 +208,7 @@ TEST_F(ReplayTest, OfCamerasThatCannotOpenTheFirstInTheRigIsNamed) {
 // GL objects deleted in its own context); a pipeline made next on the same thread draws its view.
 TEST_F(ReplayTest, ARendererOpenedBesideACameraThatCannotOpenGoesWithIt) {
   const testing::TempDir dir;
-  config_.capture.pacing = capture::Pacing::kAsFastAsPossible;
-  config_.render.widthPx = 320;
-  config_.render.heightPx = 180;
-  OutputConfig snapshot;
-  snapshot.kind = OutputKind::kSnapshot;
-  snapshot.stream = OutputStream::kSurround;
-  snapshot.path = dir / "last.png";
-  snapshot.atSeconds = 1e6;
-  config_.outputs = {snapshot};
+  replayIntoLastPicture(dir / "last.png", OutputStream::kSurround);
   Config broken = config_;
   broken.cameras[2].source->path = "/nonexistent/back.mkv";
   try {
