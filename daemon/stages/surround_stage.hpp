@@ -10,10 +10,10 @@
 // picture has gone out), or as a switch to it begins, the renderer maps where each of its pixels
 // samples the panorama and draws the car and background once, and the panorama stage composes
 // the view's table from that on a thread of its own, while the renderer draws the view as it
-// draws those that move. From then on the panorama stage gathers
-// its picture from the camera frames (PanoramaStage::ViewPicture), the car and background are
-// laid over it, and the split view's camera picture is scaled into its half. The output gets it
-// in the same set. Kept for when the output shows that view again.
+// draws those that move. From then on the panorama stage gathers its picture from the camera
+// frames (PanoramaStage::ViewPicture), the car and background are laid over it, and the split
+// view's camera picture is scaled into its half. The output gets it in the same set. Kept for when
+// the output shows that view again.
 //
 // With processing.backend gpu (or auto on a hardware renderer) the panorama the views sample is
 // stitched and colour-corrected on the GPU (render/gpu_stitcher.hpp) from the set's frames in
