@@ -46,9 +46,8 @@ std::unique_ptr<render::EglContext> madeCurrent(std::unique_ptr<render::EglConte
 }  // namespace
 
 SurroundRenderer::SurroundRenderer(std::unique_ptr<render::EglContext> context,
-                                   std::unique_ptr<render::SurroundScene> built,
-                                   std::size_t triangles)
-    : gl(std::move(context)), scene(std::move(built)), meshTriangles(triangles) {}
+                                   std::unique_ptr<render::SurroundScene> built)
+    : gl(std::move(context)), scene(std::move(built)) {}
 
 SurroundRenderer::~SurroundRenderer() {
   if (!scene || !gl) return;
@@ -74,13 +73,16 @@ std::future<std::unique_ptr<SurroundRenderer>> openSurroundRenderer(const Config
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(fmt::format("{}: {}", config.file.string(), e.what()));
     }
-    const cv::Size splitCamera =
-        config.cameras.at(splitCameraOf(config)).calibration.intrinsics.imageSize;
+    const std::size_t split = splitCameraOf(config);
     auto renderer = std::make_unique<SurroundRenderer>(
-        std::move(gl),
-        std::make_unique<render::SurroundScene>(mesh, settings.geometry, config.render.car,
-                                                splitCamera),
-        mesh.indices.size() / 3);
+        std::move(gl), std::make_unique<render::SurroundScene>(
+                           mesh, settings.geometry, config.render.car,
+                           config.cameras.at(split).calibration.intrinsics.imageSize));
+    spdlog::info("render: {} mesh of {} triangles, split view shows '{}'",
+                 config.mesh.model == MeshModel::kBowl   ? "bowl"
+                 : config.mesh.model == MeshModel::kFlat ? "flat"
+                                                         : "sphere360",
+                 mesh.indices.size() / 3, cameraNames(config)[split]);
     renderer->gl->release();
     return renderer;
   });
@@ -116,11 +118,6 @@ SurroundStage::SurroundStage(const Config& config, SurroundRenderer renderer,
   }
   spdlog::info("processing: {} ({}){}", gpu_ ? "gpu" : "cpu", why,
                gpu_ ? fmt::format(", frames uploaded as {}", toString(cameraFormat)) : "");
-  spdlog::info("render: {} mesh of {} triangles, split view shows '{}'",
-               config.mesh.model == MeshModel::kBowl   ? "bowl"
-               : config.mesh.model == MeshModel::kFlat ? "flat"
-                                                       : "sphere360",
-               renderer.meshTriangles, cameraNames(config)[splitCamera_]);
 }
 
 std::unique_ptr<render::SurroundView> SurroundStage::makeView(cv::Size size, ViewKind view) {

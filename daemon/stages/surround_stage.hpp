@@ -58,7 +58,7 @@ namespace surroundd::daemon {
 class SurroundRenderer {
  public:
   SurroundRenderer(std::unique_ptr<render::EglContext> context,
-                   std::unique_ptr<render::SurroundScene> built, std::size_t triangles);
+                   std::unique_ptr<render::SurroundScene> built);
   // Never taken by a stage (the start-up failed elsewhere): the scene's GL objects are deleted
   // with its context current on this thread.
   ~SurroundRenderer();
@@ -68,7 +68,6 @@ class SurroundRenderer {
   // The context first, so that it outlives the GL objects of the scene.
   std::unique_ptr<render::EglContext> gl;
   std::unique_ptr<render::SurroundScene> scene;
-  std::size_t meshTriangles = 0;
 };
 
 // Opens the renderer for `config`'s surround views on a thread of its own; `config` must outlive
