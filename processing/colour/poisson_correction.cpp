@@ -73,7 +73,9 @@ PoissonColourCorrection::PoissonColourCorrection(const Rig& rig, const PanoramaS
       rig_(rig),
       panorama_(panorama),
       missingSets_(rig.cameras.size(), 0),
-      meter_(static_cast<std::size_t>(std::lround(1 / settings.scale * (1 / settings.scale)))),
+      meters_(static_cast<std::size_t>(pool.threads()) * 4,
+              SeamBlockMeter(static_cast<std::size_t>(
+                  std::lround(1 / settings.scale * (1 / settings.scale))))),
       window_(2 * kSeamHalfWindow + 1) {
   activeCameras_ = (1U << rig.cameras.size()) - 1;
   full_ = &configurationFor(activeCameras_);

@@ -147,6 +147,9 @@ class PoissonColourCorrection {
   Configuration& configurationFor(std::uint32_t presentCameras);
   void followLostCameras(std::span<const cv::Mat> frames);
   void gatherSeams(std::span<const cv::Mat> frames, PixelFormat format);
+  // Measures part `part` of the seam blocks, with its own meter: of the regions' blocks counted
+  // in turn, every meters_.size()-th from the part's, so that the parts cost alike.
+  void measureSeamBlocks(std::size_t part, std::span<const cv::Mat> frames, PixelFormat format);
   // Gives the seam's blocks past the bowl's floor one value, their median (of each channel).
   void farGroundAsOneBand(const CorrectionRegion& region, const CorrectionSeam& seam,
                           RegionState& state);
@@ -176,10 +179,10 @@ class PoissonColourCorrection {
   std::vector<int> missingSets_;  // per camera: frame sets in a row without it
   std::vector<std::string> changes_;
   std::vector<SeamReport> seamReports_;
-  SeamBlockMeter meter_;
-  std::vector<float> window_;          // running median along a seam
-  std::vector<std::uint8_t> resolve_;  // per region
-  std::vector<float> stepScratch_;     // per block of a seam: its step without and with the field
+  std::vector<SeamBlockMeter> meters_;  // one per part of the seam blocks measured at once
+  std::vector<float> window_;           // running median along a seam
+  std::vector<std::uint8_t> resolve_;   // per region
+  std::vector<float> stepScratch_;      // per block of a seam: its step without and with the field
   // CV_32FC3 over fieldStorage_, which has one float past the last block: the vector applies read
   // four floats for a block's three channels.
   std::vector<float> fieldStorage_;

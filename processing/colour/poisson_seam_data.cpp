@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "common/work_pool.hpp"
 #include "processing/colour/poisson_correction_state.hpp"
 
 namespace surroundd::processing {
@@ -86,22 +87,24 @@ void PoissonColourCorrection::farGroundAsOneBand(const CorrectionRegion& region,
   }
 }
 
-void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames, PixelFormat format) {
+void PoissonColourCorrection::measureSeamBlocks(std::size_t part, std::span<const cv::Mat> frames,
+                                                PixelFormat format) {
   Configuration& active = *active_;
-  const float keep = active.firstFrame ? 0.0f : static_cast<float>(settings_.temporalSmoothing);
   const bool multiplicative = settings_.field == CorrectionField::kMultiplicative;
+  SeamBlockMeter& meter = meters_[part];
+  std::size_t turn = 0;  // of the block, counted over the regions
   for (std::size_t r = 0; r < active.regions.size(); ++r) {
     const CorrectionRegion& region = active.domain.regions[r];
     RegionState& state = active.regions[r];
     const cv::Mat& source = frames[region.source];
-    for (std::size_t k = 0; k < region.dirichlet.size(); ++k) {
+    for (std::size_t k = 0; k < region.dirichlet.size(); ++k, ++turn) {
+      if (turn % meters_.size() != part) continue;
       const DirichletBlock& d = region.dirichlet[k];
       const cv::Mat& target = frames[d.target];
       state.measuredValid[k] = 0;
       if (source.empty() || target.empty()) continue;
-      const SeamBlockLevels levels = meter_.measure(active.domain, d,
-                                                    SampledImage::of(target, format),
-                                                    SampledImage::of(source, format));
+      const SeamBlockLevels levels = meter.measure(
+          active.domain, d, SampledImage::of(target, format), SampledImage::of(source, format));
       state.levels[k] = levels;
       state.measuredValid[k] = levels.valid ? 1 : 0;
       for (int c = 0; c < 3; ++c) {
@@ -112,6 +115,23 @@ void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames, Pixel
       }
     }
   }
+}
+
+void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames, PixelFormat format) {
+  Configuration& active = *active_;
+  const float keep = active.firstFrame ? 0.0f : static_cast<float>(settings_.temporalSmoothing);
+  const bool multiplicative = settings_.field == CorrectionField::kMultiplicative;
+  // Each part writes only its own blocks' entries. Four parts a thread: a thread that the encoder
+  // or the decoders keep from starting leaves its parts to the others instead of being waited for.
+  const auto parts = static_cast<int>(meters_.size());
+  pool_.parallelFor(
+      parts,
+      [&](int first, int last) {
+        for (int part = first; part < last; ++part) {
+          measureSeamBlocks(static_cast<std::size_t>(part), frames, format);
+        }
+      },
+      parts);
 
   seamReports_.resize(active.domain.seams.size());
   const auto logMin = static_cast<float>(std::log(settings_.minGain));

@@ -189,6 +189,28 @@ TEST_F(ColourCorrectionTest, SolversGiveTheSameField) {
   EXPECT_GT(cv::norm(fields[0], cv::NORM_INF), 10.0);  // and there is a field to agree on
 }
 
+// The seam blocks are measured in parts on the work pool: one thread or three, the same seam data
+// and the same field, to the bit.
+TEST_F(ColourCorrectionTest, TheFieldDoesNotDependOnTheThreadsThatMeasureTheSeams) {
+  const auto frames = firstFrames(truth_);
+  std::vector<cv::Mat> fields;
+  std::vector<std::vector<int>> validBlocks;
+  for (const int threads : {1, 2, 3}) {
+    WorkPool pool(threads);
+    PoissonColourCorrection poisson(truth_.rig, settings_, lut_,
+                                    correction(PoissonSolverKind::kAuto), pool);
+    poisson.update(frames);
+    fields.push_back(poisson.field().clone());
+    auto& valid = validBlocks.emplace_back();
+    for (const auto& seam : poisson.seams()) valid.push_back(seam.validBlocks);
+  }
+  EXPECT_GT(cv::norm(fields[0], cv::NORM_INF), 10.0);
+  for (std::size_t i = 1; i < fields.size(); ++i) {
+    EXPECT_EQ(cv::norm(fields[0], fields[i], cv::NORM_INF), 0.0) << i + 1 << " threads";
+    EXPECT_EQ(validBlocks[0], validBlocks[i]) << i + 1 << " threads";
+  }
+}
+
 // A static scene: the same picture with fresh sensor noise each frame.
 TEST_F(ColourCorrectionTest, AStaticSceneDoesNotFlickerAndWarmStartsAreCheap) {
   const auto& frame = truth_.frames.front();
