@@ -27,8 +27,8 @@ struct FrameWork {
   // Per camera: a buffer that bgr() converts a YUV frame into, kept by the pipeline from set to set
   // (allocated at the first conversion, then reused).
   std::array<cv::Mat, kMaxCameras>& bgrBuffers;
-  std::chrono::nanoseconds streamTime{0};            // since the run's first set
-  std::chrono::steady_clock::time_point origin{};    // the capture time of its oldest frame
+  std::chrono::nanoseconds streamTime{0};          // since the run's first set
+  std::chrono::steady_clock::time_point origin{};  // the capture time of its oldest frame
   // Per camera: what is wrong with it (its health), or null; a faulty camera's picture is marked
   // and left out of colour correction.
   std::array<const char*, kMaxCameras> faults{};

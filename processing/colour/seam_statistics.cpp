@@ -46,8 +46,7 @@ SeamBlockMeter::SeamBlockMeter(std::size_t maxSamples)
     : scratch_(6 * std::max<std::size_t>(maxSamples, 1)), maxSamples_(maxSamples) {}
 
 SeamBlockLevels SeamBlockMeter::measure(const CorrectionDomain& domain, const DirichletBlock& block,
-                                        const SampledImage& target,
-                                        const SampledImage& source) {
+                                        const SampledImage& target, const SampledImage& source) {
   SeamBlockLevels levels;
   std::size_t count = 0;
   for (auto s = block.firstSample; s < block.endSample && count < maxSamples_; ++s) {
