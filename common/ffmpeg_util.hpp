@@ -58,6 +58,25 @@ using PacketPtr = std::unique_ptr<AVPacket, PacketDeleter>;
 using SwsContextPtr = std::unique_ptr<SwsContext, SwsContextDeleter>;
 using BufferPtr = std::unique_ptr<AVBufferRef, BufferDeleter>;
 
+// While one lives, FFmpeg's messages from this thread are about failures its caller expects and
+// reports in its own words (a hardware encoder tried where there is none): the daemon's log takes
+// them at debug level instead of as errors (daemon/logging.hpp routes FFmpeg's log).
+class ExpectedFailures {
+ public:
+  ExpectedFailures() { ++depth(); }
+  ~ExpectedFailures() { --depth(); }
+  ExpectedFailures(const ExpectedFailures&) = delete;
+  ExpectedFailures& operator=(const ExpectedFailures&) = delete;
+
+  static bool active() { return depth() > 0; }
+
+ private:
+  static int& depth() {
+    thread_local int depth = 0;
+    return depth;
+  }
+};
+
 // av_err2str() is a C macro built on a compound literal, which C++ does not have.
 inline std::string errorText(int error) {
   char text[AV_ERROR_MAX_STRING_SIZE] = {};

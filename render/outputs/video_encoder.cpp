@@ -215,6 +215,8 @@ void VideoEncoder::Impl::openCodec(AVPixelFormat pixelFormat) {
     if (!x264Only && wanted == "auto") {
       for (const char* name : kHardwareH264Encoders) {
         const AVCodec* encoder = avcodec_find_encoder_by_name(name);
+        // Said below in one line if none opens, not as FFmpeg's errors ("Cannot load libcuda").
+        const ffmpeg::ExpectedFailures expected;
         std::string why =
             encoder == nullptr ? "not in this FFmpeg" : tryCodec(encoder, pixelFormat);
         if (why.empty()) {

@@ -1,6 +1,6 @@
 #pragma once
 // What is logged through spdlog's default logger while a LogCapture lives, a line each as
-// "[level] message"; the default logger is put back after.
+// "[level] message" (from `level` up); the default logger is put back after.
 
 #include <memory>
 #include <sstream>
@@ -14,11 +14,12 @@ namespace surroundd::testing {
 
 class LogCapture {
  public:
-  LogCapture() : previous_(spdlog::default_logger()) {
+  explicit LogCapture(spdlog::level::level_enum level = spdlog::level::info)
+      : previous_(spdlog::default_logger()) {
     auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(text_);
     sink->set_pattern("[%l] %v");
     auto logger = std::make_shared<spdlog::logger>("captured", sink);
-    logger->set_level(spdlog::level::info);
+    logger->set_level(level);
     spdlog::set_default_logger(logger);
   }
   ~LogCapture() { spdlog::set_default_logger(previous_); }
