@@ -213,12 +213,10 @@ void VideoEncoder::Impl::openCodec(AVPixelFormat pixelFormat) {
     // What only x264 does, or the fallback after the hardware encoders.
     std::vector<std::string> notOpened;
     if (!x264Only && wanted == "auto") {
+      const ffmpeg::ExpectedFailures expected;  // said in one line below, not as FFmpeg's errors
       for (const char* name : kHardwareH264Encoders) {
         const AVCodec* encoder = avcodec_find_encoder_by_name(name);
-        // Said below in one line if none opens, not as FFmpeg's errors ("Cannot load libcuda").
-        const ffmpeg::ExpectedFailures expected;
-        std::string why =
-            encoder == nullptr ? "not in this FFmpeg" : tryCodec(encoder, pixelFormat);
+        std::string why = encoder ? tryCodec(encoder, pixelFormat) : "not in this FFmpeg";
         if (why.empty()) {
           spdlog::info("{} '{}': H.264 by {}", kind(), target(), name);
           return;
