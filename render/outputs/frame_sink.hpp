@@ -5,7 +5,7 @@
 //
 // Threads: a sink that may block (an encoder, a display's vblank, JPEG encoding, a network write)
 // runs behind a QueuedSink: its consume() runs on the queue's thread while the pipeline thread may
-// ask its wantsFrame() and page(), so a sink keeps those two safe for that.
+// ask its wantsFrame(), takesI420() and page(), so a sink keeps those three safe for that.
 //
 // Error policy: consume() and finish() throw (EncoderError, std::runtime_error) naming the file;
 // the pipeline logs the failure and drops that sink, the others go on.
@@ -35,6 +35,14 @@ struct PictureTime {
   std::optional<std::chrono::system_clock::time_point> captured;
 };
 
+// Pictures are 8-bit BGR (CV_8UC3); a sink that takesI420() may be handed I420 ones instead, made
+// for its encoder as the picture was finished (processing/stitch/i420_picture.hpp): CV_8UC1,
+// continuous, of width x height * 3 / 2, the luma plane then the Cb and the Cr one.
+inline bool isI420(const cv::Mat& picture, cv::Size size) {
+  return picture.type() == CV_8UC1 && picture.isContinuous() && picture.cols == size.width &&
+         picture.rows == size.height * 3 / 2;
+}
+
 class FrameSink {
  public:
   virtual ~FrameSink() = default;
@@ -42,8 +50,11 @@ class FrameSink {
   FrameSink(const FrameSink&) = delete;
   FrameSink& operator=(const FrameSink&) = delete;
 
-  // `bgr` is 8-bit BGR.
-  virtual void consume(const cv::Mat& bgr, const PictureTime& time) = 0;
+  // `picture` is 8-bit BGR, or I420 where takesI420().
+  virtual void consume(const cv::Mat& picture, const PictureTime& time) = 0;
+  // Whether its pictures may come in I420 (an H.264 encoder's own format), sparing it the
+  // conversion. A picture made another way (drawn by OpenGL) still comes in BGR.
+  virtual bool takesI420() const { return false; }
   // Whether the frame at `streamTime` is needed: the pipeline skips making pictures (renders) that
   // no sink wants.
   virtual bool wantsFrame(std::chrono::nanoseconds /*streamTime*/) const { return true; }

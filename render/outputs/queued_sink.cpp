@@ -10,8 +10,12 @@ QueuedSink::QueuedSink(std::unique_ptr<FrameSink> sink, cv::Size size, std::size
       whenFull_(whenFull),
       depth_(std::max<std::size_t>(depth, 1)),
       queue_(depth_ + 1) {
+  // In the format its pictures come in where the sink takes I420 (a view gathered through its
+  // table); a slot is made again, once, when they change format (a view drawn by OpenGL: BGR).
+  const bool i420 = sink_->takesI420();
   for (std::size_t i = 0; i < queue_.size(); ++i) {
-    slots_.emplace_back(size, CV_8UC3);
+    slots_.emplace_back(i420 ? cv::Size(size.width, size.height * 3 / 2) : size,
+                        i420 ? CV_8UC1 : CV_8UC3);
     free_.push_back(i);
   }
   worker_ = std::thread([this] { work(); });
@@ -52,7 +56,7 @@ void QueuedSink::work() {
   }
 }
 
-void QueuedSink::consume(const cv::Mat& bgr, const PictureTime& time) {
+void QueuedSink::consume(const cv::Mat& picture, const PictureTime& time) {
   std::size_t slot = 0;
   {
     std::unique_lock lock(mutex_);
@@ -70,7 +74,7 @@ void QueuedSink::consume(const cv::Mat& bgr, const PictureTime& time) {
     free_.pop_back();
   }
   // The slot is this thread's until it is queued.
-  bgr.copyTo(slots_[slot]);
+  picture.copyTo(slots_[slot]);
   {
     const std::lock_guard lock(mutex_);
     queue_[(head_ + size_) % queue_.size()] = {slot, time};

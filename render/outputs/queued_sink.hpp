@@ -29,16 +29,17 @@ class QueuedSink final : public FrameSink {
  public:
   enum class WhenFull { kWait, kDropOldest };
 
-  // Pictures are `size` 8-bit BGR; `depth` of them can wait.
+  // Pictures are of `size`; `depth` of them can wait.
   QueuedSink(std::unique_ptr<FrameSink> sink, cv::Size size, std::size_t depth, WhenFull whenFull);
   ~QueuedSink() override;  // without finish(): stops the worker; the sink finalizes itself
 
-  void consume(const cv::Mat& bgr, const PictureTime& time) override;
+  void consume(const cv::Mat& picture, const PictureTime& time) override;
   void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) override;
   std::string describe() const override;
   // The wrapped sink's: a picture nobody wants is neither made nor queued.
   bool wantsFrame(std::chrono::nanoseconds streamTime) const override;
   ViewPage* page() override { return sink_->page(); }
+  bool takesI420() const override { return sink_->takesI420(); }
 
   std::uint64_t dropped() const override;
 

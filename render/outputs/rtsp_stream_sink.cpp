@@ -303,12 +303,14 @@ RtspStreamSink::~RtspStreamSink() {
   impl_->encoder.reset();
 }
 
-void RtspStreamSink::consume(const cv::Mat& bgr, const PictureTime& time) {
+void RtspStreamSink::consume(const cv::Mat& picture, const PictureTime& time) {
   Impl& s = *impl_;
   if (!s.watched) return;
-  s.encoder->write(bgr, time.stream, time.captured);
+  s.encoder->write(picture, time.stream, time.captured);
   ++s.frames;
 }
+
+bool RtspStreamSink::takesI420() const { return impl_->encoder->takesI420(); }
 
 bool RtspStreamSink::wantsFrame(std::chrono::nanoseconds /*streamTime*/) const {
   return impl_->watched;

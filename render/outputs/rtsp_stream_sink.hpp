@@ -37,7 +37,8 @@ class RtspStreamSink final : public FrameSink {
   explicit RtspStreamSink(RtspStreamSettings settings);  // listens at once
   ~RtspStreamSink() override;                            // closes the server if finish() did not
 
-  void consume(const cv::Mat& bgr, const PictureTime& time) override;
+  void consume(const cv::Mat& picture, const PictureTime& time) override;
+  bool takesI420() const override;
   // Whether a viewer is watching (or about to).
   bool wantsFrame(std::chrono::nanoseconds streamTime) const override;
   void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) override;

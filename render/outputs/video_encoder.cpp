@@ -12,6 +12,7 @@
 
 #include "common/ffmpeg_util.hpp"
 #include "render/outputs/capture_time_sei.hpp"
+#include "render/outputs/encoder_conversion.hpp"
 
 extern "C" {
 #include <libavutil/hwcontext.h>
@@ -55,8 +56,8 @@ struct VideoEncoder::Impl {
   ffmpeg::CodecContextPtr codec;
   ffmpeg::FramePtr frame;
   ffmpeg::PacketPtr packet;
-  ffmpeg::SwsContextPtr sws;
-  AVPixelFormat pictureFormat = AV_PIX_FMT_NONE;  // what sws writes into `frame`
+  std::optional<EncoderConversion> conversion;    // each picture into `frame`
+  AVPixelFormat pictureFormat = AV_PIX_FMT_NONE;  // `frame`'s
   ffmpeg::BufferPtr hwDevice;  // a VA-API encoder's device and frame pool; null for the others
   ffmpeg::BufferPtr hwFrames;
   ffmpeg::FramePtr hwFrame;
@@ -145,23 +146,14 @@ void VideoEncoder::Impl::open() {
   frame->height = settings.size.height;
   if (const int error = av_frame_get_buffer(frame.get(), 0); error < 0)
     fail("out of memory", error);
-  // To 4:2:0, swscale's accurate rounding would take its generic scaler (2.7 ms a 1280x720
-  // picture, measured here) where its unscaled BGR -> YUV 4:2:0 conversion takes 0.7-0.9 ms, for
-  // at most a level of luma and a few of chroma, well under what H.264 itself changes.
-  const int accuracy = pictureFormat == AV_PIX_FMT_YUV420P || pictureFormat == AV_PIX_FMT_NV12
-                           ? 0
-                           : SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT;
-  sws.reset(sws_getContext(settings.size.width, settings.size.height, AV_PIX_FMT_BGR24,
-                           settings.size.width, settings.size.height, pictureFormat,
-                           SWS_BICUBIC | SWS_BITEXACT | accuracy, nullptr, nullptr, nullptr));
-  if (!sws) fail("cannot set up the colour conversion");
+  try {
+    conversion.emplace(settings.size, pictureFormat);
+  } catch (const std::runtime_error& e) {
+    fail(e.what());
+  }
   if (hwFrames) {
     hwFrame.reset(av_frame_alloc());
     if (!hwFrame) fail("out of memory");
-  }
-  if (pixelFormat != AV_PIX_FMT_BGR24) {
-    const int* bt601 = sws_getCoefficients(SWS_CS_ITU601);
-    sws_setColorspaceDetails(sws.get(), bt601, 1, bt601, 0, 0, 1 << 16, 1 << 16);
   }
 }
 
@@ -400,15 +392,10 @@ VideoEncoder::~VideoEncoder() {
   }
 }
 
-void VideoEncoder::write(const cv::Mat& bgr, std::chrono::nanoseconds timestamp,
+void VideoEncoder::write(const cv::Mat& picture, std::chrono::nanoseconds timestamp,
                          std::optional<std::chrono::system_clock::time_point> captured) {
   auto& s = *impl_;
   if (s.closed) s.fail("write after close");
-  if (bgr.type() != CV_8UC3 || bgr.size() != s.settings.size) {
-    s.fail(fmt::format("expected an 8-bit BGR image of {}x{}, got {}x{} of type {}",
-                       s.settings.size.width, s.settings.size.height, bgr.cols, bgr.rows,
-                       bgr.type()));
-  }
   const std::int64_t pts = std::chrono::duration_cast<std::chrono::microseconds>(timestamp).count();
   // The container keeps its own precision (ms in MKV): two frames must not fall on one tick there.
   const AVRational precision = s.stream != nullptr ? s.stream->time_base : kMicroseconds;
@@ -419,11 +406,13 @@ void VideoEncoder::write(const cv::Mat& bgr, std::chrono::nanoseconds timestamp,
   }
   if (const int error = av_frame_make_writable(s.frame.get()); error < 0)
     s.fail("out of memory", error);
-  const std::uint8_t* source[] = {bgr.data};
-  const int sourceStride[] = {static_cast<int>(bgr.step[0])};
-  sws_scale(s.sws.get(), source, sourceStride, 0, bgr.rows, s.frame->data, s.frame->linesize);
+  if (!s.conversion->convert(picture, *s.frame)) {
+    s.fail(fmt::format("expected an 8-bit BGR{} picture of {}x{}, got {}x{} of type {}",
+                       s.conversion->takesI420() ? " or I420" : "", s.settings.size.width,
+                       s.settings.size.height, picture.cols, picture.rows, picture.type()));
+  }
   s.frame->pts = pts;
-  AVFrame* picture = s.frame.get();
+  AVFrame* encoded = s.frame.get();
   if (s.hwFrames) {
     // Into one of the device's frames (from its pool): the encoder reads only those.
     if (const int error = av_hwframe_get_buffer(s.hwFrames.get(), s.hwFrame.get(), 0); error < 0)
@@ -431,19 +420,19 @@ void VideoEncoder::write(const cv::Mat& bgr, std::chrono::nanoseconds timestamp,
     if (const int error = av_hwframe_transfer_data(s.hwFrame.get(), s.frame.get(), 0); error < 0)
       s.fail("cannot upload the picture to the VA-API device", error);
     s.hwFrame->pts = pts;
-    picture = s.hwFrame.get();
+    encoded = s.hwFrame.get();
   }
-  picture->pict_type = s.keyframeWanted.exchange(false) ? AV_PICTURE_TYPE_I : AV_PICTURE_TYPE_NONE;
+  encoded->pict_type = s.keyframeWanted.exchange(false) ? AV_PICTURE_TYPE_I : AV_PICTURE_TYPE_NONE;
   if (s.settings.stampCaptureTime && captured) {
     const CaptureTimeSei payload = captureTimeSei(*captured);
     AVFrameSideData* sei =
-        av_frame_new_side_data(picture, AV_FRAME_DATA_SEI_UNREGISTERED, payload.size());
+        av_frame_new_side_data(encoded, AV_FRAME_DATA_SEI_UNREGISTERED, payload.size());
     if (sei == nullptr) s.fail("out of memory");
     std::copy(payload.begin(), payload.end(), sei->data);
   }
-  const int sent = avcodec_send_frame(s.codec.get(), picture);
+  const int sent = avcodec_send_frame(s.codec.get(), encoded);
   // The frame is used again for the next picture: its capture time must not stay with it.
-  av_frame_remove_side_data(picture, AV_FRAME_DATA_SEI_UNREGISTERED);
+  av_frame_remove_side_data(encoded, AV_FRAME_DATA_SEI_UNREGISTERED);
   if (s.hwFrames) av_frame_unref(s.hwFrame.get());
   if (sent < 0) s.fail("encoding failed", sent);
   s.drain(false);
@@ -496,5 +485,7 @@ std::uint64_t VideoEncoder::framesWritten() const { return impl_->framesWritten;
 void VideoEncoder::requestKeyframe() { impl_->keyframeWanted = true; }
 
 std::string VideoEncoder::encoderName() const { return impl_->codec->codec->name; }
+
+bool VideoEncoder::takesI420() const { return impl_->conversion->takesI420(); }
 
 }  // namespace surroundd::render

@@ -93,11 +93,14 @@ class VideoEncoder {
   VideoEncoder(const VideoEncoder&) = delete;
   VideoEncoder& operator=(const VideoEncoder&) = delete;
 
-  // `bgr` is 8-bit BGR of settings.size. Timestamps must increase at the file's precision (see
-  // above); converted as BT.601 limited range, and tagged so, so that decoders convert back alike.
-  // `captured` goes into the stream with settings.stampCaptureTime.
-  void write(const cv::Mat& bgr, std::chrono::nanoseconds timestamp,
+  // `picture` is 8-bit BGR of settings.size, or I420 where takesI420() (frame_sink.hpp).
+  // Timestamps must increase at the file's precision (see above); converted as BT.601 limited
+  // range, and tagged so, so that decoders convert back alike. `captured` goes into the stream
+  // with settings.stampCaptureTime.
+  void write(const cv::Mat& picture, std::chrono::nanoseconds timestamp,
              std::optional<std::chrono::system_clock::time_point> captured = std::nullopt);
+  // Whether write() takes I420 pictures: the stream is 4:2:0 (pixel format yuv420p).
+  bool takesI420() const;
   // The next picture written is a keyframe (a viewer has joined). Safe from any thread.
   void requestKeyframe();
   // Flushes, finalizes and renames the file. Idempotent; the destructor calls it and logs errors.

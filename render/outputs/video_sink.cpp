@@ -49,6 +49,7 @@ VideoSink::VideoSink(VideoEncoderSettings settings, std::chrono::nanoseconds seg
     segment_ = firstSegment_ - 1;
   }
   openSegment();
+  takesI420_ = encoder_->takesI420();
 }
 
 std::filesystem::path VideoSink::segmentPath(std::int64_t number) const {
@@ -71,7 +72,7 @@ void VideoSink::openSegment() {
   }
 }
 
-void VideoSink::consume(const cv::Mat& bgr, const PictureTime& time) {
+void VideoSink::consume(const cv::Mat& picture, const PictureTime& time) {
   const std::chrono::nanoseconds streamTime = time.stream;
   if (segmentLength_.count() > 0) {
     // Segments cover whole multiples of their length in stream time: [0, L), [L, 2L), ...
@@ -82,7 +83,7 @@ void VideoSink::consume(const cv::Mat& bgr, const PictureTime& time) {
     }
     window_ = window;
   }
-  encoder_->write(bgr, streamTime, time.captured);
+  encoder_->write(picture, streamTime, time.captured);
   ++frames_;
 }
 

@@ -24,7 +24,8 @@ class VideoSink final : public FrameSink {
   // Opens the file (the first segment) or the stream; throws EncoderError naming it.
   explicit VideoSink(VideoEncoderSettings settings,
                      std::chrono::nanoseconds segmentLength = std::chrono::nanoseconds(0));
-  void consume(const cv::Mat& bgr, const PictureTime& time) override;
+  void consume(const cv::Mat& picture, const PictureTime& time) override;
+  bool takesI420() const override { return takesI420_; }
   void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) override;
   std::string describe() const override;
 
@@ -39,6 +40,9 @@ class VideoSink final : public FrameSink {
   std::int64_t firstSegment_ = 1;
   std::int64_t segment_ = 0;  // the one being written
   std::uint64_t frames_ = 0;
+  // Every segment's encoder's: kept here, as the pipeline thread asks it while a queue's thread
+  // may be opening the next segment.
+  bool takesI420_ = false;
 };
 
 }  // namespace surroundd::render

@@ -12,6 +12,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "tests/support/test_support.hpp"
 
@@ -21,6 +22,7 @@ namespace {
 using std::chrono::milliseconds;
 using WhenFull = QueuedSink::WhenFull;
 
+// NOLINTNEXTLINE(cert-err58-cpp): cv::Size stores two ints; its constructor throws nothing.
 const cv::Size kSize(64, 48);
 
 cv::Mat picture(int index) { return testing::syntheticPicture(kSize, index); }
@@ -38,6 +40,7 @@ class KeepingSink final : public FrameSink {
     bool holdingSet = false;     // only the worker thread touches it
     int failAt = -1;
     bool finished = false;
+    bool takesI420 = false;
   };
   explicit KeepingSink(Shared& shared) : shared_(shared) {}
   void consume(const cv::Mat& bgr, const PictureTime& time) override {
@@ -55,6 +58,7 @@ class KeepingSink final : public FrameSink {
     shared_.finished = true;
   }
   std::string describe() const override { return "kept"; }
+  bool takesI420() const override { return shared_.takesI420; }
 
  private:
   Shared& shared_;
@@ -73,6 +77,34 @@ TEST(QueuedSink, WhenItWaitsEveryPictureArrivesInOrder) {
   }
   EXPECT_EQ(sink.dropped(), 0u);
   EXPECT_EQ(sink.describe(), "kept");
+}
+
+// For an encoder that takes I420: its slots hold that, and a picture drawn in BGR (a view that
+// moves) still comes through as it was given, each in turn.
+TEST(QueuedSink, ASinkThatTakesI420GetsEachPictureInTheFormatItCameIn) {
+  KeepingSink::Shared shared;
+  shared.takesI420 = true;
+  QueuedSink sink(std::make_unique<KeepingSink>(shared), kSize, 2, WhenFull::kWait);
+  EXPECT_TRUE(sink.takesI420());
+  std::vector<cv::Mat> given;
+  for (int i = 0; i < 12; ++i) {
+    cv::Mat& next = given.emplace_back();
+    if (i % 4 < 2) {
+      cv::cvtColor(picture(i), next, cv::COLOR_BGR2YUV_I420);
+    } else {
+      next = picture(i);
+    }
+    sink.consume(next, milliseconds(i));
+  }
+  sink.finish({}, {});
+  ASSERT_EQ(shared.consumed.size(), given.size());
+  for (std::size_t i = 0; i < given.size(); ++i) {
+    const cv::Mat& consumed = shared.consumed[i].first;
+    ASSERT_EQ(consumed.type(), given[i].type()) << i;
+    ASSERT_EQ(consumed.size(), given[i].size()) << i;
+    EXPECT_EQ(cv::norm(consumed, given[i], cv::NORM_INF), 0.0) << i;
+  }
+  EXPECT_TRUE(isI420(shared.consumed[0].first, kSize));
 }
 
 TEST(QueuedSink, WhenItDropsTheNewestPicturesWinAndDropsAreCounted) {

@@ -7,6 +7,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "common/ffmpeg_util.hpp"
 #include "render/outputs/video_sink.hpp"
@@ -289,6 +290,50 @@ TEST(VideoEncoder, RejectsPicturesOfTheWrongShape) {
   EXPECT_THAT([&] { encoder.write(cv::Mat(kSize, CV_8UC1), milliseconds(0)); }, rejected);
   EXPECT_THAT([&] { encoder.write(cv::Mat(), milliseconds(0)); }, rejected);
   EXPECT_EQ(encoder.framesWritten(), 0u);
+}
+
+// A 4:2:0 stream takes I420 pictures as they are (its maker converted them): the video is the one
+// the same pictures in BGR give, but for the two conversions' rounding; a 4:4:4 one takes only BGR.
+TEST(VideoEncoder, A420StreamTakesI420PicturesAsTheyAre) {
+  const testing::TempDir dir;
+  auto settings = settingsFor(dir / "bgr.mkv");
+  settings.pixelFormat = "yuv420p";
+  settings.crf = 0;
+  writeVideo(settings, 3);
+  settings.path = dir / "i420.mkv";
+  {
+    VideoEncoder encoder(settings);
+    EXPECT_TRUE(encoder.takesI420());
+    for (int i = 0; i < 3; ++i) {
+      cv::Mat i420;
+      cv::cvtColor(testPicture(i), i420, cv::COLOR_BGR2YUV_I420);
+      encoder.write(i420, timestampOf(i));
+    }
+    encoder.close();
+  }
+  const auto fromBgr = testing::decodeAll(dir / "bgr.mkv");
+  const auto fromI420 = testing::decodeAll(settings.path);
+  ASSERT_EQ(fromI420.images.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    // Lossless (crf 0): what comes back is the I420 that went in, converted back (the decoder
+    // interpolates the chroma where OpenCV repeats it: 37 dB at this picture's sharp edges).
+    cv::Mat i420;
+    cv::Mat expected;
+    cv::cvtColor(testPicture(i), i420, cv::COLOR_BGR2YUV_I420);
+    cv::cvtColor(i420, expected, cv::COLOR_YUV2BGR_I420);
+    EXPECT_GE(cv::PSNR(fromI420.images[static_cast<std::size_t>(i)], expected), 35.0);
+    EXPECT_GE(cv::PSNR(fromI420.images[static_cast<std::size_t>(i)],
+                       fromBgr.images[static_cast<std::size_t>(i)]),
+              35.0);
+  }
+  settings.path = dir / "444.mkv";
+  settings.pixelFormat = "yuv444p";
+  VideoEncoder full(settings);
+  EXPECT_FALSE(full.takesI420());
+  cv::Mat i420;
+  cv::cvtColor(testPicture(0), i420, cv::COLOR_BGR2YUV_I420);
+  EXPECT_THAT([&] { full.write(i420, milliseconds(0)); },
+              ThrowsMessage<EncoderError>(HasSubstr("expected an 8-bit BGR picture of 320x240")));
 }
 
 TEST(VideoEncoder, CloseWithoutFramesThrowsAndLeavesNothing) {
