@@ -59,14 +59,14 @@ void PipelineOutputs::drop(PictureOutput& output, const std::exception& error) {
 
 void PipelineOutputs::handOver(PictureOutput& output, const cv::Mat& picture,
                                std::chrono::nanoseconds streamTime, Clock::time_point origin,
-                               std::optional<render::DrawnPicture> drawn) {
+                               std::optional<render::DrawnPicture> drawn, const cv::Mat* asBgr) {
   guarded(output, [&] {
     // The wall clock of the capture, for viewers that measure how late they show it.
     const auto captured =
         std::chrono::system_clock::now() -
         std::chrono::duration_cast<std::chrono::system_clock::duration>(Clock::now() - origin);
     output.sink->consume(picture, {streamTime, captured});
-    output.latest = picture;
+    output.latest = asBgr != nullptr ? *asBgr : picture;
     const auto now = Clock::now();
     latency_.record(now - origin);
     if (!firstPictureAt_) firstPictureAt_ = now;

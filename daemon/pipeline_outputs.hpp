@@ -46,7 +46,7 @@ class PipelineOutputs {
     std::chrono::seconds retryDelay{0};
     std::chrono::nanoseconds pendingTime{0};  // stream time of the view's pending picture
     Clock::time_point pendingOrigin{};        // capture time of the pending picture's set
-    cv::Mat latest;                           // header over the picture last handed over
+    cv::Mat latest;                           // header over the picture last handed over, BGR
     // The current switch of view: whether the output shows it settled (or was spared it), and
     // whether it has had any picture since (an output that takes none, a snapshot after its
     // time, does not hold the switch's end back).
@@ -79,9 +79,12 @@ class PipelineOutputs {
     }
   }
   // Hands `picture` of the set captured at `origin` to the output (guarded), timing the latency;
-  // a surround view's picture says when it was drawn, timing a switch of view.
+  // a surround view's picture says when it was drawn, timing a switch of view. An I420 picture
+  // (render/outputs/frame_sink.hpp) comes with the BGR one it was made from, `asBgr`, to be the
+  // latest picture.
   void handOver(PictureOutput& output, const cv::Mat& picture, std::chrono::nanoseconds streamTime,
-                Clock::time_point origin, std::optional<render::DrawnPicture> drawn = std::nullopt);
+                Clock::time_point origin, std::optional<render::DrawnPicture> drawn = std::nullopt,
+                const cv::Mat* asBgr = nullptr);
   // Each recording's copy of the set.
   void record(const capture::FrameSet& set);
   // Opens again the failed outputs whose retry is due.
@@ -99,8 +102,8 @@ class PipelineOutputs {
 
   // Whether any output works: with none, the run records nothing (a full disk).
   bool anyWorks() const;
-  // The newest picture handed to the first output that shows one (a surround view if any); a
-  // header over the pipeline's buffer, valid until the next frame set. Empty before.
+  // The newest picture handed to the first output that shows one (a surround view if any), in
+  // BGR; a header over the pipeline's buffer, valid until the next frame set. Empty before.
   cv::Mat latestPicture() const;
   std::size_t count() const { return pictures_.size() + recordings_.size(); }
   std::uint64_t failures() const { return failures_; }

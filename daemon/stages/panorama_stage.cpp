@@ -1,11 +1,14 @@
 #include "daemon/stages/panorama_stage.hpp"
 
+#include <algorithm>
 #include <optional>
+#include <span>
 
 #include <spdlog/spdlog.h>
 
 #include "daemon/panorama_setup.hpp"
 #include "daemon/pipeline_ends.hpp"
+#include "processing/stitch/i420_picture.hpp"
 #include "processing/stitch/view_lut.hpp"
 
 namespace surroundd::daemon {
@@ -119,17 +122,28 @@ std::future<std::unique_ptr<PanoramaStage::ViewPicture>> PanoramaStage::buildVie
   return built;
 }
 
-void PanoramaStage::draw(ViewPicture& view, const FrameWork& work, cv::Mat& picture) {
-  // The same frames as the panorama's, corrected by the fields and gains its last update() fitted.
+void PanoramaStage::gather(ViewPicture& view, cv::Mat& picture) {
+  // The same frames as the panorama's.
   view.stitcher_.stitch(stitched_, format_, picture);
+}
+
+void PanoramaStage::correct(ViewPicture& view, const FrameWork& work, cv::Mat& picture,
+                            cv::Mat* i420) {
+  const auto faults = std::span(work.faults).first(work.set.cameraCount);
+  const bool anyFaulty = std::ranges::any_of(faults, [](const char* f) { return f != nullptr; });
+  if (poisson_ && i420 != nullptr && !anyFaulty) {
+    poisson_->applyAt(view.fieldSamples_, picture, *i420);
+    return;
+  }
   if (poisson_) {
     poisson_->applyAt(view.fieldSamples_, picture);
   } else if (gains_) {
     gains_->apply(picture, view.lut_);
   }
-  for (std::size_t c = 0; c < work.set.cameraCount; ++c) {
-    if (work.faults[c] != nullptr) view.ownership_.markFaulty(picture, c);
+  for (std::size_t c = 0; c < faults.size(); ++c) {
+    if (faults[c] != nullptr) view.ownership_.markFaulty(picture, c);
   }
+  if (i420 != nullptr) processing::bgrToI420(picture, *i420, pool_);
 }
 
 }  // namespace surroundd::daemon

@@ -77,8 +77,14 @@ class PanoramaStage final : public PipelineStage {
   // set-up only (process() may run meanwhile): composing it takes tenths of a second, which no
   // set should wait for. The stage waits for the builds under way when it goes.
   std::future<std::unique_ptr<ViewPicture>> buildView(cv::Mat panoramaPositions);
-  // The view's picture of the set process() was last given: 8-bit BGR of its size.
-  void draw(ViewPicture& view, const FrameWork& work, cv::Mat& picture);
+  // The view's picture of the set process() was last given, in two steps, so that what is laid
+  // where the view shows no panorama (the car, the background) goes in between, where correcting
+  // leaves it as it is: gathered into `picture`, 8-bit BGR of its size; then corrected by the
+  // fields or gains the last update() fitted and each faulty camera's part marked. With `i420`,
+  // the picture is also converted into it (processing/stitch/i420_picture.hpp) for an encoder:
+  // in the same pass as the Poisson field where no camera is faulty.
+  void gather(ViewPicture& view, cv::Mat& picture);
+  void correct(ViewPicture& view, const FrameWork& work, cv::Mat& picture, cv::Mat* i420);
 
  private:
   void setUpColourCorrection(const Config& config, WorkPool& pool);

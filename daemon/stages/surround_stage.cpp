@@ -1,6 +1,7 @@
 #include "daemon/stages/surround_stage.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <span>
 #include <string_view>
 
@@ -10,6 +11,7 @@
 
 #include "daemon/panorama_setup.hpp"
 #include "daemon/pipeline_ends.hpp"
+#include "processing/stitch/i420_picture.hpp"
 #include "render/render_error.hpp"
 
 namespace surroundd::daemon {
@@ -167,10 +169,14 @@ void SurroundStage::startFixedView(render::SurroundView& view, FixedView& fixed)
   // car and background when it is taken into use.
   const auto start = std::chrono::steady_clock::now();
   try {
-    const cv::Mat positions = view.panoramaPositions(0);
+    cv::Mat positions = view.panoramaPositions(0);
     cv::bitwise_not(render::SurroundView::panoramaShown(positions), fixed.overlayMask);
-    // The split view's camera half is the camera's own picture, scaled in each set.
-    if (const auto camera = view.cameraArea()) fixed.overlayMask(*camera).setTo(0);
+    // The split view's camera half is the camera's own picture, scaled in each set: nothing of
+    // the panorama is gathered or corrected there.
+    if (const auto camera = view.cameraArea()) {
+      fixed.overlayMask(*camera).setTo(0);
+      positions(*camera).setTo(cv::Scalar::all(std::numeric_limits<float>::quiet_NaN()));
+    }
     fixed.mappedIn = std::chrono::steady_clock::now() - start;
     fixed.building = panoramaStage_.buildView(positions);
   } catch (const render::RenderError& e) {
@@ -274,7 +280,6 @@ void SurroundStage::setVehicleSignals(const vehicle::VehicleSignals& signals) {
 }
 
 void SurroundStage::layGuidelines(render::SurroundView& view, FixedView& fixed) {
-  if (!scene_->hasGuidelines()) return;
   if (fixed.guidesVersion != guidesVersion_) {
     // Drawn by OpenGL and read back once per change of steering, not per set.
     view.guidelineLayer(0).copyTo(fixed.guides);
@@ -308,15 +313,28 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
         // Without a panorama this set, also when not wanted: the run's end hands over the last
         // set's picture, and there is no panorama to draw it from.
         if (!wanted && !panoramaSkipped_) return;
-        panoramaStage_.draw(*fixed->view, work, fixed->picture);
+        // The car, the background and the split view's camera go where the view shows no
+        // panorama, before the correction, which leaves those pixels as they are; the guidelines
+        // over the corrected picture.
+        panoramaStage_.gather(*fixed->view, fixed->picture);
         fixed->overlay.copyTo(fixed->picture, fixed->overlayMask);
-        layGuidelines(*output.view, *fixed);
         // As the renderer samples it (bilinear, pixel centres at halves); a missing frame leaves
         // the last one shown.
         const auto area = output.view->cameraArea();
         if (const cv::Mat* camera = area ? work.bgr(splitCamera_) : nullptr; camera != nullptr) {
           cv::Mat into = fixed->picture(*area);
           cv::resize(*camera, into, area->size(), 0, 0, cv::INTER_LINEAR);
+        }
+        // An encoder's picture is made in I420 as it is corrected; with guidelines, after them.
+        const bool guided = scene_->hasGuidelines();
+        fixed->inI420 = output.sink->takesI420();
+        panoramaStage_.correct(*fixed->view, work, fixed->picture,
+                               fixed->inI420 && !guided ? &fixed->i420 : nullptr);
+        if (guided) {
+          layGuidelines(*output.view, *fixed);
+          if (fixed->inI420) {
+            processing::bgrToI420(fixed->picture, fixed->i420, panoramaStage_.pool());
+          }
         }
         fixed->drawnAt = work.streamTime;
         fixed->handOver = wanted;
@@ -347,8 +365,10 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
     if (fixed == fixedViews_.end() || !fixed->second.handOver) continue;
     fixed->second.handOver = false;
     // Gathered in this set, with the view settled: a fixed view does not move.
-    work.outputs.handOver(output, fixed->second.picture, work.streamTime, work.origin,
-                          render::DrawnPicture{PipelineOutputs::Clock::now(), true});
+    const FixedView& drawn = fixed->second;
+    work.outputs.handOver(output, drawn.inI420 ? drawn.i420 : drawn.picture, work.streamTime,
+                          work.origin, render::DrawnPicture{PipelineOutputs::Clock::now(), true},
+                          &drawn.picture);
   }
   times.lap(Stage::kOutput);
 }

@@ -11,9 +11,11 @@
 // samples the panorama and draws the car and background once, and the panorama stage composes
 // the view's table from that on a thread of its own, while the renderer draws the view as it
 // draws those that move. From then on the panorama stage gathers its picture from the camera
-// frames (PanoramaStage::ViewPicture), the car and background are laid over it, and the split
-// view's camera picture is scaled into its half. The output gets it in the same set. Kept for when
-// the output shows that view again.
+// frames (PanoramaStage::ViewPicture), the car and background are laid where it shows no panorama
+// and the split view's camera picture is scaled into its half, then it is corrected and the
+// guidelines laid over it; for an output that encodes it, it is converted to I420 in the
+// correction's pass (processing/stitch/i420_picture.hpp). The output gets it in the same set. Kept
+// for when the output shows that view again.
 //
 // With processing.backend gpu (or auto on a hardware renderer) the panorama the views sample is
 // stitched and colour-corrected on the GPU (render/gpu_stitcher.hpp) from the set's frames in
@@ -141,6 +143,8 @@ class SurroundStage final : public PipelineStage {
     cv::Mat overlay;                       // 8-bit BGR, the renderer's picture of the view
     cv::Mat overlayMask;                   // CV_8U: where it shows no panorama
     cv::Mat picture;                       // the last drawn
+    cv::Mat i420;                          // and in I420, for an output that takes that
+    bool inI420 = false;                   // whether `i420` is the picture its output gets
     std::chrono::nanoseconds drawnAt{-1};  // the stream time of its set
     bool handOver = false;                 // drawn this set for its output
     cv::Mat guides;                        // the guidelines as the view shows them, on black
@@ -148,7 +152,8 @@ class SurroundStage final : public PipelineStage {
     cv::Mat guidesMask;      // CV_8U: where they are
     int guidesVersion = -1;  // of SurroundStage::guidesVersion_
   };
-  // Lays the guidelines over a fixed view's picture, drawing them again when they have changed.
+  // Lays the guidelines (the scene has some) over a fixed view's picture, drawing them again when
+  // they have changed.
   void layGuidelines(render::SurroundView& view, FixedView& fixed);
   // The output's fixed view, its building started the first time it shows it; null until built
   // and the switch to it has ended, for a view that moves, with render.view_lut off, on the GPU

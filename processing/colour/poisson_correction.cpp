@@ -12,6 +12,7 @@
 #include "common/work_pool.hpp"
 #include "processing/colour/float_lanes.hpp"
 #include "processing/colour/poisson_correction_state.hpp"
+#include "processing/stitch/i420_picture.hpp"
 
 namespace surroundd::processing {
 namespace {
@@ -399,19 +400,43 @@ PoissonColourCorrection::ViewSamples PoissonColourCorrection::viewSamples(
   return samples;
 }
 
-void PoissonColourCorrection::applyAt(const ViewSamples& samples, cv::Mat& picture,
-                                      KernelPath path) {
+PoissonColourCorrection::ViewRows PoissonColourCorrection::viewRowsFor(const ViewSamples& samples,
+                                                                       const cv::Mat& picture,
+                                                                       KernelPath path) const {
   if (picture.type() != CV_8UC3 || picture.size() != samples.size) {
     throw std::invalid_argument(
         fmt::format("colour correction: expected an 8-bit BGR picture of {}x{}", samples.size.width,
                     samples.size.height));
   }
-  const auto rows = kernelFor(path, []<CorrectionField kField, KernelPath kPath>() {
+  return kernelFor(path, []<CorrectionField kField, KernelPath kPath>() {
     return &PoissonColourCorrection::applyAtRows<kField, kPath>;
   });
+}
+
+void PoissonColourCorrection::applyAt(const ViewSamples& samples, cv::Mat& picture,
+                                      KernelPath path) {
+  const ViewRows rows = viewRowsFor(samples, picture, path);
   pool_.parallelFor(
       samples.size.height,
       [&](int first, int last) { (this->*rows)(first, last, samples, picture); },
+      pool_.threads() * 4);
+}
+
+void PoissonColourCorrection::applyAt(const ViewSamples& samples, cv::Mat& picture, cv::Mat& i420,
+                                      KernelPath path) {
+  const ViewRows rows = viewRowsFor(samples, picture, path);
+  if (picture.cols % 2 != 0 || picture.rows % 2 != 0) {
+    throw std::invalid_argument("colour correction: an I420 picture needs even sides");
+  }
+  i420.create(i420HeldSize(picture.size()), CV_8UC1);
+  pool_.parallelFor(
+      samples.size.height / 2,
+      [&](int first, int last) {
+        for (int pair = first; pair < last; ++pair) {
+          (this->*rows)(2 * pair, 2 * pair + 2, samples, picture);
+          bgrRowsToI420(picture, 2 * pair, 2 * pair + 2, i420, path);
+        }
+      },
       pool_.threads() * 4);
 }
 

@@ -134,6 +134,11 @@ class PoissonColourCorrection {
   // bicubically: they are smooth, so the two differ by a fraction of a level, at a quarter of the
   // taps. `path`: as apply()'s.
   void applyAt(const ViewSamples& samples, cv::Mat& picture, KernelPath path = kNativeKernels);
+  // The same, each pair of rows then converted into `i420` (processing/stitch/i420_picture.hpp;
+  // reallocated only if not of the picture's size) while it is still in the cache: the picture of
+  // a view made for an encoder in one pass.
+  void applyAt(const ViewSamples& samples, cv::Mat& picture, cv::Mat& i420,
+               KernelPath path = kNativeKernels);
 
   const std::vector<SeamReport>& seams() const { return seamReports_; }
 
@@ -165,6 +170,9 @@ class PoissonColourCorrection {
   void applyRows(int first, int last, cv::Mat& panorama, std::vector<float>& columnBuffer) const;
   template <CorrectionField kField, KernelPath kPath>
   void applyAtRows(int first, int last, const ViewSamples& samples, cv::Mat& picture) const;
+  // applyAt()'s kernel for this field and `path`, once the picture is checked against `samples`.
+  using ViewRows = void (PoissonColourCorrection::*)(int, int, const ViewSamples&, cv::Mat&) const;
+  ViewRows viewRowsFor(const ViewSamples& samples, const cv::Mat& picture, KernelPath path) const;
 
   const PanoramaLut& lut_;
   WorkPool& pool_;

@@ -9,6 +9,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "daemon/pipeline.hpp"
 #include "daemon/pipeline_report.hpp"
@@ -89,6 +90,45 @@ TEST(ViewTableTest, AViewSwitchedToIsDrawnWhileItsTableIsMadeBesideTheSets) {
                                       "through its own look-up table (made in")));
   // Every set's picture went out, those drawn while the table was made included.
   EXPECT_EQ(testing::decodeAll(dir / "surround.mp4").images.size(), summary.frameSets);
+}
+
+// A fixed view for a 4:2:0 H.264 output is handed over in I420, made in its correction's pass
+// (processing/stitch/i420_picture.hpp): losslessly encoded, the luma of each picture is that of the
+// same view handed over in BGR to a lossless RGB video, within rounding; its colour within what
+// 4:2:0 costs the sharp edges.
+TEST(ViewTableTest, AFixedViewForA420VideoIsMadeInI420AsItsBgrPicture) {
+  const testing::TempDir dir;
+  OutputConfig yuv = videoOutputAt(dir / "yuv.mkv");
+  yuv.stream = OutputStream::kSurround;
+  yuv.view = ViewKind::kTop;
+  yuv.crf = 0;
+  OutputConfig rgb = yuv;
+  rgb.path = dir / "rgb.mkv";
+  rgb.pixelFormat = "bgr24";
+  Config config = fixtureReplay("synth_small", {yuv, rgb});
+  config.pipeline.threads = 2;
+  std::atomic<bool> stop{false};
+  std::vector<std::string> log;
+  {
+    const testing::LogCapture capture;
+    Pipeline pipeline(config);
+    pipeline.run(stop);
+    log = capture.lines();
+  }
+  EXPECT_THAT(log, Contains(HasSubstr("the top view 320x180 is gathered from the camera frames")));
+  const auto fromI420 = testing::decodeAll(yuv.path).images;
+  const auto fromBgr = testing::decodeAll(rgb.path).images;
+  ASSERT_EQ(fromI420.size(), fromBgr.size());
+  ASSERT_GT(fromI420.size(), 5U);
+  for (std::size_t i = 0; i < fromI420.size(); ++i) {
+    SCOPED_TRACE(i);
+    cv::Mat lumaI420;
+    cv::Mat lumaBgr;
+    cv::cvtColor(fromI420[i], lumaI420, cv::COLOR_BGR2GRAY);
+    cv::cvtColor(fromBgr[i], lumaBgr, cv::COLOR_BGR2GRAY);
+    EXPECT_GE(cv::PSNR(lumaI420, lumaBgr), 45.0);
+    EXPECT_GE(cv::PSNR(fromI420[i], fromBgr[i]), 32.0);
+  }
 }
 
 }  // namespace

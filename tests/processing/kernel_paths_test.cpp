@@ -2,8 +2,8 @@
 // arm64) gives exactly the bytes of the portable one (issue 19.4), on the synth_small recording's
 // first frame set through its own panorama LUT, its frames held as BGR, YUYV and NV12 as cameras
 // deliver them (issue 19.3): every tap of the LUT and of its seam blends sampled alone, the whole
-// stitch, the colour correction's fields applied to it, and every pair of weights on pictures of
-// random and extreme bytes.
+// stitch, the colour correction's fields applied to it, its conversion to I420, and every pair of
+// weights on pictures of random and extreme bytes.
 
 #include <array>
 #include <cstdint>
@@ -20,6 +20,7 @@
 #include "common/work_pool.hpp"
 #include "processing/colour/poisson_correction.hpp"
 #include "processing/stitch/bilinear_sample.hpp"
+#include "processing/stitch/i420_picture.hpp"
 #include "processing/stitch/kernel_path.hpp"
 #include "processing/stitch/stitcher.hpp"
 #include "tests/processing/panorama_test_support.hpp"
@@ -161,6 +162,23 @@ TEST_F(KernelPathsTest, EveryPathStitchesTheSameBytes) {
   }
 }
 
+// A stitched panorama converted to I420 by each path; 510 columns, so that the vector paths' last
+// blocks are done the portable way.
+TEST_F(KernelPathsTest, EveryPathConvertsToI420Alike) {
+  Stitcher stitcher(lut_, pool_);
+  cv::Mat panorama;
+  stitcher.stitch(frames_, panorama);
+  const cv::Mat picture = panorama(cv::Rect(2, 0, 510, lut_.size.height));
+  cv::Mat portable(i420HeldSize(picture.size()), CV_8UC1);
+  bgrRowsToI420(picture, 0, picture.rows, portable, KernelPath::kPortable);
+  for (const KernelPath path : kKernelPaths) {
+    SCOPED_TRACE(kernelPathName(path));
+    cv::Mat i420(portable.size(), CV_8UC1, cv::Scalar(0));
+    bgrRowsToI420(picture, 0, picture.rows, i420, path);
+    EXPECT_EQ(cv::norm(i420, portable, cv::NORM_INF), 0.0);
+  }
+}
+
 // The colour correction's field applied by each path, both fields, over the whole stitched
 // panorama: the blend bands' pixels (a share of the source camera) and the rest.
 TEST_F(KernelPathsTest, EveryPathAppliesTheSameCorrection) {
@@ -171,16 +189,12 @@ TEST_F(KernelPathsTest, EveryPathAppliesTheSameCorrection) {
                                        KernelPath path) { poisson.apply(picture, path); });
 }
 
-// The same for a picture that samples the panorama elsewhere (a fixed view): a 320x200 view that
-// looks at the whole panorama from sub-pixel positions, with a band that shows none of it; the
-// picture the panorama resized to it.
-TEST_F(KernelPathsTest, EveryPathAppliesTheSameCorrectionToAView) {
-  Stitcher stitcher(lut_, pool_);
-  cv::Mat raw;
-  stitcher.stitch(frames_, raw);
+// Where a 320x200 view samples the panorama of `panorama`'s size: all of it, from sub-pixel
+// positions, but for a band that shows none of it.
+cv::Mat viewPositions(cv::Size panorama) {
   const cv::Size view(320, 200);
-  const float across = static_cast<float>(lut_.size.width) / static_cast<float>(view.width);
-  const float down = static_cast<float>(lut_.size.height - 1) / static_cast<float>(view.height);
+  const float across = static_cast<float>(panorama.width) / static_cast<float>(view.width);
+  const float down = static_cast<float>(panorama.height - 1) / static_cast<float>(view.height);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   cv::Mat positions(view, CV_32FC2);
   for (int v = 0; v < view.height; ++v) {
@@ -191,12 +205,49 @@ TEST_F(KernelPathsTest, EveryPathAppliesTheSameCorrectionToAView) {
                                             : cv::Vec2f(nan, nan);
     }
   }
+  return positions;
+}
+
+// The same for a picture that samples the panorama elsewhere (a fixed view, viewPositions()): the
+// picture the panorama resized to it.
+TEST_F(KernelPathsTest, EveryPathAppliesTheSameCorrectionToAView) {
+  Stitcher stitcher(lut_, pool_);
+  cv::Mat raw;
+  stitcher.stitch(frames_, raw);
+  const cv::Mat positions = viewPositions(lut_.size);
   cv::Mat picture;
-  cv::resize(raw, picture, view, 0, 0, cv::INTER_AREA);
+  cv::resize(raw, picture, positions.size(), 0, 0, cv::INTER_AREA);
   expectEveryPathCorrectsAlike(
       picture, [&](PoissonColourCorrection& poisson, cv::Mat& corrected, KernelPath path) {
         poisson.applyAt(poisson.viewSamples(positions), corrected, path);
       });
+}
+
+// A view's picture corrected and converted to I420 in one pass, by each path: the picture
+// corrected as by the two passes, and the I420 of it.
+TEST_F(KernelPathsTest, EveryPathCorrectsAViewAndConvertsItInOnePass) {
+  Stitcher stitcher(lut_, pool_);
+  cv::Mat raw;
+  stitcher.stitch(frames_, raw);
+  const cv::Mat positions = viewPositions(lut_.size);
+  cv::Mat picture;
+  cv::resize(raw, picture, positions.size(), 0, 0, cv::INTER_AREA);
+  PoissonColourCorrection poisson(truth_.rig, testing::settingsFor(truth_), lut_, {}, pool_);
+  poisson.update(frames_);
+  const auto samples = poisson.viewSamples(positions);
+  cv::Mat twoPasses = picture.clone();
+  poisson.applyAt(samples, twoPasses, KernelPath::kPortable);
+  cv::Mat expected(i420HeldSize(picture.size()), CV_8UC1);
+  bgrRowsToI420(twoPasses, 0, twoPasses.rows, expected, KernelPath::kPortable);
+  for (const KernelPath path : kKernelPaths) {
+    SCOPED_TRACE(kernelPathName(path));
+    cv::Mat corrected = picture.clone();
+    cv::Mat i420;
+    poisson.applyAt(samples, corrected, i420, path);
+    EXPECT_EQ(cv::norm(corrected, twoPasses, cv::NORM_INF), 0.0);
+    ASSERT_EQ(i420.size(), expected.size());
+    EXPECT_EQ(cv::norm(i420, expected, cv::NORM_INF), 0.0);
+  }
 }
 
 // Every weight pair (0..128 each) on 2x2 pictures of random bytes, of all 0 and of all 255 (the
