@@ -77,6 +77,16 @@ class KernelPathsTest : public ::testing::Test {
     }
   }
 
+  // The frame set's panorama, resized to a view's picture.
+  cv::Mat panoramaResizedTo(cv::Size view) {
+    Stitcher stitcher(lut_, pool_);
+    cv::Mat raw;
+    stitcher.stitch(frames_, raw);
+    cv::Mat picture;
+    cv::resize(raw, picture, view, 0, 0, cv::INTER_AREA);
+    return picture;
+  }
+
   static constexpr std::array kFormats = {PixelFormat::kBgr, PixelFormat::kYuyv, PixelFormat::kUyvy,
                                           PixelFormat::kNv12};
   WorkPool pool_{2};
@@ -211,12 +221,8 @@ cv::Mat viewPositions(cv::Size panorama) {
 // The same for a picture that samples the panorama elsewhere (a fixed view, viewPositions()): the
 // picture the panorama resized to it.
 TEST_F(KernelPathsTest, EveryPathAppliesTheSameCorrectionToAView) {
-  Stitcher stitcher(lut_, pool_);
-  cv::Mat raw;
-  stitcher.stitch(frames_, raw);
   const cv::Mat positions = viewPositions(lut_.size);
-  cv::Mat picture;
-  cv::resize(raw, picture, positions.size(), 0, 0, cv::INTER_AREA);
+  const cv::Mat picture = panoramaResizedTo(positions.size());
   expectEveryPathCorrectsAlike(
       picture, [&](PoissonColourCorrection& poisson, cv::Mat& corrected, KernelPath path) {
         poisson.applyAt(poisson.viewSamples(positions), corrected, path);
@@ -226,12 +232,8 @@ TEST_F(KernelPathsTest, EveryPathAppliesTheSameCorrectionToAView) {
 // A view's picture corrected and converted to I420 in one pass, by each path: the picture
 // corrected as by the two passes, and the I420 of it.
 TEST_F(KernelPathsTest, EveryPathCorrectsAViewAndConvertsItInOnePass) {
-  Stitcher stitcher(lut_, pool_);
-  cv::Mat raw;
-  stitcher.stitch(frames_, raw);
   const cv::Mat positions = viewPositions(lut_.size);
-  cv::Mat picture;
-  cv::resize(raw, picture, positions.size(), 0, 0, cv::INTER_AREA);
+  const cv::Mat picture = panoramaResizedTo(positions.size());
   PoissonColourCorrection poisson(truth_.rig, testing::settingsFor(truth_), lut_, {}, pool_);
   poisson.update(frames_);
   const auto samples = poisson.viewSamples(positions);
