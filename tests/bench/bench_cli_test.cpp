@@ -53,6 +53,9 @@ TEST(BenchCli, StitchReportsTimingsAndAccuracyAsJson) {
   EXPECT_GT(top["map_ms"].as<double>(), 0);
   EXPECT_GT(top["compose_s"].as<double>(), 0);
   EXPECT_GT(top["view_lut_ms"].as<double>(), 0);
+  // The same made in I420 for an encoder, and the encoder's own conversion that spares.
+  EXPECT_GT(top["view_lut_i420_ms"].as<double>(), 0);
+  EXPECT_GT(top["encoder_bgr_ms"].as<double>(), 0);
   EXPECT_GT(top["rendered_ms"].as<double>(), 0);
   EXPECT_GT(top["psnr_db"].as<double>(), 30.0);
   // Both gathers from the frames held in each format a camera may hand over.

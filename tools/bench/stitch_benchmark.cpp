@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 #include <unistd.h>
 
+#include "common/ffmpeg_util.hpp"
 #include "common/work_pool.hpp"
 #include "processing/colour/poisson_correction.hpp"
 #include "processing/stitch/panorama_lut_cache.hpp"
@@ -20,6 +21,7 @@
 #include "processing/stitch/view_lut.hpp"
 #include "processing/surround_mesh.hpp"
 #include "render/egl_context.hpp"
+#include "render/outputs/encoder_conversion.hpp"
 #include "render/surround_view.hpp"
 #include "tools/bench/panorama_accuracy.hpp"
 #include "tools/bench/recording_truth.hpp"
@@ -55,14 +57,16 @@ struct FormatTiming {
 // the same picture.
 struct TopViewTiming {
   cv::Size size{1280, 720};
-  double mapMs = 0;       // OpenGL's part of its set-up, on the pipeline's thread at a switch:
-                          // where the view samples the panorama, and its car and background
-  double composeS = 0;    // the view LUT from the panorama's and the field's samples, on one
-                          // thread (beside the sets)
-  double directMs = 0;    // one gather into the picture, the field applied to it
-  double renderedMs = 0;  // stitch + field + upload + draw + read-back
-  double psnr = 0;        // of the direct picture against the rendered one, where both show the
-                          // panorama
+  double mapMs = 0;         // OpenGL's part of its set-up, on the pipeline's thread at a switch:
+                            // where the view samples the panorama, and its car and background
+  double composeS = 0;      // the view LUT from the panorama's and the field's samples, on one
+                            // thread (beside the sets)
+  double directMs = 0;      // one gather into the picture, the field applied to it
+  double directI420Ms = 0;  // the same for an encoder: the field's pass converting it to I420
+  double encoderBgrMs = 0;  // what that spares the encoder: its conversion of the BGR picture
+  double renderedMs = 0;    // stitch + field + upload + draw + read-back
+  double psnr = 0;          // of the direct picture against the rendered one, where both show the
+                            // panorama
   std::vector<FormatTiming> formats;
 };
 
@@ -142,20 +146,36 @@ TopViewTiming measureTopView(const processing::Rig& rig,
   cv::Mat panorama(lut.size, CV_8UC3);
   cv::Mat directPicture(timing.size, CV_8UC3);
   cv::Mat rendered;
-  const auto medians = interleavedMedians({[&] {
-                                             direct.stitch(images, directPicture);
-                                             correction.applyAt(fieldSamples, directPicture);
-                                           },
-                                           [&] {
-                                             stitcher.stitch(images, panorama);
-                                             correction.apply(panorama);
-                                             scene.uploadPanorama(panorama);
-                                             view.draw(0);
-                                             rendered = view.collect();
-                                           }},
-                                          repeats);
+  cv::Mat i420;
+  const render::EncoderConversion encoderConversion(timing.size, AV_PIX_FMT_YUV420P);
+  const ffmpeg::FramePtr encoderFrame(av_frame_alloc());
+  if (encoderFrame == nullptr) throw std::runtime_error("out of memory");
+  encoderFrame->format = AV_PIX_FMT_YUV420P;
+  encoderFrame->width = timing.size.width;
+  encoderFrame->height = timing.size.height;
+  if (av_frame_get_buffer(encoderFrame.get(), 0) < 0) throw std::runtime_error("out of memory");
+  const auto medians =
+      interleavedMedians({[&] {
+                            direct.stitch(images, directPicture);
+                            correction.applyAt(fieldSamples, directPicture);
+                          },
+                          [&] {
+                            direct.stitch(images, directPicture);
+                            correction.applyAt(fieldSamples, directPicture, i420);
+                          },
+                          [&] { (void)encoderConversion.convert(directPicture, *encoderFrame); },
+                          [&] {
+                            stitcher.stitch(images, panorama);
+                            correction.apply(panorama);
+                            scene.uploadPanorama(panorama);
+                            view.draw(0);
+                            rendered = view.collect();
+                          }},
+                         repeats);
   timing.directMs = medians[0];
-  timing.renderedMs = medians[1];
+  timing.directI420Ms = medians[1];
+  timing.encoderBgrMs = medians[2];
+  timing.renderedMs = medians[3];
   for (const PixelFormat format :
        {PixelFormat::kBgr, PixelFormat::kYuyv, PixelFormat::kUyvy, PixelFormat::kNv12}) {
     std::vector<cv::Mat> held(images.size());
@@ -248,6 +268,11 @@ void printText(const std::vector<InputReport>& reports) {
         top.size.width, top.size.height, r.timings.back().threads, top.directMs,
         1000 / top.directMs, top.renderedMs, top.directMs / top.renderedMs, top.psnr, top.mapMs,
         top.composeS);
+    fmt::print(
+        "  top view for an encoder: gather + field + I420 {:6.2f} ms ({:.2f}x the BGR picture's), "
+        "sparing the encoder its BGR -> 4:2:0 conversion ({:.2f} ms): ratio {:.2f}x\n",
+        top.directI420Ms, top.directI420Ms / top.directMs, top.encoderBgrMs,
+        top.directI420Ms / (top.directMs + top.encoderBgrMs));
     const FormatTiming& bgr = top.formats.front();
     for (const FormatTiming& f : top.formats) {
       fmt::print(
@@ -294,14 +319,16 @@ void printJson(const std::vector<InputReport>& reports) {
         "{}\n  {{\"input\": \"{}\", \"camera\": [{}, {}], \"panorama\": [{}, {}], "
         "\"lut_build_s\": {:.4f}, \"lut_load_s\": {:.4f}, \"lut_bytes\": {}, "
         "\"timings\": [{}], \"top_view\": {{\"size\": [{}, {}], \"view_lut_ms\": {:.4f}, "
+        "\"view_lut_i420_ms\": {:.4f}, \"encoder_bgr_ms\": {:.4f}, "
         "\"rendered_ms\": {:.4f}, \"psnr_db\": {:.2f}, \"map_ms\": {:.4f}, \"compose_s\": {:.4f}, "
         "\"held_formats\": "
         "[{}]}}, \"bowl\": {}, "
         "\"sphere\": {}}}",
         i == 0 ? "" : ",", r.name, r.camera.width, r.camera.height, r.panorama.width,
         r.panorama.height, r.lutBuildS, r.lutLoadS, r.lutBytes, timings, r.topView.size.width,
-        r.topView.size.height, r.topView.directMs, r.topView.renderedMs, r.topView.psnr,
-        r.topView.mapMs, r.topView.composeS, formats, accuracy(r.bowl), accuracy(r.sphere));
+        r.topView.size.height, r.topView.directMs, r.topView.directI420Ms, r.topView.encoderBgrMs,
+        r.topView.renderedMs, r.topView.psnr, r.topView.mapMs, r.topView.composeS, formats,
+        accuracy(r.bowl), accuracy(r.sphere));
   }
   fmt::print("\n]}}\n");
 }
