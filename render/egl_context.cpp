@@ -86,6 +86,24 @@ EGLDisplay surfacelessDisplay(std::string& why) {
   return display;
 }
 
+EGLDisplay x11Display(void* nativeDisplay, std::string& why) {
+  if (nativeDisplay == nullptr) {
+    why = "no X display given";
+    return EGL_NO_DISPLAY;
+  }
+  if (!hasExtension(eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS), "EGL_KHR_platform_x11")) {
+    why = "the EGL client has no EGL_KHR_platform_x11";
+    return EGL_NO_DISPLAY;
+  }
+  const auto platformDisplay =
+      procedure<PFNEGLGETPLATFORMDISPLAYEXTPROC>("eglGetPlatformDisplayEXT");
+  const EGLDisplay display = platformDisplay != nullptr
+                                 ? platformDisplay(EGL_PLATFORM_X11_KHR, nativeDisplay, nullptr)
+                                 : EGL_NO_DISPLAY;
+  if (display == EGL_NO_DISPLAY) why = eglErrorText("eglGetPlatformDisplayEXT(x11)");
+  return display;
+}
+
 }  // namespace
 
 bool softwareRenderer() {
@@ -107,11 +125,13 @@ const char* toString(EglPlatform platform) {
       return "surfaceless";
     case EglPlatform::kDefault:
       return "default";
+    case EglPlatform::kX11:
+      return "x11";
   }
   return "?";
 }
 
-EglContext::EglContext(EglPlatform platform) {
+EglContext::EglContext(EglPlatform platform, void* nativeDisplay) {
   const std::vector<EglPlatform> order =
       platform == EglPlatform::kAuto
           ? std::vector{EglPlatform::kDevice, EglPlatform::kSurfaceless, EglPlatform::kDefault}
@@ -119,7 +139,7 @@ EglContext::EglContext(EglPlatform platform) {
   std::string failures;
   for (const EglPlatform candidate : order) {
     std::string why;
-    if (open(candidate, why)) return;
+    if (open(candidate, nativeDisplay, why)) return;
     close();
     failures += fmt::format("; {}: {}", toString(candidate), why);
   }
@@ -128,8 +148,9 @@ EglContext::EglContext(EglPlatform platform) {
 
 EglContext::~EglContext() { close(); }
 
-bool EglContext::open(EglPlatform platform, std::string& why) {
+bool EglContext::open(EglPlatform platform, void* nativeDisplay, std::string& why) {
   if (platform == EglPlatform::kDevice) display_ = deviceDisplay(why);
+  if (platform == EglPlatform::kX11) display_ = x11Display(nativeDisplay, why);
   if (platform == EglPlatform::kSurfaceless) display_ = surfacelessDisplay(why);
   if (platform == EglPlatform::kDefault) {
     display_ = eglGetDisplay(EGL_DEFAULT_DISPLAY);
@@ -147,29 +168,29 @@ bool EglContext::open(EglPlatform platform, std::string& why) {
     why = eglErrorText("eglBindAPI(OpenGL ES)");
     return false;
   }
-  const std::array<EGLint, 13> configAttributes{EGL_SURFACE_TYPE,
-                                                EGL_PBUFFER_BIT,
-                                                EGL_RENDERABLE_TYPE,
-                                                EGL_OPENGL_ES3_BIT,
-                                                EGL_RED_SIZE,
-                                                8,
-                                                EGL_GREEN_SIZE,
-                                                8,
-                                                EGL_BLUE_SIZE,
-                                                8,
-                                                EGL_ALPHA_SIZE,
-                                                8,
-                                                EGL_NONE};
-  EGLConfig config = nullptr;
+  const std::array<EGLint, 13> configAttributes{
+      EGL_SURFACE_TYPE,
+      platform == EglPlatform::kX11 ? EGL_WINDOW_BIT : EGL_PBUFFER_BIT,
+      EGL_RENDERABLE_TYPE,
+      EGL_OPENGL_ES3_BIT,
+      EGL_RED_SIZE,
+      8,
+      EGL_GREEN_SIZE,
+      8,
+      EGL_BLUE_SIZE,
+      8,
+      EGL_ALPHA_SIZE,
+      8,
+      EGL_NONE};
   EGLint configs = 0;
-  if (eglChooseConfig(display_, configAttributes.data(), &config, 1, &configs) != EGL_TRUE ||
+  if (eglChooseConfig(display_, configAttributes.data(), &config_, 1, &configs) != EGL_TRUE ||
       configs == 0) {
     why = "no RGBA8 OpenGL ES 3 configuration";
     return false;
   }
   const std::array<EGLint, 5> contextAttributes{EGL_CONTEXT_MAJOR_VERSION, 3,
                                                 EGL_CONTEXT_MINOR_VERSION, 0, EGL_NONE};
-  context_ = eglCreateContext(display_, config, EGL_NO_CONTEXT, contextAttributes.data());
+  context_ = eglCreateContext(display_, config_, EGL_NO_CONTEXT, contextAttributes.data());
   if (context_ == EGL_NO_CONTEXT) {
     why = eglErrorText("eglCreateContext(OpenGL ES 3.0)");
     return false;
@@ -178,7 +199,7 @@ bool EglContext::open(EglPlatform platform, std::string& why) {
   // EGL_KHR_surfaceless_context.
   if (!hasExtension(eglQueryString(display_, EGL_EXTENSIONS), "EGL_KHR_surfaceless_context")) {
     const std::array<EGLint, 5> pbuffer{EGL_WIDTH, 1, EGL_HEIGHT, 1, EGL_NONE};
-    surface_ = eglCreatePbufferSurface(display_, config, pbuffer.data());
+    surface_ = eglCreatePbufferSurface(display_, config_, pbuffer.data());
     if (surface_ == EGL_NO_SURFACE) {
       why = eglErrorText("eglCreatePbufferSurface");
       return false;
@@ -206,6 +227,13 @@ void EglContext::makeCurrent() {
   }
 }
 
+void EglContext::drawInto(EGLSurface surface) {
+  const EGLSurface target = surface == EGL_NO_SURFACE ? surface_ : surface;
+  if (eglMakeCurrent(display_, target, target, context_) != EGL_TRUE) {
+    throw RenderError(eglErrorText("eglMakeCurrent(surface)"));
+  }
+}
+
 void EglContext::close() {
   if (display_ == EGL_NO_DISPLAY) return;
   eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
@@ -215,6 +243,7 @@ void EglContext::close() {
   display_ = EGL_NO_DISPLAY;
   context_ = EGL_NO_CONTEXT;
   surface_ = EGL_NO_SURFACE;
+  config_ = nullptr;
 }
 
 }  // namespace surroundd::render

@@ -1,9 +1,12 @@
 #pragma once
-// A headless OpenGL ES 3 context through EGL, for rendering into framebuffer objects: no window,
-// no display server. Platforms, in the order `kAuto` tries them:
+// An OpenGL ES 3 context through EGL, for rendering into framebuffer objects: headless, no
+// display server. Platforms, in the order `kAuto` tries them:
 //   device       EGL_EXT_platform_device on a hardware device (NVIDIA's driver, or a DRM node);
 //   surfaceless  EGL_MESA_platform_surfaceless (Mesa: a GPU, or llvmpipe on the CPU);
 //   default      the default display with a 1x1 pbuffer, for drivers with neither.
+// And, asked for by name only, on an X server's connection (EGL_KHR_platform_x11), so that it can
+// also draw into that server's windows (render/outputs/egl_window.hpp):
+//   x11          the framebuffer objects as on the others, and EGL window surfaces.
 // The context is current on the thread that made it until release() hands it on, and then on
 // the one that calls makeCurrent(): EGL binds a context to one thread at a time, so GL objects are
 // made and used on the thread that has it, and destroyed before the context.
@@ -14,12 +17,13 @@
 
 namespace surroundd::render {
 
-enum class EglPlatform { kAuto, kDevice, kSurfaceless, kDefault };
+enum class EglPlatform { kAuto, kDevice, kSurfaceless, kDefault, kX11 };
 
 class EglContext {
  public:
-  // Throws RenderError listing each platform tried and why it failed.
-  explicit EglContext(EglPlatform platform = EglPlatform::kAuto);
+  // Throws RenderError listing each platform tried and why it failed. kX11 needs
+  // `nativeDisplay`: an Xlib Display*, which must stay open longer than the context.
+  explicit EglContext(EglPlatform platform = EglPlatform::kAuto, void* nativeDisplay = nullptr);
   ~EglContext();
   EglContext(const EglContext&) = delete;
   EglContext& operator=(const EglContext&) = delete;
@@ -32,15 +36,23 @@ class EglContext {
   // Current on the calling thread; no other may have it. Throws RenderError.
   void makeCurrent();
   EglPlatform platform() const { return platform_; }
+  // For surfaces of the context's display (kX11: windows): its display and configuration.
+  EGLDisplay display() const { return display_; }
+  EGLConfig config() const { return config_; }
+  // Draws into `surface`'s default framebuffer from now on (EGL_NO_SURFACE: none, only into
+  // framebuffer objects, as after construction), on the thread that has the context. Throws
+  // RenderError.
+  void drawInto(EGLSurface surface);
   // Whether the renderer runs on the CPU (Mesa's llvmpipe, softpipe or swrast; SwiftShader):
   // there, pixel work is faster in the CPU path than through OpenGL.
   bool software() const { return software_; }
 
  private:
-  bool open(EglPlatform platform, std::string& why);
+  bool open(EglPlatform platform, void* nativeDisplay, std::string& why);
   void close();
 
   EGLDisplay display_ = EGL_NO_DISPLAY;
+  EGLConfig config_ = nullptr;
   EGLContext context_ = EGL_NO_CONTEXT;
   EGLSurface surface_ = EGL_NO_SURFACE;  // only for the default platform
   EglPlatform platform_ = EglPlatform::kAuto;

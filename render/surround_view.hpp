@@ -58,6 +58,9 @@ class SurroundView {
   DrawnPicture drawn() const { return drawn_; }
   // The picture of the last draw(), 8-bit BGR; valid until the next collect().
   const cv::Mat& collect();
+  // The framebuffer the view draws into: row 0 of its colour is the picture's top row (as the
+  // read-back gives it), for what shows it on the GPU without reading it back (EglWindow).
+  GLuint framebuffer() const { return framebuffer_.name(); }
 
   // Where each pixel of the view (as it is now, its eye at `timeS`) samples the panorama, in
   // panorama pixels (centres at integers, as PanoramaGeometry): CV_32FC2, NaN where it shows no

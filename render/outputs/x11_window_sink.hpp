@@ -60,12 +60,12 @@ class X11WindowSink final : public FrameSink {
   std::uint64_t framesShown() const { return framesShown_; }
 
  private:
-  class XlibWindow;  // the connection, the window and its picture (keeps Xlib out of this header)
+  class ShownWindow;  // the connection, the window and its picture (keeps Xlib out of this header)
 
   X11WindowSettings settings_;
   // Xlib's connection is used by one thread at a time: this guards window_ after construction.
   mutable std::mutex xlib_;
-  std::unique_ptr<XlibWindow> window_;
+  std::unique_ptr<ShownWindow> window_;
   mutable std::atomic<bool> open_{true};  // the window's state when last looked at
   std::uint64_t framesShown_ = 0;
 };
