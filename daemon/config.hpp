@@ -138,6 +138,11 @@ struct RenderConfig {
 // surround view.
 enum class OutputStream { kMosaic, kPanorama, kSurround };
 
+// How a window output shows its pictures: read back and sent to the X server
+// (render::X11WindowSink), or the surround view as OpenGL drew it, through EGL on the GPU with
+// no read-back (render::EglWindowSink; the renderer's context is then on that X server).
+enum class WindowPresent { kPicture, kEgl };
+
 // An output's `type:`: the name of an output type in the registry (output_type.hpp), where each
 // type registers its keys, its factory and what it takes from the pipeline. The built-in types are
 // named here for code that writes configs; a type registered elsewhere is OutputKind{"its-name"}.
@@ -225,6 +230,7 @@ struct OutputConfig {
   // window (X11)
   std::string display;  // empty: $DISPLAY
   std::string title = "surroundd";
+  WindowPresent present = WindowPresent::kPicture;
   // display (DRM/KMS)
   std::filesystem::path device;  // empty: the first card with a connected connector
   std::string connector;         // e.g. HDMI-A-1; empty: the first connected one

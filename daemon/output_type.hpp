@@ -23,6 +23,7 @@
 #include "daemon/config.hpp"
 #include "daemon/config_keys.hpp"
 #include "daemon/yaml_reader.hpp"
+#include "render/egl_context.hpp"
 #include "render/outputs/frame_sink.hpp"
 
 namespace surroundd::daemon {
@@ -31,7 +32,7 @@ namespace surroundd::daemon {
 enum class OutputInput {
   kPicture,       // each wanted frame set's picture of its stream, 8-bit BGR (render::FrameSink)
   kCameraFrames,  // every frame set's camera frames as captured (CameraFramesSink: a recording)
-  // Later: a GL framebuffer, for outputs that can show a surround view without read-back.
+  // (A picture output may show the surround view on the GPU instead: FrameSink::presentsViews.)
 };
 
 // What the files an output writes at `path` are, for the rule that no run destroys another's data
@@ -50,6 +51,10 @@ struct OutputContext {
   double nominalFps = 30;   // the cameras' frame rate
   bool latestWins = false;  // live: a queue drops its oldest picture instead of waiting
   const std::vector<RigCamera>* cameras = nullptr;  // the rig (kCameraFrames)
+  // The surround views' renderer, its context current on the thread that opens the output; null
+  // where the config has no surround output. For a sink that shows the views on the GPU
+  // (FrameSink::presentsViews()).
+  render::EglContext* renderer = nullptr;
 };
 
 // Two outputs of one config that cannot both work: the key of the later one to blame, and why
@@ -87,6 +92,10 @@ struct OutputType {
       openPictureSink;
   std::function<std::unique_ptr<CameraFramesSink>(const OutputConfig&, const OutputContext&)>
       openCameraFramesSink;
+  // For a type whose outputs may show the surround views on the GPU (a window through EGL): the
+  // renderer's context opened where it can draw into `output` (its X server), or null where this
+  // output does not ask for that. Throws RenderError naming what could not be opened.
+  std::function<std::unique_ptr<render::EglContext>(const OutputConfig& output)> openRenderer;
 };
 
 // Adds a type; throws std::logic_error if its name is taken or it has no factory for its input

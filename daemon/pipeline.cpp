@@ -82,6 +82,7 @@ Pipeline::Pipeline(const Config& config, RunStart start)
     auto stage = std::make_unique<SurroundStage>(config, std::move(*renderer_.get()), *panorama,
                                                  cameraFormatOf(cameras_));
     surround_ = stage.get();
+    outputs_.setRenderer(&surround_->context());
     stages_.push_back(std::move(stage));
     panorama->setWanted(
         [surround = surround_](FrameWork& work) { return surround->needsPanorama(work); });

@@ -1,6 +1,7 @@
 #include "daemon/pipeline_outputs.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include <spdlog/spdlog.h>
 
@@ -57,21 +58,36 @@ void PipelineOutputs::drop(PictureOutput& output, const std::exception& error) {
   ++failures_;
 }
 
-void PipelineOutputs::handOver(PictureOutput& output, const cv::Mat& picture,
-                               std::chrono::nanoseconds streamTime, Clock::time_point origin,
-                               std::optional<render::DrawnPicture> drawn, const cv::Mat* asBgr) {
+template <typename Show>
+void PipelineOutputs::deliver(PictureOutput& output, std::chrono::nanoseconds streamTime,
+                              Clock::time_point origin, std::optional<render::DrawnPicture> drawn,
+                              Show&& show) {
   guarded(output, [&] {
     // The wall clock of the capture, for viewers that measure how late they show it.
     const auto captured =
         std::chrono::system_clock::now() -
         std::chrono::duration_cast<std::chrono::system_clock::duration>(Clock::now() - origin);
-    output.sink->consume(picture, {streamTime, captured});
-    output.latest = asBgr != nullptr ? *asBgr : picture;
+    std::forward<Show>(show)(render::PictureTime{streamTime, captured});
     const auto now = Clock::now();
     latency_.record(now - origin);
     if (!firstPictureAt_) firstPictureAt_ = now;
     if (drawn) timeSwitch(output, *drawn, now);
   });
+}
+
+void PipelineOutputs::handOver(PictureOutput& output, const cv::Mat& picture,
+                               std::chrono::nanoseconds streamTime, Clock::time_point origin,
+                               std::optional<render::DrawnPicture> drawn, const cv::Mat* asBgr) {
+  deliver(output, streamTime, origin, drawn, [&](const render::PictureTime& time) {
+    output.sink->consume(picture, time);
+    output.latest = asBgr != nullptr ? *asBgr : picture;
+  });
+}
+
+void PipelineOutputs::present(PictureOutput& output, std::chrono::nanoseconds streamTime,
+                              Clock::time_point origin, const render::DrawnPicture& drawn) {
+  deliver(output, streamTime, origin, drawn,
+          [&](const render::PictureTime& time) { output.sink->present(*output.view, time); });
 }
 
 void PipelineOutputs::switchView(PictureOutput& output, ViewKind view) {
@@ -125,7 +141,10 @@ void PipelineOutputs::open(PictureOutput& output) {
   // Where the failed try left data, this one writes the next name.
   output.config.path = unusedOutputPath(output.config);
   output.sink = outputTypeOf(output.config)
-                    .openPictureSink(output.config, {output.size, nominalFps_, latestWins_});
+                    .openPictureSink(output.config, {.pictureSize = output.size,
+                                                     .nominalFps = nominalFps_,
+                                                     .latestWins = latestWins_,
+                                                     .renderer = renderer_});
 }
 
 void PipelineOutputs::retry(Clock::time_point now) {

@@ -24,6 +24,7 @@
 #include "daemon/config.hpp"
 #include "daemon/duration_histogram.hpp"
 #include "daemon/pipeline_report.hpp"
+#include "render/egl_context.hpp"
 #include "render/outputs/frame_sink.hpp"
 #include "render/surround_view.hpp"
 
@@ -85,6 +86,12 @@ class PipelineOutputs {
   void handOver(PictureOutput& output, const cv::Mat& picture, std::chrono::nanoseconds streamTime,
                 Clock::time_point origin, std::optional<render::DrawnPicture> drawn = std::nullopt,
                 const cv::Mat* asBgr = nullptr);
+  // As handOver(), for an output whose sink shows its view as drawn, on the GPU
+  // (FrameSink::presentsViews()): no picture, none read back.
+  void present(PictureOutput& output, std::chrono::nanoseconds streamTime, Clock::time_point origin,
+               const render::DrawnPicture& drawn);
+  // The surround views' renderer, for the outputs opened from now on (OutputContext::renderer).
+  void setRenderer(render::EglContext* renderer) { renderer_ = renderer; }
   // Each recording's copy of the set.
   void record(const capture::FrameSet& set);
   // Opens again the failed outputs whose retry is due.
@@ -116,6 +123,10 @@ class PipelineOutputs {
 
  private:
   void open(PictureOutput& output);
+  // Has `show` give the output the set's picture (guarded), then times it as handOver() says.
+  template <typename Show>
+  void deliver(PictureOutput& output, std::chrono::nanoseconds streamTime, Clock::time_point origin,
+               std::optional<render::DrawnPicture> drawn, Show&& show);
   void drop(PictureOutput& output, const std::exception& error);
   // Switches `output`'s view as part of the switch requested now.
   void switchView(PictureOutput& output, ViewKind view);
@@ -129,6 +140,7 @@ class PipelineOutputs {
 
   double nominalFps_;
   bool latestWins_;
+  render::EglContext* renderer_ = nullptr;
   std::vector<PictureOutput> pictures_;
   std::vector<std::unique_ptr<CameraFramesSink>> recordings_;  // null once failed
   std::uint64_t failures_ = 0;

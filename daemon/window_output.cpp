@@ -1,7 +1,14 @@
-// The `window` output: an X11 window on a desk (render::X11WindowSink), shown from a thread of its
-// own behind a queue.
+// The `window` output: an X11 window on a desk. With `present: picture` (render::X11WindowSink)
+// it is handed each picture read back, and shows it from a thread of its own behind a queue; with
+// `present: egl` (render::EglWindowSink) it shows the surround view as OpenGL drew it, on the
+// renderer's thread, through EGL: the renderer's context is then made on the window's X server.
+#include <fmt/format.h>
+
 #include "daemon/built_in_outputs.hpp"
+#include "render/outputs/egl_window_sink.hpp"
 #include "render/outputs/x11_window_sink.hpp"
+#include "render/outputs/xlib_display.hpp"  // after every other header: Xlib's macros
+#include "render/render_error.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -11,9 +18,45 @@ constexpr std::size_t kWindowQueue = 1;
 
 std::unique_ptr<render::FrameSink> openWindow(const OutputConfig& output,
                                               const OutputContext& context) {
-  return queuedSink(std::make_unique<render::X11WindowSink>(render::X11WindowSettings{
-                        output.display, output.title, context.pictureSize}),
-                    context, kWindowQueue);
+  render::X11WindowSettings settings{output.display, output.title, context.pictureSize};
+  if (output.present == WindowPresent::kPicture) {
+    return queuedSink(std::make_unique<render::X11WindowSink>(std::move(settings)), context,
+                      kWindowQueue);
+  }
+  if (context.renderer == nullptr) {
+    throw render::RenderError("an egl window shows the surround view, and there is no renderer");
+  }
+  return std::make_unique<render::EglWindowSink>(*context.renderer, std::move(settings));
+}
+
+// The renderer's context on the X server of a window that shows the views through EGL; it keeps
+// its own connection there.
+std::unique_ptr<render::EglContext> openRendererOnServer(const OutputConfig& output) {
+  if (output.present != WindowPresent::kEgl) return nullptr;
+  auto display = std::make_shared<render::XlibDisplay>(output.display);
+  void* native = display->get();
+  return std::make_unique<render::EglContext>(render::EglPlatform::kX11, native,
+                                              std::move(display));
+}
+
+void checkWindow(YamlObject& item, OutputConfig& output) {
+  if (output.present == WindowPresent::kEgl && output.stream != OutputStream::kSurround) {
+    item.error("present",
+               "egl shows the surround view as OpenGL draws it: the window's stream "
+               "must be surround");
+  }
+}
+
+// The renderer draws on one X server: every egl window is on it.
+std::optional<OutputConflict> otherServer(const OutputConfig& earlier, const OutputConfig& output) {
+  if (earlier.present != WindowPresent::kEgl || output.present != WindowPresent::kEgl ||
+      earlier.display == output.display) {
+    return std::nullopt;
+  }
+  return OutputConflict{
+      "display", fmt::format("an egl window must be on the X server of the renderer, which an "
+                             "earlier egl window puts on '{}'",
+                             earlier.display.empty() ? "$DISPLAY" : earlier.display)};
 }
 
 }  // namespace
@@ -26,8 +69,15 @@ OutputType windowOutputType() {
       // Empty, its default, is $DISPLAY: the reference shows an example.
       Key::text("display", &OutputConfig::display, "X display", Shown::kExample),
       Key::text("title", &OutputConfig::title, "the window's title"),
+      Key::choice("present", &OutputConfig::present,
+                  {{"picture", WindowPresent::kPicture}, {"egl", WindowPresent::kEgl}},
+                  "how it shows the view: picture (read back, sent to the server) or egl (drawn "
+                  "into the window on the GPU; the renderer then runs on that X server)"),
   };
+  type.readSettings = checkWindow;
+  type.conflict = otherServer;
   type.openPictureSink = openWindow;
+  type.openRenderer = openRendererOnServer;
   return type;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <EGL/eglext.h>
@@ -131,7 +132,8 @@ const char* toString(EglPlatform platform) {
   return "?";
 }
 
-EglContext::EglContext(EglPlatform platform, void* nativeDisplay) {
+EglContext::EglContext(EglPlatform platform, void* nativeDisplay, std::shared_ptr<void> nativeOwner)
+    : nativeOwner_(std::move(nativeOwner)) {
   const std::vector<EglPlatform> order =
       platform == EglPlatform::kAuto
           ? std::vector{EglPlatform::kDevice, EglPlatform::kSurfaceless, EglPlatform::kDefault}

@@ -11,6 +11,7 @@
 // the one that calls makeCurrent(): EGL binds a context to one thread at a time, so GL objects are
 // made and used on the thread that has it, and destroyed before the context.
 
+#include <memory>
 #include <string>
 
 #include <EGL/egl.h>
@@ -22,8 +23,10 @@ enum class EglPlatform { kAuto, kDevice, kSurfaceless, kDefault, kX11 };
 class EglContext {
  public:
   // Throws RenderError listing each platform tried and why it failed. kX11 needs
-  // `nativeDisplay`: an Xlib Display*, which must stay open longer than the context.
-  explicit EglContext(EglPlatform platform = EglPlatform::kAuto, void* nativeDisplay = nullptr);
+  // `nativeDisplay`: an Xlib Display*, open longer than the context; `nativeOwner`, when given,
+  // keeps it open and is released once the context is closed.
+  explicit EglContext(EglPlatform platform = EglPlatform::kAuto, void* nativeDisplay = nullptr,
+                      std::shared_ptr<void> nativeOwner = nullptr);
   ~EglContext();
   EglContext(const EglContext&) = delete;
   EglContext& operator=(const EglContext&) = delete;
@@ -51,6 +54,7 @@ class EglContext {
   bool open(EglPlatform platform, void* nativeDisplay, std::string& why);
   void close();
 
+  std::shared_ptr<void> nativeOwner_;  // released after close(): declared first
   EGLDisplay display_ = EGL_NO_DISPLAY;
   EGLConfig config_ = nullptr;
   EGLContext context_ = EGL_NO_CONTEXT;

@@ -119,15 +119,16 @@ void SurroundView::drawScene(ViewKind view, double timeS, SurroundScene::Pass pa
   }
 }
 
-void SurroundView::draw(double timeS) {
+void SurroundView::draw(double timeS, ReadBack readBack) {
+  const bool reading = readBack == ReadBack::kYes;
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.name());
   drawPicture(timeS);
   readStarted_ = false;
-  if (!readAtCollect_) startReadBack();
+  if (reading && !readAtCollect_) startReadBack();
   drawnFence_.place();
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   gl::check("drawing a surround view");
-  pending_ = true;
+  pending_ = reading;
 }
 
 void SurroundView::drawPicture(double timeS) {

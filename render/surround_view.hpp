@@ -49,8 +49,10 @@ class SurroundView {
   // the other views.
   std::optional<cv::Rect> cameraArea() const;
 
-  // Renders the scene as it was last uploaded; `timeS` moves the orbiting eye.
-  void draw(double timeS);
+  // Renders the scene as it was last uploaded; `timeS` moves the orbiting eye. With kNo the
+  // picture stays in framebuffer() for what shows it on the GPU, and nothing is pending.
+  enum class ReadBack { kYes, kNo };
+  void draw(double timeS, ReadBack readBack = ReadBack::kYes);
   bool pending() const { return pending_; }
   // Whether the pending picture can be collected without waiting: drawn (and on a GPU, copied).
   bool finished() const { return pending_ && drawnFence_.passed(); }

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
+#include "daemon/output_type.hpp"
 #include "daemon/panorama_setup.hpp"
 #include "daemon/pipeline_ends.hpp"
 #include "processing/stitch/i420_picture.hpp"
@@ -40,6 +41,27 @@ std::size_t splitCameraOf(const Config& config) {
   return split == names.end() ? 0 : static_cast<std::size_t>(split - names.begin());
 }
 
+// The renderer's context: on the display of an output that shows the views on the GPU
+// (OutputType::openRenderer: an egl window's X server), else on render.platform. An output's
+// display that cannot be opened leaves the renderer on render.platform, and that output failing.
+std::unique_ptr<render::EglContext> rendererContext(const Config& config) {
+  for (const OutputConfig& output : config.outputs) {
+    const OutputType& type = outputTypeOf(output);
+    if (!type.openRenderer || output.stream != OutputStream::kSurround) continue;
+    try {
+      if (auto gl = type.openRenderer(output)) {
+        spdlog::info("render: on the X server of the {} output, which shows the views through EGL",
+                     type.name);
+        return gl;
+      }
+    } catch (const render::RenderError& e) {
+      spdlog::error("render: the {} output cannot have the renderer: {}; it renders on {}",
+                    type.name, e.what(), render::toString(config.render.platform));
+    }
+  }
+  return std::make_unique<render::EglContext>(config.render.platform);
+}
+
 std::unique_ptr<render::EglContext> madeCurrent(std::unique_ptr<render::EglContext> gl) {
   gl->makeCurrent();
   return gl;
@@ -66,7 +88,7 @@ std::future<std::unique_ptr<SurroundRenderer>> openSurroundRenderer(const Config
   // (a test's pipeline), it is no race to report between that thread's lines and the cameras'.
   spdlog::default_logger_raw();
   return std::async(std::launch::async, [&config] {
-    auto gl = std::make_unique<render::EglContext>(config.render.platform);
+    auto gl = rendererContext(config);
     spdlog::info("render: {}", gl->description());
     const processing::PanoramaSettings settings = panoramaSettings(config);
     processing::SurroundMesh mesh;
@@ -163,6 +185,10 @@ SurroundStage::FixedView* SurroundStage::fixedView(render::SurroundView& view) {
   return fixed.view && !view.moves() ? &fixed : nullptr;
 }
 
+SurroundStage::FixedView* SurroundStage::fixedViewFor(PipelineOutputs::PictureOutput& output) {
+  return output.sink->presentsViews() ? nullptr : fixedView(*output.view);
+}
+
 void SurroundStage::startFixedView(render::SurroundView& view, FixedView& fixed) {
   // The map here, on the context's thread (a tenth of a second on llvmpipe the first time); the
   // composition on a thread of its own, while OpenGL draws the view (and the switch to it); the
@@ -192,7 +218,7 @@ void SurroundStage::prepare(PipelineOutputs& outputs, bool waitForTables) {
   }
   const auto eachFirstView = [&] {
     for (auto& output : outputs.pictures()) {
-      if (output.view && output.sink) (void)fixedView(*output.view);
+      if (output.view && output.sink) (void)fixedViewFor(output);
     }
   };
   eachFirstView();  // starts the tables
@@ -252,7 +278,7 @@ bool SurroundStage::needsPanorama(const FrameWork& work) {
     if (output.picture == &panorama_ && output.sink) return true;
     if (!output.view || !output.sink || gpuSet) continue;
     // A view with a read-back pending is mapped after it is collected, in process().
-    if (output.view->pending() || fixedView(*output.view) == nullptr) return true;
+    if (output.view->pending() || fixedViewFor(output) == nullptr) return true;
   }
   panoramaSkipped_ = true;
   return false;
@@ -309,7 +335,7 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
     if (!output.view || !output.sink) continue;
     const bool wanted = output.sink->wantsFrame(work.streamTime);
     work.outputs.guarded(output, [&] {
-      if (FixedView* fixed = fixedView(*output.view)) {
+      if (FixedView* fixed = fixedViewFor(output)) {
         // Without a panorama this set, also when not wanted: the run's end hands over the last
         // set's picture, and there is no panorama to draw it from.
         if (!wanted && !panoramaSkipped_) return;
@@ -352,7 +378,14 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
           cameraUploaded = true;
         }
       }
-      output.view->draw(std::chrono::duration<double>(work.streamTime).count());
+      const double timeS = std::chrono::duration<double>(work.streamTime).count();
+      if (output.sink->presentsViews()) {
+        // Shown at once: on a GPU the swap only queues the picture's copy to the screen.
+        output.view->draw(timeS, render::SurroundView::ReadBack::kNo);
+        work.outputs.present(output, work.streamTime, work.origin, output.view->drawn());
+        return;
+      }
+      output.view->draw(timeS);
       output.pendingTime = work.streamTime;
       output.pendingOrigin = work.origin;
     });

@@ -117,6 +117,8 @@ class SurroundStage final : public PipelineStage {
   std::string description() const {
     return gpu_ ? gl_->description() + "; panorama stitched on the GPU" : gl_->description();
   }
+  // The renderer's context, current on the stage's thread: for outputs that show views on the GPU.
+  render::EglContext& context() { return *gl_; }
   // Whether the GPU stitches the panorama (processing.backend as it came out on this renderer).
   bool stitchesOnGpu() const { return gpu_ != nullptr; }
   // The GPU's own time of each run of its steps so far (render/gpu_timer.hpp), read a set or two
@@ -159,6 +161,8 @@ class SurroundStage final : public PipelineStage {
   // and the switch to it has ended, for a view that moves, with render.view_lut off, on the GPU
   // backend, or where the renderer cannot map views (said once).
   FixedView* fixedView(render::SurroundView& view);
+  // The output's fixed view, as fixedView(); none for a sink that shows the view on the GPU.
+  FixedView* fixedViewFor(PipelineOutputs::PictureOutput& output);
   // Maps the view onto the panorama (OpenGL, here), then has the panorama stage build its table.
   void startFixedView(render::SurroundView& view, FixedView& fixed);
   // Whether the GPU stitches this set: the GPU backend, and no camera faulty.

@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cstdint>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -20,6 +21,8 @@
 #include "render/outputs/view_page.hpp"
 
 namespace surroundd::render {
+
+class SurroundView;
 
 // When a picture's frame set was taken. A stream time alone converts: its capture time is then
 // unknown (a test's picture, a replay's last frame).
@@ -55,6 +58,14 @@ class FrameSink {
   // Whether its pictures may come in I420 (an H.264 encoder's own format), sparing it the
   // conversion. A picture made another way (drawn by OpenGL) still comes in BGR.
   virtual bool takesI420() const { return false; }
+  // Whether it shows a surround view as OpenGL drew it, on the GPU, with no picture read back (a
+  // window through EGL): the pipeline then hands it present() instead of consume(), on the
+  // renderer's thread.
+  virtual bool presentsViews() const { return false; }
+  // Shows `view`'s picture, just drawn (SurroundView::ReadBack::kNo). Throws as consume().
+  virtual void present(const SurroundView& /*view*/, const PictureTime& /*time*/) {
+    throw std::logic_error("this output shows no views on the GPU");
+  }
   // Whether the frame at `streamTime` is needed: the pipeline skips making pictures (renders) that
   // no sink wants.
   virtual bool wantsFrame(std::chrono::nanoseconds /*streamTime*/) const { return true; }

@@ -131,6 +131,21 @@ bool X11Observer::exists(unsigned long window) const {
   return found;
 }
 
+unsigned long X11Observer::windowTitled(const std::string& wanted) const {
+  Display* x = display_->get();
+  ::Window root = 0;
+  ::Window parent = 0;
+  ::Window* children = nullptr;
+  unsigned count = 0;
+  XQueryTree(x, DefaultRootWindow(x), &root, &parent, &children, &count);
+  display_->sync("listing the windows");
+  const std::span<::Window> list(children, count);
+  const auto found = std::ranges::find_if(list, [&](::Window w) { return title(w) == wanted; });
+  const unsigned long window = found != list.end() ? *found : 0;
+  if (children != nullptr) XFree(children);
+  return window;
+}
+
 std::string X11Observer::title(unsigned long window) const {
   Display* x = display_->get();
   Atom type = 0;

@@ -52,6 +52,8 @@ class X11Observer {
   // What the window shows on the screen, as 8-bit BGR.
   cv::Mat contents(unsigned long window) const;
   bool exists(unsigned long window) const;
+  // The top-level window titled `title` (_NET_WM_NAME); 0 if none is.
+  unsigned long windowTitled(const std::string& title) const;
   // The window's title (_NET_WM_NAME).
   std::string title(unsigned long window) const;
   // What a window manager sends when the user clicks the window's close button.

@@ -5,7 +5,7 @@
 //   surround-bench colour [--threads N] [--repeats N] [--pictures DIR] RECORDING|CONFIG...
 //   surround-bench pipeline [--threads N] [--repeats N] [--json] [--solver S] [--projection P]
 //                           [--view V] [--size WxH] [--input decode|raw] [--raw-format F]
-//                           [--backend B] RECORDING...
+//                           [--backend B] [--output O] RECORDING...
 //   surround-bench receive [--transport udp|tcp] [--seconds N] [--save PICTURE] URL
 //   surround-bench gpu-kit KIT RECORDING...
 //
@@ -35,7 +35,7 @@ constexpr std::string_view kUsage =
        surround-bench colour [--threads N] [--repeats N] [--pictures DIR] RECORDING|CONFIG...
        surround-bench pipeline [--threads N] [--repeats N] [--json] [--solver S]
                                [--projection P] [--view V] [--size WxH] [--input I]
-                               [--raw-format F] [--backend B] RECORDING...
+                               [--raw-format F] [--backend B] [--output O] RECORDING...
        surround-bench receive [--transport T] [--seconds N] [--save PICTURE] URL
        surround-bench gpu-kit KIT RECORDING...
   stitch        LUT build, stitch against cv::remap, accuracy against the ground truth
@@ -67,6 +67,9 @@ constexpr std::string_view kUsage =
   --raw-format F  pipeline, --input raw: yuyv | uyvy | nv12 (default yuyv)
   --backend B   pipeline: where the panorama is made, as processing.backend: auto | cpu | gpu
                 (default auto: the CPU on a software renderer such as llvmpipe)
+  --output O    pipeline: where the view goes: video (H.264, the default) | window (an X
+                window on $DISPLAY, each picture read back) | egl-window (the window shown on
+                the GPU through EGL, nothing read back)
   --pictures DIR  colour, CONFIG: also write the panoramas (none, gain, Poisson) and body masks
   URL           receive: rtsp://HOST:PORT/NAME (an rtsp output) or udp://HOST:PORT (a network
                 output's address, bound here)
@@ -226,6 +229,14 @@ int main(int argc, char** argv) {
                                                                 {"gpu", ProcessingBackend::kGpu}});
       if (!backend) return usageError("--backend needs auto, cpu or gpu");
       pipeline.backend = *backend;
+      ++i;
+    } else if (command == "pipeline" && arg == "--output") {
+      using surroundd::bench::BenchOutput;
+      const auto output = parseWord<BenchOutput>(value, {{"video", BenchOutput::kVideo},
+                                                         {"window", BenchOutput::kWindow},
+                                                         {"egl-window", BenchOutput::kEglWindow}});
+      if (!output) return usageError("--output needs video, window or egl-window");
+      pipeline.output = *output;
       ++i;
     } else if (command == "colour" && arg == "--pictures") {
       if (!hasValue) return usageError("--pictures needs a folder");

@@ -106,11 +106,17 @@ daemon::Config configFor(const std::filesystem::path& folder, const RecordingTru
   config.processing.backend = options.backend;
   config.render.widthPx = options.outputSize.width;
   config.render.heightPx = options.outputSize.height;
-  daemon::OutputConfig video;
-  video.stream = daemon::OutputStream::kSurround;
-  video.path = scratch / "surround.mp4";
-  video.preset = "ultrafast";
-  config.outputs = {video};
+  daemon::OutputConfig output;
+  output.stream = daemon::OutputStream::kSurround;
+  if (options.output == BenchOutput::kVideo) {
+    output.path = scratch / "surround.mp4";
+    output.preset = "ultrafast";
+  } else {
+    output.kind = daemon::OutputKind::kWindow;
+    output.present = options.output == BenchOutput::kEglWindow ? daemon::WindowPresent::kEgl
+                                                               : daemon::WindowPresent::kPicture;
+  }
+  config.outputs = {output};
   return config;
 }
 

@@ -28,6 +28,10 @@ namespace surroundd::bench {
 
 enum class BenchInput { kDecode, kRaw };
 
+// Where the surround view goes: an H.264 file, or a window on $DISPLAY given each picture read
+// back (`window`, present: picture) or shown on the GPU (`egl-window`, present: egl).
+enum class BenchOutput { kVideo, kWindow, kEglWindow };
+
 struct PipelineBenchmarkOptions {
   std::vector<std::filesystem::path> recordings;
   BenchInput input = BenchInput::kDecode;
@@ -40,6 +44,7 @@ struct PipelineBenchmarkOptions {
   render::ViewKind view = render::ViewKind::kOrbit;
   cv::Size outputSize{1280, 720};
   daemon::ProcessingBackend backend = daemon::ProcessingBackend::kAuto;
+  BenchOutput output = BenchOutput::kVideo;
 };
 
 int runPipelineBenchmark(const PipelineBenchmarkOptions& options);

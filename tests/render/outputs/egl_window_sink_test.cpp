@@ -4,7 +4,7 @@
 // renderer goes on drawing; a renderer off the X server, a view of another size and a missing
 // display are named.
 
-#include "render/outputs/egl_window.hpp"
+#include "render/outputs/egl_window_sink.hpp"
 
 #include <memory>
 
@@ -14,6 +14,8 @@
 #include "processing/surround_mesh.hpp"
 #include "render/outputs/xlib_display.hpp"  // after every other header: Xlib's macros
 #include "render/render_error.hpp"
+#include "render/surround_scene.hpp"
+#include "render/surround_view.hpp"
 #include "tests/support/test_support.hpp"
 #include "tests/support/x11_test_server.hpp"
 
@@ -40,9 +42,8 @@ ViewSettings cutting() {
   return settings;
 }
 
-// The display is the renderer's connection's.
-X11WindowSettings windowSettings() {
-  return {.display = "", .title = "surroundd EGL test", .size = viewSize()};
+X11WindowSettings windowSettings(const std::string& display) {
+  return {.display = display, .title = "surroundd EGL test", .size = viewSize()};
 }
 
 // A renderer on its own X server: the connection, the context on it, and an orbit view of a
@@ -70,6 +71,16 @@ class EglRenderer {
     view_->draw(timeS);
     return view_->collect().clone();
   }
+  // The view at `timeS`, drawn and shown by `sink`, not read back; on the screen when this
+  // returns (the swap's requests go through the renderer's connection).
+  void show(EglWindowSink& sink, double timeS) {
+    view_->draw(timeS, SurroundView::ReadBack::kNo);
+    sink.present(*view_, std::chrono::duration_cast<std::chrono::nanoseconds>(
+                             std::chrono::duration<double>(timeS)));
+    EXPECT_FALSE(view_->pending());
+    display_->sync("waiting for the picture");
+  }
+  X11WindowSettings windowSettings() const { return render::windowSettings(server_.display()); }
 
   testing::XvfbServer server_;
   std::unique_ptr<XlibDisplay> display_;
@@ -80,75 +91,76 @@ class EglRenderer {
 
 double maxDifference(const cv::Mat& a, const cv::Mat& b) { return cv::norm(a, b, cv::NORM_INF); }
 
-TEST(EglWindow, ShowsTheViewAsItsReadBackPictureIs) {
+TEST(EglWindowSink, ShowsTheViewAsItsReadBackPictureIs) {
   EglRenderer renderer;
   const testing::X11Observer observer(renderer.server_.display());
-  EglWindow window(*renderer.gl_, *renderer.display_, windowSettings());
-  ASSERT_TRUE(window.open());
-  EXPECT_EQ(observer.title(window.windowId()), "surroundd EGL test");
+  EglWindowSink sink(*renderer.gl_, renderer.windowSettings());
+  EXPECT_TRUE(sink.presentsViews());
+  EXPECT_TRUE(sink.wantsFrame(std::chrono::nanoseconds(0)));
+  EXPECT_EQ(observer.title(sink.windowId()), "surroundd EGL test");
 
   const cv::Mat first = renderer.draw(0.0);
-  ASSERT_TRUE(window.present(*renderer.view_));
-  EXPECT_EQ(maxDifference(observer.contents(window.windowId()), first), 0);
+  renderer.show(sink, 0.0);
+  EXPECT_EQ(maxDifference(observer.contents(sink.windowId()), first), 0);
 
   const cv::Mat second = renderer.draw(2.5);
   ASSERT_GT(maxDifference(first, second), 100) << "the orbiting eye moved";
-  ASSERT_TRUE(window.present(*renderer.view_));
-  EXPECT_EQ(maxDifference(observer.contents(window.windowId()), second), 0);
-  EXPECT_EQ(window.framesShown(), 2U);
-  EXPECT_THAT(window.describe(), HasSubstr("(2 frames)"));
+  renderer.show(sink, 2.5);
+  EXPECT_EQ(maxDifference(observer.contents(sink.windowId()), second), 0);
+  EXPECT_EQ(sink.framesShown(), 2U);
+  EXPECT_THAT(sink.describe(), HasSubstr("(2 frames)"));
 }
 
-TEST(EglWindow, StopsWhenTheUserClosesItAndTheRendererGoesOn) {
+TEST(EglWindowSink, StopsWhenTheUserClosesItAndTheRendererGoesOn) {
   EglRenderer renderer;
   const testing::X11Observer observer(renderer.server_.display());
-  EglWindow window(*renderer.gl_, *renderer.display_, windowSettings());
+  EglWindowSink sink(*renderer.gl_, renderer.windowSettings());
   const cv::Mat picture = renderer.draw(1.0);
-  ASSERT_TRUE(window.present(*renderer.view_));
-  const unsigned long id = window.windowId();
+  renderer.show(sink, 1.0);
+  const unsigned long id = sink.windowId();
 
   observer.sendDeleteWindow(id);
-  EXPECT_FALSE(window.present(*renderer.view_));
-  EXPECT_FALSE(window.open());
+  EXPECT_FALSE(sink.wantsFrame(std::chrono::nanoseconds(0)));
   EXPECT_FALSE(observer.exists(id));
-  EXPECT_THAT(window.describe(), HasSubstr("(1 frames; closed by the user)"));
+  renderer.show(sink, 1.0);
+  EXPECT_THAT(sink.describe(), HasSubstr("(1 frames; closed by the user)"));
   EXPECT_EQ(maxDifference(renderer.draw(1.0), picture), 0);
 }
 
-TEST(EglWindow, StopsWhenTheServerGoesAwayAndTheRendererGoesOn) {
+TEST(EglWindowSink, StopsWhenTheServerGoesAwayAndTheRendererGoesOn) {
   EglRenderer renderer;
-  EglWindow window(*renderer.gl_, *renderer.display_, windowSettings());
+  EglWindowSink sink(*renderer.gl_, renderer.windowSettings());
   const cv::Mat picture = renderer.draw(1.0);
-  ASSERT_TRUE(window.present(*renderer.view_));
+  renderer.show(sink, 1.0);
 
   renderer.server_.stop();
-  EXPECT_FALSE(window.present(*renderer.view_));
-  EXPECT_EQ(window.windowId(), 0U);
-  EXPECT_THAT(window.describe(), HasSubstr("(1 frames; the display went away)"));
+  renderer.show(sink, 1.0);
+  EXPECT_FALSE(sink.wantsFrame(std::chrono::nanoseconds(0)));
+  EXPECT_EQ(sink.windowId(), 0U);
+  EXPECT_THAT(sink.describe(), HasSubstr("(1 frames; the display went away)"));
   // The context draws into its framebuffers without the server.
   EXPECT_EQ(maxDifference(renderer.draw(1.0), picture), 0);
-  EXPECT_FALSE(window.present(*renderer.view_));
 }
 
-TEST(EglWindow, RefusesAViewOfAnotherSize) {
+TEST(EglWindowSink, RefusesAViewOfAnotherSizeAndPictures) {
   EglRenderer renderer;
-  EglWindow window(*renderer.gl_, *renderer.display_, windowSettings());
+  EglWindowSink sink(*renderer.gl_, renderer.windowSettings());
   const SurroundView other(*renderer.scene_, {320, 200}, ViewKind::kTop, cutting());
   EXPECT_THAT(
-      [&] { window.present(other); },
+      [&] { sink.present(other, std::chrono::nanoseconds(0)); },
       ::testing::ThrowsMessage<RenderError>(HasSubstr("the view is 320x200, the window 322x202")));
+  EXPECT_THAT([&] { sink.consume(renderer.draw(0), std::chrono::nanoseconds(0)); },
+              ::testing::ThrowsMessage<RenderError>(HasSubstr("not pictures")));
 }
 
-TEST(EglWindow, NeedsTheRenderersContextOnTheXServer) {
+TEST(EglWindowSink, NeedsTheRenderersContextOnTheXServer) {
   const testing::XvfbServer server;
-  XlibDisplay display(server.display());
-  const EglContext headless(EglPlatform::kSurfaceless);
-  EXPECT_THAT(
-      [&] { EglWindow window(const_cast<EglContext&>(headless), display, windowSettings()); },
-      ::testing::ThrowsMessage<RenderError>(
-          HasSubstr("the renderer's context is on the surfaceless platform, not on the X "
-                    "server's")));
-  EXPECT_THAT([] { EglContext gl(EglPlatform::kX11); },
+  EglContext headless(EglPlatform::kSurfaceless);
+  EXPECT_THAT([&] { const EglWindowSink sink(headless, windowSettings(server.display())); },
+              ::testing::ThrowsMessage<RenderError>(
+                  HasSubstr("the renderer's context is on the surfaceless platform, not on an X "
+                            "server's")));
+  EXPECT_THAT([] { const EglContext gl(EglPlatform::kX11); },
               ::testing::ThrowsMessage<RenderError>(HasSubstr("x11: no X display given")));
 }
 
