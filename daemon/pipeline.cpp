@@ -295,6 +295,12 @@ void Pipeline::process(const capture::FrameSet& set) {
   times_.endSet();
 }
 
+cv::Mat Pipeline::latestPicture() {
+  return outputs_.latestPicture([&](PipelineOutputs::PictureOutput& output) {
+    return firstTimestamp_ ? surround_->redraw(output) : cv::Mat();
+  });
+}
+
 void Pipeline::finish(RunSummary& summary) {
   for (auto& camera : cameras_) camera->stop();
   for (const auto& stage : stages_) stage->finish(outputs_);

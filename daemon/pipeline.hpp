@@ -113,8 +113,9 @@ class Pipeline {
   // retried (PipelineOutputs).
   bool outputsWork() const { return outputs_.anyWorks(); }
   // The newest picture handed to the first output that shows pictures (a surround view if there
-  // is one); a header over the pipeline's buffer, valid until the next frame set. Empty before.
-  cv::Mat latestPicture() const { return outputs_.latestPicture(); }
+  // is one; one shown on the GPU is read back now); a header over the pipeline's buffer, valid
+  // until the next frame set. Empty before.
+  cv::Mat latestPicture();
 
  private:
   using Clock = std::chrono::steady_clock;

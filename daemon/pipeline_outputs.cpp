@@ -214,11 +214,13 @@ bool PipelineOutputs::anyWorks() const {
          std::ranges::any_of(recordings_, [](const auto& r) { return r != nullptr; });
 }
 
-cv::Mat PipelineOutputs::latestPicture() const {
+cv::Mat PipelineOutputs::latestPicture(
+    const std::function<cv::Mat(PictureOutput&)>& readBack) {
   const auto shown = [](const PictureOutput& o) { return !o.latest.empty(); };
-  const auto surround =
-      std::ranges::find_if(pictures_, [&](const PictureOutput& o) { return o.view && shown(o); });
-  if (surround != pictures_.end()) return surround->latest;
+  const auto onGpu = [](const PictureOutput& o) { return o.sink && o.sink->presentsViews(); };
+  const auto surround = std::ranges::find_if(
+      pictures_, [&](const PictureOutput& o) { return o.view && (shown(o) || onGpu(o)); });
+  if (surround != pictures_.end()) return shown(*surround) ? surround->latest : readBack(*surround);
   const auto any = std::ranges::find_if(pictures_, shown);
   return any != pictures_.end() ? any->latest : cv::Mat();
 }

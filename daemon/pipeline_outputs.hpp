@@ -110,8 +110,10 @@ class PipelineOutputs {
   // Whether any output works: with none, the run records nothing (a full disk).
   bool anyWorks() const;
   // The newest picture handed to the first output that shows one (a surround view if any), in
-  // BGR; a header over the pipeline's buffer, valid until the next frame set. Empty before.
-  cv::Mat latestPicture() const;
+  // BGR; a header over the pipeline's buffer, valid until the next frame set. Empty before. A
+  // surround view shown on the GPU (FrameSink::presentsViews()) has none: `readBack(output)`
+  // gives it.
+  cv::Mat latestPicture(const std::function<cv::Mat(PictureOutput&)>& readBack);
   std::size_t count() const { return pictures_.size() + recordings_.size(); }
   std::uint64_t failures() const { return failures_; }
   std::uint64_t dropped() const;  // pictures outputs dropped because they fell behind

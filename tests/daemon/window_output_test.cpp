@@ -1,7 +1,8 @@
 // The `window` output with `present: egl`, through the pipeline on a generated recording and an
 // Xvfb server of the test's own: the renderer opens on the window's X server and the window shows
 // each set's surround view as OpenGL drew it, with no read-back — at the end, exactly the last
-// picture that a lossless video of the same view holds. And the config's rules for it.
+// picture that a lossless video of the same view holds, and what a snapshot reads back. And the
+// config's rules for it.
 
 #include <atomic>
 #include <string>
@@ -62,6 +63,8 @@ TEST(WindowOutput, AnEglWindowShowsEachSetsViewAsALosslessVideoOfItHasIt) {
   ASSERT_EQ(frames.size(), summary.frameSets);
   EXPECT_LE(cv::norm(observer.contents(shown), frames.back(), cv::NORM_INF), 1);
   EXPECT_GT(cv::norm(frames.front(), frames.back(), cv::NORM_INF), 100) << "the eye orbits";
+  // A snapshot (surroundctl snapshot) reads the window's view back when asked for.
+  EXPECT_LE(cv::norm(pipeline.latestPicture(), frames.back(), cv::NORM_INF), 1);
 }
 
 TEST_F(ConfigTest, AnEglWindowShowsTheSurroundViewOnOneXServer) {
