@@ -80,10 +80,11 @@ if [ "$sanitizers" = yes ]; then
   end "asan suite"
 
   # Threads: the work pool, capture (camera streams, the synchronizer, camera health), every test
-  # that runs the pipeline (replays, faults, recordings, output files and retries, its report), the
-  # output queue and HTTP server, the control server and the whole service. Left out: the
-  # libcamera test (no camera here: it only checks a message, and libcamera's own threads are not
-  # instrumented), the v4l2loopback test (skipped without the kernel module) and the RTSP tests:
+  # that runs the pipeline (replays, faults, recordings, output files and retries, its report, an
+  # egl window), the output queue and HTTP server, the control server and the whole service.
+  # Left out: the libcamera test (no camera here: it only checks a message, and libcamera's own
+  # threads are not instrumented), the v4l2loopback test (skipped without the kernel module) and
+  # the RTSP tests:
   # GLib and GStreamer hand work between their threads and ours through their own futex-based
   # locks, which TSan cannot see, so every hand-over (a source given to the server's main loop, a
   # buffer to its pipeline) is reported as a race inside GLib; what the RTSP sink itself shares
@@ -93,7 +94,7 @@ if [ "$sanitizers" = yes ]; then
     http_stream_sink_test replay_test preload_replay_test
     processing_backend_test fault_replay_test fault_isolation_test output_retry_test
     output_files_test recording_test still_rig_test pipeline_report_test control_server_test
-    service_notifier_test service_test end_to_end_test"
+    service_notifier_test service_test end_to_end_test window_output_test"
   begin "tsan build"
   # Only these tests and the programs they run are built; their recordings are made by the ci
   # build's generator too, so it need not be built a third time.

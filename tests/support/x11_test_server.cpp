@@ -8,6 +8,7 @@
 #include <span>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 #include <fcntl.h>
 #include <fmt/format.h>
@@ -117,7 +118,7 @@ cv::Mat X11Observer::contents(unsigned long window) const {
   return bgr;
 }
 
-bool X11Observer::exists(unsigned long window) const {
+std::vector<unsigned long> X11Observer::topLevelWindows() const {
   Display* x = display_->get();
   ::Window root = 0;
   ::Window parent = 0;
@@ -126,24 +127,21 @@ bool X11Observer::exists(unsigned long window) const {
   XQueryTree(x, DefaultRootWindow(x), &root, &parent, &children, &count);
   display_->sync("listing the windows");
   const std::span<::Window> list(children, count);
-  const bool found = std::ranges::find(list, window) != list.end();
+  std::vector<unsigned long> windows(list.begin(), list.end());
   if (children != nullptr) XFree(children);
-  return found;
+  return windows;
+}
+
+bool X11Observer::exists(unsigned long window) const {
+  const std::vector<unsigned long> windows = topLevelWindows();
+  return std::ranges::find(windows, window) != windows.end();
 }
 
 unsigned long X11Observer::windowTitled(const std::string& wanted) const {
-  Display* x = display_->get();
-  ::Window root = 0;
-  ::Window parent = 0;
-  ::Window* children = nullptr;
-  unsigned count = 0;
-  XQueryTree(x, DefaultRootWindow(x), &root, &parent, &children, &count);
-  display_->sync("listing the windows");
-  const std::span<::Window> list(children, count);
-  const auto found = std::ranges::find_if(list, [&](::Window w) { return title(w) == wanted; });
-  const unsigned long window = found != list.end() ? *found : 0;
-  if (children != nullptr) XFree(children);
-  return window;
+  for (const unsigned long window : topLevelWindows()) {
+    if (title(window) == wanted) return window;
+  }
+  return 0;
 }
 
 std::string X11Observer::title(unsigned long window) const {

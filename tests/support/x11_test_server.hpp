@@ -63,6 +63,8 @@ class X11Observer {
   void uncover();
 
  private:
+  std::vector<unsigned long> topLevelWindows() const;
+
   std::unique_ptr<render::XlibDisplay> display_;
   unsigned long cover_ = 0;
 };

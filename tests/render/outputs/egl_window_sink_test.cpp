@@ -29,19 +29,6 @@ constexpr int kWidth = 322;
 constexpr int kHeight = 202;
 cv::Size viewSize() { return {kWidth, kHeight}; }
 
-processing::PanoramaGeometry testPanorama() {
-  processing::PanoramaGeometry geometry;
-  geometry.size = {1024, 512};
-  geometry.centre = {0, 0, 1.9};
-  return geometry;
-}
-
-ViewSettings cutting() {
-  ViewSettings settings;
-  settings.transitionS = 0;
-  return settings;
-}
-
 X11WindowSettings windowSettings(const std::string& display) {
   return {.display = display, .title = "surroundd EGL test", .size = viewSize()};
 }
@@ -54,10 +41,12 @@ class EglRenderer {
       : display_(std::make_unique<XlibDisplay>(server_.display())),
         gl_(std::make_unique<EglContext>(EglPlatform::kX11, display_->get())),
         scene_(std::make_unique<SurroundScene>(
-            processing::buildSurroundMesh(processing::MeshSettings{}, testPanorama()),
-            testPanorama(), CarDimensions{}, cv::Size{320, 180})),
-        view_(std::make_unique<SurroundView>(*scene_, viewSize(), ViewKind::kOrbit, cutting())) {
-    scene_->uploadPanorama(testing::syntheticPicture(testPanorama().size, 5));
+            processing::buildSurroundMesh(processing::MeshSettings{},
+                                          processing::PanoramaGeometry{}),
+            processing::PanoramaGeometry{}, CarDimensions{}, cv::Size{320, 180})),
+        view_(
+            std::make_unique<SurroundView>(*scene_, viewSize(), ViewKind::kOrbit, ViewSettings{})) {
+    scene_->uploadPanorama(testing::syntheticPicture(processing::PanoramaGeometry{}.size, 5));
   }
   ~EglRenderer() {
     view_.reset();
@@ -145,7 +134,7 @@ TEST(EglWindowSink, StopsWhenTheServerGoesAwayAndTheRendererGoesOn) {
 TEST(EglWindowSink, RefusesAViewOfAnotherSizeAndPictures) {
   EglRenderer renderer;
   EglWindowSink sink(*renderer.gl_, renderer.windowSettings());
-  const SurroundView other(*renderer.scene_, {320, 200}, ViewKind::kTop, cutting());
+  const SurroundView other(*renderer.scene_, {320, 200}, ViewKind::kTop, ViewSettings{});
   EXPECT_THAT(
       [&] { sink.present(other, std::chrono::nanoseconds(0)); },
       ::testing::ThrowsMessage<RenderError>(HasSubstr("the view is 320x200, the window 322x202")));
