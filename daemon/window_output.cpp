@@ -26,6 +26,12 @@ std::unique_ptr<render::FrameSink> openWindow(const OutputConfig& output,
   if (context.renderer == nullptr) {
     throw render::RenderError("an egl window shows the surround view, and there is no renderer");
   }
+  if (context.renderer->platform() != render::EglPlatform::kX11) {
+    throw render::RenderError(fmt::format(
+        "window on {}: present: egl needs the renderer on this X server, which it could not be "
+        "opened on (the log's render line says why)",
+        output.display.empty() ? "$DISPLAY" : output.display));
+  }
   return std::make_unique<render::EglWindowSink>(*context.renderer, std::move(settings));
 }
 

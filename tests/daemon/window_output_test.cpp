@@ -22,6 +22,7 @@
 namespace surroundd::daemon {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::Contains;
 using ::testing::HasSubstr;
 
@@ -65,6 +66,22 @@ TEST(WindowOutput, AnEglWindowShowsEachSetsViewAsALosslessVideoOfItHasIt) {
   EXPECT_GT(cv::norm(frames.front(), frames.back(), cv::NORM_INF), 100) << "the eye orbits";
   // A snapshot (surroundctl snapshot) reads the window's view back when asked for.
   EXPECT_LE(cv::norm(pipeline.latestPicture(), frames.back(), cv::NORM_INF), 1);
+}
+
+TEST(WindowOutput, AnEglWindowOnAServerThatCannotBeReachedIsNamed) {
+  OutputConfig window;
+  window.kind = OutputKind::kWindow;
+  window.stream = OutputStream::kSurround;
+  window.display = ":97";
+  window.present = WindowPresent::kEgl;
+  const Config config = fixtureReplay("synth_small", {window});
+  const testing::LogCapture capture;
+  EXPECT_THAT([&] { const Pipeline pipeline(config); },
+              ::testing::ThrowsMessage<std::runtime_error>(
+                  HasSubstr("window on :97: present: egl needs the renderer on this X server")));
+  EXPECT_THAT(capture.lines(),
+              Contains(AllOf(HasSubstr("the window output cannot have the renderer"),
+                             HasSubstr("cannot open display ':97'"))));
 }
 
 TEST_F(ConfigTest, AnEglWindowShowsTheSurroundViewOnOneXServer) {
