@@ -7,8 +7,10 @@
 #include "daemon/built_in_outputs.hpp"
 #include "render/outputs/egl_window_sink.hpp"
 #include "render/outputs/x11_window_sink.hpp"
-#include "render/outputs/xlib_display.hpp"  // after every other header: Xlib's macros
 #include "render/render_error.hpp"
+
+// After every other header: Xlib's macros.
+#include "render/outputs/xlib_display.hpp"
 
 namespace surroundd::daemon {
 namespace {

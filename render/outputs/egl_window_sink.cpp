@@ -8,9 +8,11 @@
 #include <fmt/format.h>
 
 #include "render/gl_objects.hpp"
-#include "render/outputs/xlib_window.hpp"  // after every other header: Xlib's macros
 #include "render/render_error.hpp"
 #include "render/surround_view.hpp"
+
+// After every other header: Xlib's macros.
+#include "render/outputs/xlib_window.hpp"
 
 namespace surroundd::render {
 namespace {

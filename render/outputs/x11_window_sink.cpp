@@ -7,10 +7,12 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
-#include "render/outputs/xlib_display.hpp"  // after every other header: Xlib's macros
+#include "render/render_error.hpp"
+
+// After every other header: Xlib's macros.
+#include "render/outputs/xlib_display.hpp"
 #include "render/outputs/xlib_image.hpp"
 #include "render/outputs/xlib_window.hpp"
-#include "render/render_error.hpp"
 
 namespace surroundd::render {
 namespace {

@@ -1,5 +1,3 @@
-#include "render/outputs/xlib_window.hpp"  // after every other header: Xlib's macros
-
 #include <chrono>
 #include <utility>
 
@@ -7,6 +5,9 @@
 #include <poll.h>
 
 #include "render/render_error.hpp"
+
+// After every other header: Xlib's macros.
+#include "render/outputs/xlib_window.hpp"
 
 namespace surroundd::render {
 namespace {

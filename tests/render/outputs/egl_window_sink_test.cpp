@@ -12,12 +12,14 @@
 #include <gtest/gtest.h>
 
 #include "processing/surround_mesh.hpp"
-#include "render/outputs/xlib_display.hpp"  // after every other header: Xlib's macros
 #include "render/render_error.hpp"
 #include "render/surround_scene.hpp"
 #include "render/surround_view.hpp"
 #include "tests/support/test_support.hpp"
 #include "tests/support/x11_test_server.hpp"
+
+// After every other header: Xlib's macros.
+#include "render/outputs/xlib_display.hpp"
 
 namespace surroundd::render {
 namespace {
