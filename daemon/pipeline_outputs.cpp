@@ -214,8 +214,7 @@ bool PipelineOutputs::anyWorks() const {
          std::ranges::any_of(recordings_, [](const auto& r) { return r != nullptr; });
 }
 
-cv::Mat PipelineOutputs::latestPicture(
-    const std::function<cv::Mat(PictureOutput&)>& readBack) {
+cv::Mat PipelineOutputs::latestPicture(const std::function<cv::Mat(PictureOutput&)>& readBack) {
   const auto shown = [](const PictureOutput& o) { return !o.latest.empty(); };
   const auto onGpu = [](const PictureOutput& o) { return o.sink && o.sink->presentsViews(); };
   const auto surround = std::ranges::find_if(
