@@ -3,6 +3,7 @@
 // `present: egl` (render::EglWindowSink) it shows the surround view as OpenGL drew it, on the
 // renderer's thread, through EGL: the renderer's context is then made on the window's X server.
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include "daemon/built_in_outputs.hpp"
 #include "render/outputs/egl_window_sink.hpp"
@@ -33,6 +34,12 @@ std::unique_ptr<render::FrameSink> openWindow(const OutputConfig& output,
         "window on {}: present: egl needs the renderer on this X server, which it could not be "
         "opened on (the log's render line says why)",
         output.display.empty() ? "$DISPLAY" : output.display));
+  }
+  if (context.renderer->software()) {
+    spdlog::warn(
+        "window on {}: present: egl on a renderer that runs on the CPU, whose swap "
+        "copies each picture on the renderer's thread; present: picture is faster here",
+        output.display.empty() ? "$DISPLAY" : output.display);
   }
   return std::make_unique<render::EglWindowSink>(*context.renderer, std::move(settings));
 }

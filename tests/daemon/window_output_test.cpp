@@ -53,6 +53,7 @@ TEST(WindowOutput, AnEglWindowShowsEachSetsViewAsALosslessVideoOfItHasIt) {
 
   EXPECT_THAT(log, Contains(HasSubstr("render: on the X server of the window output")));
   EXPECT_THAT(log, Contains(HasSubstr("render: x11: llvmpipe")));
+  EXPECT_THAT(log, Contains(HasSubstr("present: egl on a renderer that runs on the CPU")));
   ASSERT_GT(summary.frameSets, 5U);
   EXPECT_EQ(summary.failedOutputs, 0U);
   EXPECT_THAT(summary.outputs, Contains(fmt::format("EGL window on {} ({} frames)",
