@@ -308,7 +308,8 @@ void Pipeline::finish(RunSummary& summary) {
   outputs_.finish(
       lastStreamTime_,
       [&](PipelineOutputs::PictureOutput& output) {
-        if (!firstTimestamp_) return cv::Mat();
+        // A view shown on the GPU keeps its last picture: none is read back for it.
+        if (!firstTimestamp_ || (output.sink && output.sink->presentsViews())) return cv::Mat();
         return output.view ? surround_->redraw(output) : *output.picture;
       },
       summary.outputs);

@@ -172,18 +172,10 @@ bool EglContext::open(EglPlatform platform, void* nativeDisplay, std::string& wh
   }
   const std::array<EGLint, 13> configAttributes{
       EGL_SURFACE_TYPE,
-      platform == EglPlatform::kX11 ? EGL_WINDOW_BIT : EGL_PBUFFER_BIT,
-      EGL_RENDERABLE_TYPE,
-      EGL_OPENGL_ES3_BIT,
-      EGL_RED_SIZE,
-      8,
-      EGL_GREEN_SIZE,
-      8,
-      EGL_BLUE_SIZE,
-      8,
-      EGL_ALPHA_SIZE,
-      8,
-      EGL_NONE};
+      // On X11 also windows; a pbuffer stays possible for drivers without surfaceless contexts.
+      platform == EglPlatform::kX11 ? EGL_WINDOW_BIT | EGL_PBUFFER_BIT : EGL_PBUFFER_BIT,
+      EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT, EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8, EGL_BLUE_SIZE, 8,
+      EGL_ALPHA_SIZE, 8, EGL_NONE};
   EGLint configs = 0;
   if (eglChooseConfig(display_, configAttributes.data(), &config_, 1, &configs) != EGL_TRUE ||
       configs == 0) {

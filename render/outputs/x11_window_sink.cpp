@@ -35,7 +35,7 @@ struct GcDeleter {
 }  // namespace
 
 // The X connection, the window and the picture it shows. The picture and GC are made once the
-// window is (and freed when it closes, before it): declared before it, so that they are there,
+// window is, and freed just before it when it closes; declared before it, so that they are there,
 // empty, should it close while it opens.
 class X11WindowSink::ShownWindow {
  public:
