@@ -33,7 +33,9 @@ end() { timings="$timings
   $1: $(($(date +%s) - phase_start)) s"; }
 
 begin "dependencies"
-scripts/install-deps.sh
+# With what runs the display tests on a virtual machine's screen, and Debian's kernel for it.
+scripts/install-deps.sh --kms-vm
+scripts/kms-vm.sh fetch
 end "dependencies"
 begin "ci build"
 cmake --preset ci

@@ -1,13 +1,17 @@
-// The DRM/KMS display output. This machine has no display hardware (and a test must not take over
-// a real screen), so what is checked here is that every way of not having a usable display gives
-// one clear message naming the device; showing pictures needs a KMS card (vkms works).
+// The DRM/KMS display output: every way of not having a usable display gives one clear message
+// naming the device; and, on a screen the tests may take over (a virtual machine's, which ctest
+// gives them through scripts/kms-vm.sh: DrmDisplaySink.OnAKmsScreen), the screen shows each
+// picture where it should, and is given back as it was found. A test must not take over a real
+// screen: without SURROUNDD_KMS_SCREEN those are skipped.
 
 #include "render/outputs/drm_display_sink.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "render/render_error.hpp"
+#include "tests/support/kms_scanout.hpp"
 
 namespace surroundd::render {
 namespace {
@@ -43,6 +47,90 @@ TEST(DrmDisplaySink, WithoutADeviceTheCardsAreSearchedAndTheOutcomeSaid) {
                                            HasSubstr("cannot become DRM master"),
                                            HasSubstr("no card could show the picture")));
   }
+}
+
+class DrmDisplaySinkOnAScreen : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    card_ = testing::kmsScreenForTests();
+    if (card_.empty()) {
+      GTEST_SKIP() << "no KMS screen to take over here (ctest runs these on a virtual machine's: "
+                      "DrmDisplaySink.OnAKmsScreen)";
+    }
+  }
+
+  static PictureTime at(int frame) { return PictureTime(std::chrono::milliseconds(frame * 33)); }
+
+  // What the screen shows, in the rows and columns `area` of its mode, and black around it.
+  void expectShown(const cv::Mat& expected, const cv::Rect& area, double maxLevels) const {
+    const auto shown = testing::scanout(card_);
+    ASSERT_FALSE(shown.picture.empty()) << "the screen shows nothing";
+    EXPECT_LE(cv::norm(shown.picture(area), expected, cv::NORM_INF), maxLevels);
+    cv::Mat outside = shown.picture.clone();
+    outside(area).setTo(cv::Scalar::all(0));
+    EXPECT_EQ(cv::countNonZero(outside.reshape(1)), 0) << "the bars around it are not black";
+  }
+
+  std::filesystem::path card_;
+};
+
+TEST_F(DrmDisplaySinkOnAScreen, ShowsEachPictureCentredAndFittedToTheMode) {
+  DrmDisplaySink sink({card_, ""});
+  const cv::Size mode = testing::scanout(card_).picture.size();
+  ASSERT_FALSE(mode.empty()) << "the sink set no mode";
+
+  // As wide as the mode and half as high: shown as it is, between black bars.
+  cv::Mat wide(mode.height / 2, mode.width, CV_8UC3);
+  cv::randu(wide, 0, 256);
+  sink.consume(wide, at(0));
+  sink.finish(wide, at(0).stream);
+  const cv::Rect middle(0, (mode.height - wide.rows) / 2, wide.cols, wide.rows);
+  expectShown(wide, middle, 0);
+  const std::uint32_t first = testing::scanout(card_).framebuffer;
+
+  // Half that size: doubled to the same place, on the other buffer.
+  cv::Mat small(wide.rows / 2, wide.cols / 2, CV_8UC3);
+  cv::randu(small, 0, 256);
+  sink.consume(small, at(1));
+  sink.finish(small, at(1).stream);
+  cv::Mat doubled;
+  cv::resize(small, doubled, middle.size(), 0, 0, cv::INTER_LINEAR);
+  expectShown(doubled, middle, 1);
+  EXPECT_NE(testing::scanout(card_).framebuffer, first) << "no page flip";
+  EXPECT_THAT(sink.describe(), ::testing::MatchesRegex(
+                                   "display .+-[0-9]+ [0-9]+x[0-9]+@[0-9]+ on .+ \\(2 frames\\)"));
+}
+
+TEST_F(DrmDisplaySinkOnAScreen, GivesTheScreenBackAsItFoundIt) {
+  const auto before = testing::scanout(card_);
+  {
+    DrmDisplaySink sink({card_, ""});
+    const cv::Mat grey(480, 640, CV_8UC3, cv::Scalar::all(128));
+    sink.consume(grey, at(0));
+    sink.finish(grey, at(0).stream);
+    ASSERT_NE(testing::scanout(card_).framebuffer, before.framebuffer);
+  }
+  const auto after = testing::scanout(card_);
+  EXPECT_EQ(after.framebuffer, before.framebuffer);
+  if (!before.picture.empty()) EXPECT_EQ(cv::norm(after.picture, before.picture, cv::NORM_INF), 0);
+}
+
+TEST_F(DrmDisplaySinkOnAScreen, AScreenAnotherProcessDrivesIsRefused) {
+  const DrmDisplaySink first({card_, ""});
+  EXPECT_THAT(
+      [this] {
+        DrmDisplaySink second({card_, ""});
+      },
+      ThrowsMessage<RenderError>(HasSubstr("cannot become DRM master")));
+}
+
+TEST_F(DrmDisplaySinkOnAScreen, AConnectorThatIsNotThereIsNamedWithThoseThatAre) {
+  EXPECT_THAT(
+      [this] {
+        DrmDisplaySink sink({card_, "HDMI-A-9"});
+      },
+      ThrowsMessage<RenderError>(::testing::MatchesRegex(
+          ".*no connected connector 'HDMI-A-9' \\(found: .+ connected.*\\)")));
 }
 
 }  // namespace

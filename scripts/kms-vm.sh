@@ -1,0 +1,118 @@
+#!/usr/bin/env bash
+# Runs one command on a KMS display: a virtual machine (QEMU, KVM when /dev/kvm is there) with
+# Debian's kernel and a virtio GPU whose screen is connected, so that the DRM/KMS outputs can be
+# tried for real on a machine that has no display hardware. The machine sees this one's files
+# read-only (9p) and runs the command in them as root, with /dev/dri/card0 and a writable /tmp.
+#
+#   scripts/kms-vm.sh fetch            Debian's kernel, downloaded once into build/kms-vm
+#   scripts/kms-vm.sh run CMD [ARG..]  the command's exit status is this script's; its output is
+#                                      the machine's console
+#   scripts/kms-vm.sh check            exit 0 when `run` can work here, else 77 and why
+#
+# Needs qemu-system-x86, busybox-static, kmod and cpio (Debian packages). KMS_VM_DIR overrides where
+# the kernel is kept; KMS_VM_SCREEN=FILE.ppm keeps QEMU's own capture of the screen after CMD.
+set -euo pipefail
+
+root=$(cd "$(dirname "$0")/.." && pwd)
+store=${KMS_VM_DIR:-$root/build/kms-vm}
+kernel_package=linux-image-amd64
+
+kernel_tree() { find "$store/kernel/lib/modules" -mindepth 1 -maxdepth 1 -type d 2>/dev/null | head -1; }
+
+fetch() {
+  [[ -n "$(kernel_tree)" ]] && return 0
+  mkdir -p "$store"
+  local work
+  work=$(mktemp -d "$store/fetch.XXXXXX")
+  # The metapackage names the current kernel; its image package holds vmlinuz and the modules.
+  local image
+  image=$(apt-cache depends "$kernel_package" | awk '/Depends: linux-image-/ {print $2; exit}')
+  [[ -n "$image" ]] || { echo "kms-vm: apt knows no $kernel_package" >&2; exit 1; }
+  (cd "$work" && apt-get download "$image" >/dev/null 2>&1) ||
+    { echo "kms-vm: cannot download $image (apt-get download)" >&2; exit 1; }
+  dpkg-deb -x "$work"/*.deb "$work/tree"
+  depmod -b "$work/tree" "$(ls "$work/tree/lib/modules")"
+  rm -rf "$store/kernel" && mv "$work/tree" "$store/kernel" && rm -rf "$work"
+}
+
+missing() {
+  command -v qemu-system-x86_64 >/dev/null || { echo "qemu-system-x86_64 (qemu-system-x86)"; return; }
+  [[ -x /bin/busybox ]] || { echo "/bin/busybox (busybox-static)"; return; }
+  command -v modprobe >/dev/null || { echo "modprobe (kmod)"; return; }
+  command -v cpio >/dev/null || { echo "cpio (cpio)"; return; }
+  [[ -n "$(kernel_tree)" ]] || { echo "a kernel in $store ($0 fetch)"; return; }
+}
+
+# The initramfs: busybox, the modules for virtio, 9p and the GPU, and an init that mounts this
+# machine's files and runs the command in them.
+make_initramfs() {
+  local modules=$1 out=$2 dir
+  dir=$(mktemp -d)
+  mkdir -p "$dir"/{bin,host,modules,proc,sys,dev}
+  cp /bin/busybox "$dir/bin/"
+  local version
+  version=$(basename "$modules")
+  local order=()
+  for module in virtio_pci 9p 9pnet_virtio virtio-gpu; do
+    while read -r _ path; do
+      local name
+      name=$(basename "$path")
+      [[ " ${order[*]} " == *" $name "* ]] && continue
+      cp "$path" "$dir/modules/"
+      order+=("$name")
+    done < <(modprobe -d "$store/kernel" -S "$version" --show-depends "$module")
+  done
+  cat >"$dir/init" <<EOF
+#!/bin/busybox sh
+/bin/busybox --install -s /bin
+mount -t proc proc /proc; mount -t sysfs sys /sys; mount -t devtmpfs dev /dev
+for m in ${order[*]}; do insmod /modules/\$m || echo "kms-vm: cannot load \$m"; done
+mount -t 9p -o trans=virtio,version=9p2000.L,ro host /host || echo "kms-vm: no host files"
+mount -t proc proc /host/proc; mount -t sysfs sys /host/sys; mount -t devtmpfs dev /host/dev
+mount -t 9p -o trans=virtio,version=9p2000.L out /host/tmp
+i=0; while [ ! -e /dev/dri/card0 ] && [ \$i -lt 50 ]; do sleep 0.1; i=\$((i+1)); done
+chroot /host /bin/bash /tmp/kms-vm-command; echo \$? > /host/tmp/kms-vm-status
+sync; poweroff -f
+EOF
+  chmod +x "$dir/init"
+  (cd "$dir" && find . | cpio -o -H newc --quiet | gzip -1) >"$out"
+  rm -rf "$dir"
+}
+
+run() {
+  local why
+  why=$(missing || true)
+  [[ -z "$why" ]] || { echo "kms-vm: cannot run here: it needs $why" >&2; exit 77; }
+  local modules
+  modules=$(kernel_tree)
+  shared=$(mktemp -d)
+  trap 'rm -rf "$shared"' EXIT
+  make_initramfs "$modules" "$shared/initramfs.gz"
+  # The command as run here: the same environment (sanitizers' options, a test filter) and folder.
+  {
+    export -p | grep -v -E '^declare -x (HOME|PWD|OLDPWD|SHLVL|TMPDIR)='
+    printf 'cd %q\nexec' "$PWD"
+    printf ' %q' "$@"
+    echo
+  } >"$shared/kms-vm-command"
+  local accel=(-accel tcg)
+  [[ -n "${KMS_VM_KVM:-}" ]] && accel=(-accel kvm)
+  local monitor=()
+  [[ -n "${KMS_VM_SCREEN:-}" ]] && monitor=(-monitor "unix:$shared/monitor,server=on,wait=off")
+  qemu-system-x86_64 "${accel[@]}" -m 2048 -smp 2 -nographic -nodefaults -serial stdio -no-reboot \
+    -kernel "$store/kernel/boot/vmlinuz-$(basename "$modules")" -initrd "$shared/initramfs.gz" \
+    -append "console=ttyS0 quiet panic=-1" \
+    -device virtio-gpu-pci -vga none -display none \
+    -virtfs local,path=/,mount_tag=host,security_model=none,readonly=on,multidevs=remap \
+    -virtfs "local,path=$shared,mount_tag=out,security_model=none,multidevs=remap" \
+    "${monitor[@]}" </dev/null
+  [[ -f "$shared/kms-vm-status" ]] || { echo "kms-vm: the machine ended without the command's status" >&2; exit 1; }
+  exit "$(cat "$shared/kms-vm-status")"
+}
+
+case "${1:-}" in
+  fetch) fetch ;;
+  check) why=$(missing || true); [[ -z "$why" ]] || { echo "kms-vm: cannot run here: it needs $why"; exit 77; } ;;
+  run) shift; run "$@" ;;
+  *) echo "usage: $0 fetch | check | run CMD [ARG...]" >&2; exit 2 ;;
+esac
