@@ -87,22 +87,61 @@ EGLDisplay surfacelessDisplay(std::string& why) {
   return display;
 }
 
-EGLDisplay x11Display(void* nativeDisplay, std::string& why) {
+// The display on a native one, `native` (an X display, a GBM device): `platform` is the
+// EGL_PLATFORM_* enum of `extension`.
+EGLDisplay nativePlatformDisplay(EGLenum platform, std::string_view extension,
+                                 std::string_view native, void* nativeDisplay, std::string& why) {
   if (nativeDisplay == nullptr) {
-    why = "no X display given";
+    why = fmt::format("no {} given", native);
     return EGL_NO_DISPLAY;
   }
-  if (!hasExtension(eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS), "EGL_KHR_platform_x11")) {
-    why = "the EGL client has no EGL_KHR_platform_x11";
+  if (!hasExtension(eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS), extension)) {
+    why = fmt::format("the EGL client has no {}", extension);
     return EGL_NO_DISPLAY;
   }
   const auto platformDisplay =
       procedure<PFNEGLGETPLATFORMDISPLAYEXTPROC>("eglGetPlatformDisplayEXT");
   const EGLDisplay display = platformDisplay != nullptr
-                                 ? platformDisplay(EGL_PLATFORM_X11_KHR, nativeDisplay, nullptr)
+                                 ? platformDisplay(platform, nativeDisplay, nullptr)
                                  : EGL_NO_DISPLAY;
-  if (display == EGL_NO_DISPLAY) why = eglErrorText("eglGetPlatformDisplayEXT(x11)");
+  if (display == EGL_NO_DISPLAY)
+    why = eglErrorText(fmt::format("eglGetPlatformDisplayEXT({})", extension));
   return display;
+}
+
+// DRM's XRGB8888 as a GBM surface's format and an EGL configuration's native visual id: what a
+// display controller scans out everywhere.
+constexpr EGLint kXrgb8888 = 'X' | ('R' << 8) | ('2' << 16) | ('4' << 24);
+
+// An RGB8 OpenGL ES 3 configuration: with alpha for framebuffer objects and windows; on GBM, the
+// one whose buffers are XRGB8888, for the screen.
+bool chooseConfig(EGLDisplay display, EglPlatform platform, EGLConfig& config) {
+  const bool gbm = platform == EglPlatform::kGbm;
+  EGLint surfaces = EGL_PBUFFER_BIT;
+  // On X11 also windows; a pbuffer stays possible for drivers without surfaceless contexts.
+  if (platform == EglPlatform::kX11) surfaces = EGL_WINDOW_BIT | EGL_PBUFFER_BIT;
+  if (gbm) surfaces = EGL_WINDOW_BIT;
+  const std::array<EGLint, 13> attributes{
+      EGL_SURFACE_TYPE, surfaces, EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT,
+      EGL_RED_SIZE,     8,        EGL_GREEN_SIZE,      8,
+      EGL_BLUE_SIZE,    8,        EGL_ALPHA_SIZE,      gbm ? 0 : 8,
+      EGL_NONE};
+  std::array<EGLConfig, 64> configs{};
+  EGLint count = 0;
+  if (eglChooseConfig(display, attributes.data(), configs.data(),
+                      static_cast<EGLint>(configs.size()), &count) != EGL_TRUE) {
+    return false;
+  }
+  for (EGLint i = 0; i < count; ++i) {
+    EGLint visual = 0;
+    if (!gbm ||
+        (eglGetConfigAttrib(display, configs[i], EGL_NATIVE_VISUAL_ID, &visual) == EGL_TRUE &&
+         visual == kXrgb8888)) {
+      config = configs[i];
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace
@@ -128,6 +167,8 @@ const char* toString(EglPlatform platform) {
       return "default";
     case EglPlatform::kX11:
       return "x11";
+    case EglPlatform::kGbm:
+      return "gbm";
   }
   return "?";
 }
@@ -152,7 +193,14 @@ EglContext::~EglContext() { close(); }
 
 bool EglContext::open(EglPlatform platform, void* nativeDisplay, std::string& why) {
   if (platform == EglPlatform::kDevice) display_ = deviceDisplay(why);
-  if (platform == EglPlatform::kX11) display_ = x11Display(nativeDisplay, why);
+  if (platform == EglPlatform::kX11) {
+    display_ = nativePlatformDisplay(EGL_PLATFORM_X11_KHR, "EGL_KHR_platform_x11", "X display",
+                                     nativeDisplay, why);
+  }
+  if (platform == EglPlatform::kGbm) {
+    display_ = nativePlatformDisplay(EGL_PLATFORM_GBM_KHR, "EGL_KHR_platform_gbm", "GBM device",
+                                     nativeDisplay, why);
+  }
   if (platform == EglPlatform::kSurfaceless) display_ = surfacelessDisplay(why);
   if (platform == EglPlatform::kDefault) {
     display_ = eglGetDisplay(EGL_DEFAULT_DISPLAY);
@@ -170,16 +218,9 @@ bool EglContext::open(EglPlatform platform, void* nativeDisplay, std::string& wh
     why = eglErrorText("eglBindAPI(OpenGL ES)");
     return false;
   }
-  const std::array<EGLint, 13> configAttributes{
-      EGL_SURFACE_TYPE,
-      // On X11 also windows; a pbuffer stays possible for drivers without surfaceless contexts.
-      platform == EglPlatform::kX11 ? EGL_WINDOW_BIT | EGL_PBUFFER_BIT : EGL_PBUFFER_BIT,
-      EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT, EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8, EGL_BLUE_SIZE, 8,
-      EGL_ALPHA_SIZE, 8, EGL_NONE};
-  EGLint configs = 0;
-  if (eglChooseConfig(display_, configAttributes.data(), &config_, 1, &configs) != EGL_TRUE ||
-      configs == 0) {
-    why = "no RGBA8 OpenGL ES 3 configuration";
+  if (!chooseConfig(display_, platform, config_)) {
+    why = platform == EglPlatform::kGbm ? "no OpenGL ES 3 configuration for XRGB8888 buffers"
+                                        : "no RGBA8 OpenGL ES 3 configuration";
     return false;
   }
   const std::array<EGLint, 5> contextAttributes{EGL_CONTEXT_MAJOR_VERSION, 3,
@@ -204,6 +245,7 @@ bool EglContext::open(EglPlatform platform, void* nativeDisplay, std::string& wh
     return false;
   }
   platform_ = platform;
+  nativeDisplay_ = nativeDisplay;
   software_ = softwareRenderer();
   description_ = fmt::format("{}: {}, {}", toString(platform),
                              reinterpret_cast<const char*>(glGetString(GL_RENDERER)),

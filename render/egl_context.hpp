@@ -4,9 +4,11 @@
 //   device       EGL_EXT_platform_device on a hardware device (NVIDIA's driver, or a DRM node);
 //   surfaceless  EGL_MESA_platform_surfaceless (Mesa: a GPU, or llvmpipe on the CPU);
 //   default      the default display with a 1x1 pbuffer, for drivers with neither.
-// And, asked for by name only, on an X server's connection (EGL_KHR_platform_x11), so that it can
-// also draw into that server's windows (render/outputs/egl_window.hpp):
-//   x11          the framebuffer objects as on the others, and EGL window surfaces.
+// And, asked for by name only, where it can also draw into what a display shows:
+//   x11          on an X server's connection (EGL_KHR_platform_x11): also into that server's
+//                windows (render/outputs/egl_window_sink.hpp);
+//   gbm          on a GBM device of a DRM card (EGL_KHR_platform_gbm): also into GBM surfaces,
+//                whose buffers the card scans out (render/outputs/egl_display_sink.hpp).
 // The context is current on the thread that made it until release() hands it on, and then on
 // the one that calls makeCurrent(): EGL binds a context to one thread at a time, so GL objects are
 // made and used on the thread that has it, and destroyed before the context.
@@ -18,13 +20,13 @@
 
 namespace surroundd::render {
 
-enum class EglPlatform { kAuto, kDevice, kSurfaceless, kDefault, kX11 };
+enum class EglPlatform { kAuto, kDevice, kSurfaceless, kDefault, kX11, kGbm };
 
 class EglContext {
  public:
-  // Throws RenderError listing each platform tried and why it failed. kX11 needs
-  // `nativeDisplay`: an Xlib Display*, open longer than the context; `nativeOwner`, when given,
-  // keeps it open and is released once the context is closed.
+  // Throws RenderError listing each platform tried and why it failed. kX11 and kGbm need
+  // `nativeDisplay` (an Xlib Display*, a gbm_device*), open longer than the context;
+  // `nativeOwner`, when given, keeps it open and is released once the context is closed.
   explicit EglContext(EglPlatform platform = EglPlatform::kAuto, void* nativeDisplay = nullptr,
                       std::shared_ptr<void> nativeOwner = nullptr);
   ~EglContext();
@@ -39,9 +41,11 @@ class EglContext {
   // Current on the calling thread; no other may have it. Throws RenderError.
   void makeCurrent();
   EglPlatform platform() const { return platform_; }
-  // For surfaces of the context's display (kX11: windows): its display and configuration.
+  // For surfaces of the context's display (kX11: windows; kGbm: GBM surfaces, XRGB8888): its
+  // display and configuration, and the native display it is on (null on the headless ones).
   EGLDisplay display() const { return display_; }
   EGLConfig config() const { return config_; }
+  void* nativeDisplay() const { return nativeDisplay_; }
   // Draws into `surface`'s default framebuffer from now on (EGL_NO_SURFACE: none, only into
   // framebuffer objects, as after construction), on the thread that has the context. Throws
   // RenderError.
@@ -55,6 +59,7 @@ class EglContext {
   void close();
 
   std::shared_ptr<void> nativeOwner_;  // released after close(): declared first
+  void* nativeDisplay_ = nullptr;
   EGLDisplay display_ = EGL_NO_DISPLAY;
   EGLConfig config_ = nullptr;
   EGLContext context_ = EGL_NO_CONTEXT;

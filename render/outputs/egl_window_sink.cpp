@@ -7,7 +7,7 @@
 #include <GLES3/gl3.h>
 #include <fmt/format.h>
 
-#include "render/gl_objects.hpp"
+#include "render/outputs/view_blit.hpp"
 #include "render/render_error.hpp"
 #include "render/surround_view.hpp"
 
@@ -72,16 +72,12 @@ class EglWindowSink::Surface {
   // Blits `framebuffer` (row 0 the picture's top) of `size` into the window and swaps.
   void show(GLuint framebuffer, cv::Size size) {
     gl_.drawInto(surface_);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-    // The window's row 0 is its bottom.
-    glBlitFramebuffer(0, 0, size.width, size.height, 0, size.height, size.width, 0,
-                      GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    blitView(framebuffer, size, size);
     const bool swapped = eglSwapBuffers(gl_.display(), surface_) == EGL_TRUE;
     const std::string failure = swapped ? "" : eglFailure(display_, "eglSwapBuffers");
     gl_.drawInto(EGL_NO_SURFACE);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    gl::check("showing a view in a window");
     // No round trip to wait for the server here: the renderer's thread goes on while the server
     // puts the picture on the screen (the swap's requests go through the renderer's connection).
     // A lost server shows in the window's events, read before each picture.

@@ -112,7 +112,9 @@ TEST_F(DrmDisplaySinkOnAScreen, GivesTheScreenBackAsItFoundIt) {
   }
   const auto after = testing::scanout(card_);
   EXPECT_EQ(after.framebuffer, before.framebuffer);
-  if (!before.picture.empty()) EXPECT_EQ(cv::norm(after.picture, before.picture, cv::NORM_INF), 0);
+  if (!before.picture.empty()) {
+    EXPECT_EQ(cv::norm(after.picture, before.picture, cv::NORM_INF), 0);
+  }
 }
 
 TEST_F(DrmDisplaySinkOnAScreen, AScreenAnotherProcessDrivesIsRefused) {
