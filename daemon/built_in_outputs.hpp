@@ -35,6 +35,12 @@ void checkEncoder(YamlObject& item, OutputConfig& output);
 render::VideoEncoderSettings encoderSettings(const OutputConfig& output,
                                              const OutputContext& context);
 
+// `present: picture | egl` of the types that can show the surround view as OpenGL drew it (window,
+// display; view_present.cpp): the key, with its one-line doc (a literal), and the rule that egl
+// shows the surround stream only.
+ConfigKey<OutputConfig> presentKey(std::string_view doc);
+void checkPresent(YamlObject& item, const OutputConfig& output, std::string_view type);
+
 // `listen: ADDRESS:PORT` of the types that serve (http, rtsp), `defaultPort` when absent; and the
 // rule that two of a type cannot listen on one port (listen_key.cpp).
 ConfigKey<OutputConfig> listenKey(int defaultPort);

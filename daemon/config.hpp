@@ -138,10 +138,11 @@ struct RenderConfig {
 // surround view.
 enum class OutputStream { kMosaic, kPanorama, kSurround };
 
-// How a window output shows its pictures: read back and sent to the X server
-// (render::X11WindowSink), or the surround view as OpenGL drew it, through EGL on the GPU with
-// no read-back (render::EglWindowSink; the renderer's context is then on that X server).
-enum class WindowPresent { kPicture, kEgl };
+// How a window or display output shows its pictures: read back and handed to it
+// (render::X11WindowSink, render::DrmDisplaySink), or the surround view as OpenGL drew it, through
+// EGL on the GPU with no read-back (render::EglWindowSink, render::EglDisplaySink; the renderer's
+// context is then on that X server, or on that DRM card's GBM device).
+enum class ViewPresent { kPicture, kEgl };
 
 // An output's `type:`: the name of an output type in the registry (output_type.hpp), where each
 // type registers its keys, its factory and what it takes from the pipeline. The built-in types are
@@ -230,7 +231,7 @@ struct OutputConfig {
   // window (X11)
   std::string display;  // empty: $DISPLAY
   std::string title = "surroundd";
-  WindowPresent present = WindowPresent::kPicture;
+  ViewPresent present = ViewPresent::kPicture;  // window and display
   // display (DRM/KMS)
   std::filesystem::path device;  // empty: the first card with a connected connector
   std::string connector;         // e.g. HDMI-A-1; empty: the first connected one

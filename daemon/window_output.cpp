@@ -22,7 +22,7 @@ constexpr std::size_t kWindowQueue = 1;
 std::unique_ptr<render::FrameSink> openWindow(const OutputConfig& output,
                                               const OutputContext& context) {
   render::X11WindowSettings settings{output.display, output.title, context.pictureSize};
-  if (output.present == WindowPresent::kPicture) {
+  if (output.present == ViewPresent::kPicture) {
     return queuedSink(std::make_unique<render::X11WindowSink>(std::move(settings)), context,
                       kWindowQueue);
   }
@@ -31,9 +31,10 @@ std::unique_ptr<render::FrameSink> openWindow(const OutputConfig& output,
   }
   if (context.renderer->platform() != render::EglPlatform::kX11) {
     throw render::RenderError(fmt::format(
-        "window on {}: present: egl needs the renderer on this X server, which it could not be "
-        "opened on (the log's render line says why)",
-        output.display.empty() ? "$DISPLAY" : output.display));
+        "window on {}: present: egl needs the renderer on this X server, and it runs on the {} "
+        "platform (the log's render line says why)",
+        output.display.empty() ? "$DISPLAY" : output.display,
+        render::toString(context.renderer->platform())));
   }
   if (context.renderer->software()) {
     spdlog::warn(
@@ -47,24 +48,18 @@ std::unique_ptr<render::FrameSink> openWindow(const OutputConfig& output,
 // The renderer's context on the X server of a window that shows the views through EGL; it keeps
 // its own connection there.
 std::unique_ptr<render::EglContext> openRendererOnServer(const OutputConfig& output) {
-  if (output.present != WindowPresent::kEgl) return nullptr;
+  if (output.present != ViewPresent::kEgl) return nullptr;
   auto display = std::make_shared<render::XlibDisplay>(output.display);
   void* native = display->get();
   return std::make_unique<render::EglContext>(render::EglPlatform::kX11, native,
                                               std::move(display));
 }
 
-void checkWindow(YamlObject& item, OutputConfig& output) {
-  if (output.present == WindowPresent::kEgl && output.stream != OutputStream::kSurround) {
-    item.error("present",
-               "egl shows the surround view as OpenGL draws it: the window's stream "
-               "must be surround");
-  }
-}
+void checkWindow(YamlObject& item, OutputConfig& output) { checkPresent(item, output, "window"); }
 
 // The renderer draws on one X server: every egl window is on it.
 std::optional<OutputConflict> otherServer(const OutputConfig& earlier, const OutputConfig& output) {
-  if (earlier.present != WindowPresent::kEgl || output.present != WindowPresent::kEgl ||
+  if (earlier.present != ViewPresent::kEgl || output.present != ViewPresent::kEgl ||
       earlier.display == output.display) {
     return std::nullopt;
   }
@@ -84,10 +79,8 @@ OutputType windowOutputType() {
       // Empty, its default, is $DISPLAY: the reference shows an example.
       Key::text("display", &OutputConfig::display, "X display", Shown::kExample),
       Key::text("title", &OutputConfig::title, "the window's title"),
-      Key::choice("present", &OutputConfig::present,
-                  {{"picture", WindowPresent::kPicture}, {"egl", WindowPresent::kEgl}},
-                  "how it shows the view: picture (read back, sent to the server) or egl (drawn "
-                  "into the window on the GPU; the renderer then runs on that X server)"),
+      presentKey("how it shows the view: picture (read back, sent to the server) or egl (drawn "
+                 "into the window on the GPU; the renderer then runs on that X server)"),
   };
   type.readSettings = checkWindow;
   type.conflict = otherServer;

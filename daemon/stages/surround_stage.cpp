@@ -42,7 +42,8 @@ std::size_t splitCameraOf(const Config& config) {
 }
 
 // The renderer's context: on the display of an output that shows the views on the GPU
-// (OutputType::openRenderer: an egl window's X server), else on render.platform. An output's
+// (OutputType::openRenderer: an egl window's X server, an egl display's card), else on
+// render.platform. An output's
 // display that cannot be opened leaves the renderer on render.platform, and that output failing.
 std::unique_ptr<render::EglContext> rendererContext(const Config& config) {
   for (const OutputConfig& output : config.outputs) {
@@ -50,8 +51,9 @@ std::unique_ptr<render::EglContext> rendererContext(const Config& config) {
     if (!type.openRenderer || output.stream != OutputStream::kSurround) continue;
     try {
       if (auto gl = type.openRenderer(output)) {
-        spdlog::info("render: on the X server of the {} output, which shows the views through EGL",
-                     type.name);
+        spdlog::info(
+            "render: on the {} platform of the {} output, which shows the views through EGL",
+            render::toString(gl->platform()), type.name);
         return gl;
       }
     } catch (const render::RenderError& e) {

@@ -40,7 +40,7 @@ TEST(WindowOutput, AnEglWindowShowsEachSetsViewAsALosslessVideoOfItHasIt) {
   window.view = ViewKind::kOrbit;
   window.display = server.display();
   window.title = "surroundd egl";
-  window.present = WindowPresent::kEgl;
+  window.present = ViewPresent::kEgl;
   const Config config = fixtureReplay("synth_small", {video, window});
   const testing::X11Observer observer(server.display());
   const std::atomic<bool> stop{false};
@@ -51,7 +51,7 @@ TEST(WindowOutput, AnEglWindowShowsEachSetsViewAsALosslessVideoOfItHasIt) {
   summary = pipeline.run(stop);
   log = capture.lines();
 
-  EXPECT_THAT(log, Contains(HasSubstr("render: on the X server of the window output")));
+  EXPECT_THAT(log, Contains(HasSubstr("render: on the x11 platform of the window output")));
   EXPECT_THAT(log, Contains(HasSubstr("render: x11: llvmpipe")));
   EXPECT_THAT(log, Contains(HasSubstr("present: egl on a renderer that runs on the CPU")));
   ASSERT_GT(summary.frameSets, 5U);
@@ -74,7 +74,7 @@ TEST(WindowOutput, AnEglWindowOnAServerThatCannotBeReachedIsNamed) {
   window.kind = OutputKind::kWindow;
   window.stream = OutputStream::kSurround;
   window.display = ":97";
-  window.present = WindowPresent::kEgl;
+  window.present = ViewPresent::kEgl;
   const Config config = fixtureReplay("synth_small", {window});
   const testing::LogCapture capture;
   EXPECT_THAT([&] { const Pipeline pipeline(config); },

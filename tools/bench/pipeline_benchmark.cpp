@@ -113,8 +113,8 @@ daemon::Config configFor(const std::filesystem::path& folder, const RecordingTru
     output.preset = "ultrafast";
   } else {
     output.kind = daemon::OutputKind::kWindow;
-    output.present = options.output == BenchOutput::kEglWindow ? daemon::WindowPresent::kEgl
-                                                               : daemon::WindowPresent::kPicture;
+    output.present = options.output == BenchOutput::kEglWindow ? daemon::ViewPresent::kEgl
+                                                               : daemon::ViewPresent::kPicture;
   }
   config.outputs = {output};
   return config;
