@@ -5,7 +5,8 @@
 # --soak: also gnuplot, for scripts/soak.sh's plot.
 # --cross-arm64: also the aarch64 cross compiler, qemu-user and mmdebstrap, for
 #   scripts/cross-arm64.sh.
-# --kms-vm: also QEMU, busybox, kmod and cpio, for scripts/kms-vm.sh (the display tests' screen).
+# --device-vm: also QEMU, busybox, kmod and cpio, for scripts/device-vm.sh (the tests' machine with
+#   a KMS screen, V4L2 cameras and a CAN bus).
 set -eu
 
 PACKAGES="
@@ -26,8 +27,8 @@ for argument in "$@"; do
     --fuzz) PACKAGES="$PACKAGES clang libclang-rt-dev" ;;
     --soak) PACKAGES="$PACKAGES gnuplot-nox" ;;
     --cross-arm64) PACKAGES="$PACKAGES crossbuild-essential-arm64 qemu-user-static mmdebstrap" ;;
-    --kms-vm) PACKAGES="$PACKAGES qemu-system-x86 busybox-static kmod cpio" ;;
-    *) echo "usage: scripts/install-deps.sh [--fuzz] [--soak] [--cross-arm64] [--kms-vm]" >&2; exit 2 ;;
+    --device-vm) PACKAGES="$PACKAGES qemu-system-x86 busybox-static kmod cpio" ;;
+    *) echo "usage: scripts/install-deps.sh [--fuzz] [--soak] [--cross-arm64] [--device-vm]" >&2; exit 2 ;;
   esac
 done
 

@@ -33,9 +33,10 @@ end() { timings="$timings
   $1: $(($(date +%s) - phase_start)) s"; }
 
 begin "dependencies"
-# With what runs the display tests on a virtual machine's screen, and Debian's kernel for it.
-scripts/install-deps.sh --kms-vm
-scripts/kms-vm.sh fetch
+# With what runs the tests that need a KMS screen, V4L2 cameras or a CAN bus on a virtual
+# machine that has them, and Debian's kernel for it.
+scripts/install-deps.sh --device-vm
+scripts/device-vm.sh fetch
 end "dependencies"
 begin "ci build"
 cmake --preset ci

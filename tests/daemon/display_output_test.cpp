@@ -1,6 +1,6 @@
 // The `display` output with `present: egl`, through the pipeline on a generated recording: on a
 // screen the tests may take over (a virtual machine's: ctest's DisplayOutput.OnAKmsScreen, through
-// scripts/kms-vm.sh), the renderer opens on the card's GBM device and the screen shows the sets'
+// scripts/device-vm.sh), the renderer opens on the card's GBM device and the screen shows the sets'
 // surround views as OpenGL drew them, with no read-back — at the end, a picture that a lossless
 // video of the same view holds (the last, unless a flip was still pending), and the snapshot reads
 // the last one back. Anywhere: the config's rules for it and a card that cannot be opened.

@@ -2,7 +2,7 @@
 // What a KMS screen shows: the frame buffer its display controller scans out, read through the
 // kernel as the tests' second look at a display output (as x11_test_server.hpp's observer is for
 // windows). Reading another client's buffers takes root (DRM_IOCTL_MODE_GETFB2 hands their
-// handles to the DRM master or CAP_SYS_ADMIN only): scripts/kms-vm.sh runs the tests that take a
+// handles to the DRM master or CAP_SYS_ADMIN only): scripts/device-vm.sh runs the tests that take a
 // screen over as root in a virtual machine with one, and says so in SURROUNDD_KMS_SCREEN.
 
 #include <cstdint>

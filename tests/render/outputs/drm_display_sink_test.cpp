@@ -1,6 +1,6 @@
 // The DRM/KMS display output: every way of not having a usable display gives one clear message
 // naming the device; and, on a screen the tests may take over (a virtual machine's, which ctest
-// gives them through scripts/kms-vm.sh: DrmDisplaySink.OnAKmsScreen), the screen shows each
+// gives them through scripts/device-vm.sh: DrmDisplaySink.OnAKmsScreen), the screen shows each
 // picture where it should, and is given back as it was found. A test must not take over a real
 // screen: without SURROUNDD_KMS_SCREEN those are skipped.
 

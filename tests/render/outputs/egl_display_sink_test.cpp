@@ -1,6 +1,6 @@
 // The surround view shown on a KMS screen through EGL on the card's GBM device: on a screen the
 // tests may take over (a virtual machine's: ctest's EglDisplaySink.OnAKmsScreen, through
-// scripts/kms-vm.sh), the frame buffer the screen scans out is exactly the view's read-back
+// scripts/device-vm.sh), the frame buffer the screen scans out is exactly the view's read-back
 // picture, between black bars, and flips with each view; a view smaller than the mode is scaled
 // up to fill it; the screen is given back as it was found. Anywhere: a renderer that is not on a
 // card is refused.

@@ -1,20 +1,26 @@
 #!/usr/bin/env bash
-# Runs one command on a KMS display: a virtual machine (QEMU, KVM when /dev/kvm is there) with
-# Debian's kernel and a virtio GPU whose screen is connected, so that the DRM/KMS outputs can be
-# tried for real on a machine that has no display hardware. The machine sees this one's files
-# read-only (9p) and runs the command in them as root, with /dev/dri/card0 and a writable /tmp.
+# Runs one command on a machine with the kernel devices a vehicle computer has and this one does
+# not: a virtual machine (QEMU) with Debian's kernel and
+#   - a KMS screen: a virtio GPU whose screen is connected (/dev/dri/card0);
+#   - four V4L2 capture devices: vivid, the kernel's virtual video test driver (its test patterns;
+#     the first and third through the single-planar API, the others through the multi-planar one);
+#   - a CAN bus: vcan0, up.
+# so that the outputs, cameras and vehicle signals can be tried through the real kernel interfaces.
+# The machine sees this one's files read-only (9p) and runs the command in them as root, in the
+# same folder and environment, with a writable /tmp. About 7 s to boot, on QEMU's emulated CPU.
 #
-#   scripts/kms-vm.sh fetch            Debian's kernel, downloaded once into build/kms-vm
-#   scripts/kms-vm.sh run CMD [ARG..]  the command's exit status is this script's; its output is
-#                                      the machine's console
-#   scripts/kms-vm.sh check            exit 0 when `run` can work here, else 77 and why
+#   scripts/device-vm.sh fetch            Debian's kernel, downloaded once into build/device-vm
+#   scripts/device-vm.sh run CMD [ARG..]  the command's exit status is this script's; its output
+#                                         is the machine's console
+#   scripts/device-vm.sh check            exit 0 when `run` can work here, else 77 and why
 #
-# Needs qemu-system-x86, busybox-static, kmod and cpio (Debian packages). KMS_VM_DIR overrides where
-# the kernel is kept; KMS_VM_SCREEN=FILE.ppm keeps QEMU's own capture of the screen after CMD.
+# Needs qemu-system-x86, busybox-static, kmod and cpio (Debian packages;
+# scripts/install-deps.sh --device-vm). DEVICE_VM_DIR overrides where the kernel is kept;
+# DEVICE_VM_KVM=1 uses KVM (not by default: nested KVM is often there and broken).
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
-store=${KMS_VM_DIR:-$root/build/kms-vm}
+store=${DEVICE_VM_DIR:-$root/build/device-vm}
 kernel_package=linux-image-amd64
 
 kernel_tree() { find "$store/kernel/lib/modules" -mindepth 1 -maxdepth 1 -type d 2>/dev/null | head -1; }
@@ -27,9 +33,9 @@ fetch() {
   # The metapackage names the current kernel; its image package holds vmlinuz and the modules.
   local image
   image=$(apt-cache depends "$kernel_package" | awk '/Depends: linux-image-/ {print $2; exit}')
-  [[ -n "$image" ]] || { echo "kms-vm: apt knows no $kernel_package" >&2; exit 1; }
+  [[ -n "$image" ]] || { echo "device-vm: apt knows no $kernel_package" >&2; exit 1; }
   (cd "$work" && apt-get download "$image" >/dev/null 2>&1) ||
-    { echo "kms-vm: cannot download $image (apt-get download)" >&2; exit 1; }
+    { echo "device-vm: cannot download $image (apt-get download)" >&2; exit 1; }
   dpkg-deb -x "$work"/*.deb "$work/tree"
   depmod -b "$work/tree" "$(ls "$work/tree/lib/modules")"
   rm -rf "$store/kernel" && mv "$work/tree" "$store/kernel" && rm -rf "$work"
@@ -43,8 +49,8 @@ missing() {
   [[ -n "$(kernel_tree)" ]] || { echo "a kernel in $store ($0 fetch)"; return; }
 }
 
-# The initramfs: busybox, the modules for virtio, 9p and the GPU, and an init that mounts this
-# machine's files and runs the command in them.
+# The initramfs: busybox, the modules for virtio, 9p, the GPU, vivid and vcan, and an init that
+# mounts this machine's files and runs the command in them.
 make_initramfs() {
   local modules=$1 out=$2 dir
   dir=$(mktemp -d)
@@ -53,7 +59,7 @@ make_initramfs() {
   local version
   version=$(basename "$modules")
   local order=()
-  for module in virtio_pci 9p 9pnet_virtio virtio-gpu; do
+  for module in virtio_pci 9p 9pnet_virtio virtio-gpu vivid vcan can-raw; do
     while read -r _ path; do
       local name
       name=$(basename "$path")
@@ -66,12 +72,19 @@ make_initramfs() {
 #!/bin/busybox sh
 /bin/busybox --install -s /bin
 mount -t proc proc /proc; mount -t sysfs sys /sys; mount -t devtmpfs dev /dev
-for m in ${order[*]}; do insmod /modules/\$m || echo "kms-vm: cannot load \$m"; done
-mount -t 9p -o trans=virtio,version=9p2000.L,ro host /host || echo "kms-vm: no host files"
+for m in ${order[*]}; do
+  case \$m in
+    vivid.ko) options="n_devs=4 node_types=0x1,0x1,0x1,0x1 multiplanar=1,2,1,2" ;;
+    *) options="" ;;
+  esac
+  insmod /modules/\$m \$options || echo "device-vm: cannot load \$m"
+done
+ip link add dev vcan0 type vcan && ip link set up vcan0
+mount -t 9p -o trans=virtio,version=9p2000.L,ro host /host || echo "device-vm: no host files"
 mount -t proc proc /host/proc; mount -t sysfs sys /host/sys; mount -t devtmpfs dev /host/dev
 mount -t 9p -o trans=virtio,version=9p2000.L out /host/tmp
 i=0; while [ ! -e /dev/dri/card0 ] && [ \$i -lt 50 ]; do sleep 0.1; i=\$((i+1)); done
-chroot /host /bin/bash /tmp/kms-vm-command; echo \$? > /host/tmp/kms-vm-status
+chroot /host /bin/bash /tmp/device-vm-command; echo \$? > /host/tmp/device-vm-status
 sync; poweroff -f
 EOF
   chmod +x "$dir/init"
@@ -82,7 +95,7 @@ EOF
 run() {
   local why
   why=$(missing || true)
-  [[ -z "$why" ]] || { echo "kms-vm: cannot run here: it needs $why" >&2; exit 77; }
+  [[ -z "$why" ]] || { echo "device-vm: cannot run here: it needs $why" >&2; exit 77; }
   local modules
   modules=$(kernel_tree)
   shared=$(mktemp -d)
@@ -94,25 +107,23 @@ run() {
     printf 'cd %q\nexec' "$PWD"
     printf ' %q' "$@"
     echo
-  } >"$shared/kms-vm-command"
+  } >"$shared/device-vm-command"
   local accel=(-accel tcg)
-  [[ -n "${KMS_VM_KVM:-}" ]] && accel=(-accel kvm)
-  local monitor=()
-  [[ -n "${KMS_VM_SCREEN:-}" ]] && monitor=(-monitor "unix:$shared/monitor,server=on,wait=off")
+  [[ -n "${DEVICE_VM_KVM:-}" ]] && accel=(-accel kvm)
   qemu-system-x86_64 "${accel[@]}" -m 2048 -smp 2 -nographic -nodefaults -serial stdio -no-reboot \
     -kernel "$store/kernel/boot/vmlinuz-$(basename "$modules")" -initrd "$shared/initramfs.gz" \
     -append "console=ttyS0 quiet panic=-1" \
     -device virtio-gpu-pci -vga none -display none \
     -virtfs local,path=/,mount_tag=host,security_model=none,readonly=on,multidevs=remap \
     -virtfs "local,path=$shared,mount_tag=out,security_model=none,multidevs=remap" \
-    "${monitor[@]}" </dev/null
-  [[ -f "$shared/kms-vm-status" ]] || { echo "kms-vm: the machine ended without the command's status" >&2; exit 1; }
-  exit "$(cat "$shared/kms-vm-status")"
+    </dev/null
+  [[ -f "$shared/device-vm-status" ]] || { echo "device-vm: the machine ended without the command's status" >&2; exit 1; }
+  exit "$(cat "$shared/device-vm-status")"
 }
 
 case "${1:-}" in
   fetch) fetch ;;
-  check) why=$(missing || true); [[ -z "$why" ]] || { echo "kms-vm: cannot run here: it needs $why"; exit 77; } ;;
+  check) why=$(missing || true); [[ -z "$why" ]] || { echo "device-vm: cannot run here: it needs $why"; exit 77; } ;;
   run) shift; run "$@" ;;
   *) echo "usage: $0 fetch | check | run CMD [ARG...]" >&2; exit 2 ;;
 esac
