@@ -36,7 +36,7 @@ begin "dependencies"
 # With what runs the tests that need a KMS screen, V4L2 cameras or a CAN bus on a virtual
 # machine that has them, and Debian's kernel for it.
 scripts/install-deps.sh --device-vm
-scripts/device-vm.sh fetch
+scripts/device-vm.sh fetch || echo "test: no kernel for the device machine: its tests will say so"
 end "dependencies"
 begin "ci build"
 cmake --preset ci
@@ -76,10 +76,14 @@ if [ "$sanitizers" = yes ]; then
   dri="/usr/lib/$(gcc -print-multiarch)/dri/swrast_dri.so"
   [ -e "$dri" ] || dri=""
   # Left out: the browser tests (Chromium and its node driver are not instrumented; the server
-  # side of the page runs under ASan in http_stream_sink_test and end_to_end_test) and lintian's
-  # verdict on the .deb (it judges a release package; the ci suite runs it).
+  # side of the page runs under ASan in http_stream_sink_test and end_to_end_test), lintian's
+  # verdict on the .deb (it judges a release package; the ci suite runs it) and the runs on the
+  # device machine (scripts/device-vm.sh: 5.6 min under ASan on its emulated CPU, against 2.6 in
+  # the ci suite, which runs them; their programs' other tests run here; there LeakSanitizer also
+  # reports blocks that Mesa's GBM and DRI driver keep after gbm_device_destroy(), in stacks that
+  # end inside Mesa and that a suppression by module cannot reliably name).
   LD_PRELOAD="$dri" ASAN_OPTIONS="$ASAN_OPTIONS:verify_asan_link_order=0" \
-    ctest --preset asan -j2 -LE '^browser$' -E '^Packaging\.TheDebPassesLintian$'
+    ctest --preset asan -j2 -LE '^(browser|device_vm)$' -E '^Packaging\.TheDebPassesLintian$'
   end "asan suite"
 
   # Threads: the work pool, capture (camera streams, the synchronizer, camera health), every test
