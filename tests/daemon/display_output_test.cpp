@@ -39,16 +39,6 @@ OutputConfig eglDisplay(const std::filesystem::path& card) {
   return display;
 }
 
-// `picture` as the screen shows it: fitted to the mode, centred (the sink's rule).
-cv::Rect placeOf(cv::Size picture, cv::Size screen) {
-  const double scale = std::min(static_cast<double>(screen.width) / picture.width,
-                                static_cast<double>(screen.height) / picture.height);
-  const cv::Size fitted(static_cast<int>(picture.width * scale),
-                        static_cast<int>(picture.height * scale));
-  return {(screen.width - fitted.width) / 2, (screen.height - fitted.height) / 2, fitted.width,
-          fitted.height};
-}
-
 TEST(DisplayOutputOnAScreen, AnEglDisplayShowsTheSetsViewsAsALosslessVideoOfThemHasThem) {
   const auto card = testing::kmsScreenForTests();
   if (card.empty()) {
@@ -81,7 +71,7 @@ TEST(DisplayOutputOnAScreen, AnEglDisplayShowsTheSetsViewsAsALosslessVideoOfThem
   // The screen keeps showing the last view presented until the pipeline goes.
   const auto shown = testing::scanout(card);
   ASSERT_FALSE(shown.picture.empty());
-  const cv::Rect area = placeOf(frames.back().size(), shown.picture.size());
+  const cv::Rect area = testing::fittedPlace(frames.back().size(), shown.picture.size());
   double closest = std::numeric_limits<double>::max();
   std::size_t closestFrame = 0;
   for (std::size_t i = 0; i < frames.size(); ++i) {

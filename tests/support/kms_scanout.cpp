@@ -1,5 +1,6 @@
 #include "tests/support/kms_scanout.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <memory>
@@ -79,6 +80,21 @@ Scanout scanout(const std::filesystem::path& card) {
     }
   }
   return {};
+}
+
+cv::Rect fittedPlace(cv::Size picture, cv::Size screen) {
+  const double scale = std::min(static_cast<double>(screen.width) / picture.width,
+                                static_cast<double>(screen.height) / picture.height);
+  const cv::Size fitted(static_cast<int>(picture.width * scale),
+                        static_cast<int>(picture.height * scale));
+  return {(screen.width - fitted.width) / 2, (screen.height - fitted.height) / 2, fitted.width,
+          fitted.height};
+}
+
+ShownAgainst compareShown(const cv::Mat& shown, const cv::Mat& expected, const cv::Rect& area) {
+  cv::Mat around = shown.clone();
+  around(area).setTo(cv::Scalar::all(0));
+  return {cv::norm(shown(area), expected, cv::NORM_INF), cv::countNonZero(around.reshape(1))};
 }
 
 }  // namespace surroundd::testing

@@ -24,4 +24,15 @@ struct Scanout {
 // it cannot be read (not root, a format other than 32-bit RGB).
 Scanout scanout(const std::filesystem::path& card);
 
+// Where the display outputs show a picture of `picture` size on a screen of `screen` size:
+// fitted, keeping its aspect, and centred.
+cv::Rect fittedPlace(cv::Size picture, cv::Size screen);
+
+// A screen's picture against what it should show: `expected` in `area`, black around it.
+struct ShownAgainst {
+  double largestDifference = 0;  // in `area`, in levels
+  int litAround = 0;             // levels around `area` that are not 0
+};
+ShownAgainst compareShown(const cv::Mat& shown, const cv::Mat& expected, const cv::Rect& area);
+
 }  // namespace surroundd::testing

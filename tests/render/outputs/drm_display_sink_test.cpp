@@ -61,14 +61,13 @@ class DrmDisplaySinkOnAScreen : public ::testing::Test {
 
   static PictureTime at(int frame) { return PictureTime(std::chrono::milliseconds(frame * 33)); }
 
-  // What the screen shows, in the rows and columns `area` of its mode, and black around it.
+  // The screen shows `expected` in `area` of its mode (within `maxLevels`), and black around it.
   void expectShown(const cv::Mat& expected, const cv::Rect& area, double maxLevels) const {
     const auto shown = testing::scanout(card_);
     ASSERT_FALSE(shown.picture.empty()) << "the screen shows nothing";
-    EXPECT_LE(cv::norm(shown.picture(area), expected, cv::NORM_INF), maxLevels);
-    cv::Mat outside = shown.picture.clone();
-    outside(area).setTo(cv::Scalar::all(0));
-    EXPECT_EQ(cv::countNonZero(outside.reshape(1)), 0) << "the bars around it are not black";
+    const auto against = testing::compareShown(shown.picture, expected, area);
+    EXPECT_LE(against.largestDifference, maxLevels);
+    EXPECT_EQ(against.litAround, 0) << "the bars around it are not black";
   }
 
   std::filesystem::path card_;

@@ -84,20 +84,13 @@ class EglDisplaySinkOnAScreen : public ::testing::Test {
     }
   }
 
-  // Where a picture of `size` is shown on the screen, centred: its rows and columns.
-  static cv::Rect placeOf(cv::Size picture, cv::Size screen) {
-    return {(screen.width - picture.width) / 2, (screen.height - picture.height) / 2, picture.width,
-            picture.height};
-  }
-
-  // The screen shows `expected` in `area` (within `maxLevels`), and black around it.
+  // The screen shows `expected` in `area` of its mode (within `maxLevels`), and black around it.
   void expectShown(const cv::Mat& expected, const cv::Rect& area, double maxLevels) const {
     const auto shown = testing::scanout(card_);
     ASSERT_FALSE(shown.picture.empty()) << "the screen shows nothing";
-    EXPECT_LE(cv::norm(shown.picture(area), expected, cv::NORM_INF), maxLevels);
-    cv::Mat outside = shown.picture.clone();
-    outside(area).setTo(cv::Scalar::all(0));
-    EXPECT_EQ(cv::countNonZero(outside.reshape(1)), 0) << "the bars around it are not black";
+    const auto against = testing::compareShown(shown.picture, expected, area);
+    EXPECT_LE(against.largestDifference, maxLevels);
+    EXPECT_EQ(against.litAround, 0) << "the bars around it are not black";
   }
 
   std::filesystem::path card_;
@@ -111,7 +104,7 @@ TEST_F(EglDisplaySinkOnAScreen, ShowsEachViewAsItsReadBackPictureIs) {
   const cv::Mat first = renderer.draw(0.0);
   renderer.show(sink, 0.0);
   const auto mode = testing::scanout(card_).picture.size();
-  const cv::Rect area = placeOf(first.size(), mode);
+  const cv::Rect area = testing::fittedPlace(first.size(), mode);
   expectShown(first, area, 0);
   const std::uint32_t firstBuffer = testing::scanout(card_).framebuffer;
 
@@ -136,14 +129,11 @@ TEST_F(EglDisplaySinkOnAScreen, ScalesASmallerViewUpToFillTheMode) {
   const cv::Mat picture = renderer.draw(1.0);
   renderer.show(sink, 1.0);
   const auto mode = testing::scanout(card_).picture.size();
-  const double scale = std::min(static_cast<double>(mode.width) / picture.cols,
-                                static_cast<double>(mode.height) / picture.rows);
-  const cv::Size fitted(static_cast<int>(picture.cols * scale),
-                        static_cast<int>(picture.rows * scale));
+  const cv::Rect area = testing::fittedPlace(picture.size(), mode);
   cv::Mat expected;
-  cv::resize(picture, expected, fitted, 0, 0, cv::INTER_LINEAR);
+  cv::resize(picture, expected, area.size(), 0, 0, cv::INTER_LINEAR);
   // The GPU's bilinear filter against OpenCV's: the same samples, rounded apart.
-  expectShown(expected, placeOf(fitted, mode), 2);
+  expectShown(expected, area, 2);
 }
 
 TEST_F(EglDisplaySinkOnAScreen, GivesTheScreenBackAsItFoundIt) {
