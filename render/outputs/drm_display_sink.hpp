@@ -36,7 +36,9 @@ class DrmDisplaySink final : public FrameSink {
   struct Buffers;  // the two scan-out buffers (keeps GBM out of the header)
 
   DrmCard card_;
-  KmsScreen screen_;  // before the buffers it shows: removes their frame buffers first
+  // The buffers go before the screen: a frame buffer keeps its buffer's memory until the screen,
+  // having given the controller back, removes it.
+  KmsScreen screen_;
   std::unique_ptr<Buffers> buffers_;
   std::uint64_t frames_ = 0;
 };
