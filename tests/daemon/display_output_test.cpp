@@ -19,6 +19,7 @@
 #include "tests/daemon/config_test_support.hpp"
 #include "tests/daemon/replay_config.hpp"
 #include "tests/support/kms_scanout.hpp"
+#include "tests/support/kms_screen_test.hpp"
 #include "tests/support/log_capture.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -39,12 +40,10 @@ OutputConfig eglDisplay(const std::filesystem::path& card) {
   return display;
 }
 
-TEST(DisplayOutputOnAScreen, AnEglDisplayShowsTheSetsViewsAsALosslessVideoOfThemHasThem) {
-  const auto card = testing::kmsScreenForTests();
-  if (card.empty()) {
-    GTEST_SKIP() << "no KMS screen to take over here (ctest runs this on a virtual machine's: "
-                    "DisplayOutput.OnAKmsScreen)";
-  }
+using DisplayOutputOnAScreen = testing::KmsScreenTest;
+
+TEST_F(DisplayOutputOnAScreen, AnEglDisplayShowsTheSetsViewsAsALosslessVideoOfThemHasThem) {
+  const std::filesystem::path& card = card_;
   const testing::TempDir dir;
   OutputConfig video = videoOutputAt(dir.path() / "orbit.mkv");
   video.stream = OutputStream::kSurround;

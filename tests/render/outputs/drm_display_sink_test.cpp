@@ -12,6 +12,7 @@
 
 #include "render/render_error.hpp"
 #include "tests/support/kms_scanout.hpp"
+#include "tests/support/kms_screen_test.hpp"
 
 namespace surroundd::render {
 namespace {
@@ -49,28 +50,9 @@ TEST(DrmDisplaySink, WithoutADeviceTheCardsAreSearchedAndTheOutcomeSaid) {
   }
 }
 
-class DrmDisplaySinkOnAScreen : public ::testing::Test {
+class DrmDisplaySinkOnAScreen : public testing::KmsScreenTest {
  protected:
-  void SetUp() override {
-    card_ = testing::kmsScreenForTests();
-    if (card_.empty()) {
-      GTEST_SKIP() << "no KMS screen to take over here (ctest runs these on a virtual machine's: "
-                      "DrmDisplaySink.OnAKmsScreen)";
-    }
-  }
-
   static PictureTime at(int frame) { return PictureTime(std::chrono::milliseconds(frame * 33)); }
-
-  // The screen shows `expected` in `area` of its mode (within `maxLevels`), and black around it.
-  void expectShown(const cv::Mat& expected, const cv::Rect& area, double maxLevels) const {
-    const auto shown = testing::scanout(card_);
-    ASSERT_FALSE(shown.picture.empty()) << "the screen shows nothing";
-    const auto against = testing::compareShown(shown.picture, expected, area);
-    EXPECT_LE(against.largestDifference, maxLevels);
-    EXPECT_EQ(against.litAround, 0) << "the bars around it are not black";
-  }
-
-  std::filesystem::path card_;
 };
 
 TEST_F(DrmDisplaySinkOnAScreen, ShowsEachPictureCentredAndFittedToTheMode) {

@@ -18,6 +18,7 @@
 #include "render/surround_scene.hpp"
 #include "render/surround_view.hpp"
 #include "tests/support/kms_scanout.hpp"
+#include "tests/support/kms_screen_test.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace surroundd::render {
@@ -74,27 +75,7 @@ class CardRenderer {
   std::unique_ptr<SurroundView> view_;
 };
 
-class EglDisplaySinkOnAScreen : public ::testing::Test {
- protected:
-  void SetUp() override {
-    card_ = testing::kmsScreenForTests();
-    if (card_.empty()) {
-      GTEST_SKIP() << "no KMS screen to take over here (ctest runs these on a virtual machine's: "
-                      "EglDisplaySink.OnAKmsScreen)";
-    }
-  }
-
-  // The screen shows `expected` in `area` of its mode (within `maxLevels`), and black around it.
-  void expectShown(const cv::Mat& expected, const cv::Rect& area, double maxLevels) const {
-    const auto shown = testing::scanout(card_);
-    ASSERT_FALSE(shown.picture.empty()) << "the screen shows nothing";
-    const auto against = testing::compareShown(shown.picture, expected, area);
-    EXPECT_LE(against.largestDifference, maxLevels);
-    EXPECT_EQ(against.litAround, 0) << "the bars around it are not black";
-  }
-
-  std::filesystem::path card_;
-};
+using EglDisplaySinkOnAScreen = testing::KmsScreenTest;
 
 TEST_F(EglDisplaySinkOnAScreen, ShowsEachViewAsItsReadBackPictureIs) {
   CardRenderer renderer(card_, 1.0);  // as wide as the mode, half as high
