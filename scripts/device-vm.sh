@@ -7,7 +7,8 @@
 #   - a CAN bus: vcan0, up.
 # so that the outputs, cameras and vehicle signals can be tried through the real kernel interfaces.
 # The machine sees this one's files read-only (9p) and runs the command in them as root, in the
-# same folder and environment, with a writable /tmp. About 7 s to boot, on QEMU's emulated CPU.
+# same folder and environment, with a writable temporary folder ($TMPDIR). About 7 s to boot, on
+# QEMU's emulated CPU.
 #
 #   scripts/device-vm.sh fetch            Debian's kernel, downloaded once into build/device-vm
 #   scripts/device-vm.sh run CMD [ARG..]  the command's exit status is this script's; its output
@@ -82,9 +83,12 @@ done
 ip link add dev vcan0 type vcan && ip link set up vcan0
 mount -t 9p -o trans=virtio,version=9p2000.L,ro host /host || echo "device-vm: no host files"
 mount -t proc proc /host/proc; mount -t sysfs sys /host/sys; mount -t devtmpfs dev /host/dev
-mount -t 9p -o trans=virtio,version=9p2000.L out /host/tmp
+# The only writable place, the one folder shared back: in the guest's own /dev (this machine's
+# /tmp stays as it is, read-only: the command may live there).
+mkdir /host/dev/device-vm
+mount -t 9p -o trans=virtio,version=9p2000.L out /host/dev/device-vm
 i=0; while [ ! -e /dev/dri/card0 ] && [ \$i -lt 50 ]; do sleep 0.1; i=\$((i+1)); done
-chroot /host /bin/bash /tmp/device-vm-command; echo \$? > /host/tmp/device-vm-status
+chroot /host /bin/bash /dev/device-vm/command; echo \$? > /host/dev/device-vm/status
 sync; poweroff -f
 EOF
   chmod +x "$dir/init"
@@ -101,13 +105,15 @@ run() {
   shared=$(mktemp -d)
   trap 'rm -rf "$shared"' EXIT
   make_initramfs "$modules" "$shared/initramfs.gz"
-  # The command as run here: the same environment (sanitizers' options, a test filter) and folder.
+  # The command as run here: the same environment (sanitizers' options, a test filter) and folder;
+  # its temporary files in the shared folder.
   {
     export -p | grep -v -E '^declare -x (HOME|PWD|OLDPWD|SHLVL|TMPDIR)='
+    echo 'mkdir -p /dev/device-vm/tmp && export TMPDIR=/dev/device-vm/tmp'
     printf 'cd %q\nexec' "$PWD"
     printf ' %q' "$@"
     echo
-  } >"$shared/device-vm-command"
+  } >"$shared/command"
   local accel=(-accel tcg)
   [[ -n "${DEVICE_VM_KVM:-}" ]] && accel=(-accel kvm)
   qemu-system-x86_64 "${accel[@]}" -m 2048 -smp 2 -nographic -nodefaults -serial stdio -no-reboot \
@@ -117,8 +123,8 @@ run() {
     -virtfs local,path=/,mount_tag=host,security_model=none,readonly=on,multidevs=remap \
     -virtfs "local,path=$shared,mount_tag=out,security_model=none,multidevs=remap" \
     </dev/null
-  [[ -f "$shared/device-vm-status" ]] || { echo "device-vm: the machine ended without the command's status" >&2; exit 1; }
-  exit "$(cat "$shared/device-vm-status")"
+  [[ -f "$shared/status" ]] || { echo "device-vm: the machine ended without the command's status" >&2; exit 1; }
+  exit "$(cat "$shared/status")"
 }
 
 case "${1:-}" in
