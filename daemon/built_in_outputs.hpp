@@ -40,6 +40,10 @@ render::VideoEncoderSettings encoderSettings(const OutputConfig& output,
 // shows the surround stream only.
 ConfigKey<OutputConfig> presentKey(std::string_view doc);
 void checkPresent(YamlObject& item, const OutputConfig& output, std::string_view type);
+// The renderer such an output draws through, which must be on `platform` (where the output shows
+// it); else RenderError naming the output (`shown`: "window on :1") and `where` ("X server").
+render::EglContext& presentingRenderer(const OutputContext& context, render::EglPlatform platform,
+                                       std::string_view shown, std::string_view where);
 
 // `listen: ADDRESS:PORT` of the types that serve (http, rtsp), `defaultPort` when absent; and the
 // rule that two of a type cannot listen on one port (listen_key.cpp).

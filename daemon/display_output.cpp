@@ -8,7 +8,6 @@
 #include "daemon/built_in_outputs.hpp"
 #include "render/outputs/drm_display_sink.hpp"
 #include "render/outputs/egl_display_sink.hpp"
-#include "render/render_error.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -28,16 +27,9 @@ std::unique_ptr<render::FrameSink> openDisplay(const OutputConfig& output,
                           render::DrmDisplaySettings{output.device, output.connector}),
                       context, kDisplayQueue);
   }
-  if (context.renderer == nullptr) {
-    throw render::RenderError("an egl display shows the surround view, and there is no renderer");
-  }
-  if (context.renderer->platform() != render::EglPlatform::kGbm) {
-    throw render::RenderError(fmt::format(
-        "display on {}: present: egl needs the renderer on this card, and it runs on the {} "
-        "platform (the log's render line says why)",
-        cardName(output), render::toString(context.renderer->platform())));
-  }
-  return std::make_unique<render::EglDisplaySink>(*context.renderer, output.connector);
+  render::EglContext& gl = presentingRenderer(
+      context, render::EglPlatform::kGbm, fmt::format("display on {}", cardName(output)), "card");
+  return std::make_unique<render::EglDisplaySink>(gl, output.connector);
 }
 
 // The renderer's context on the GBM device of the card of a display that shows the views through

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "daemon/built_in_outputs.hpp"
+#include "render/render_error.hpp"
 
 namespace surroundd::daemon {
 
@@ -18,6 +19,21 @@ void checkPresent(YamlObject& item, const OutputConfig& output, std::string_view
                                       "stream must be surround",
                                       type));
   }
+}
+
+render::EglContext& presentingRenderer(const OutputContext& context, render::EglPlatform platform,
+                                       std::string_view shown, std::string_view where) {
+  if (context.renderer == nullptr) {
+    throw render::RenderError(
+        fmt::format("{}: present: egl shows the surround view, and there is no renderer", shown));
+  }
+  if (context.renderer->platform() != platform) {
+    throw render::RenderError(fmt::format(
+        "{}: present: egl needs the renderer on this {}, and it runs on the {} platform (the "
+        "log's render line says why)",
+        shown, where, render::toString(context.renderer->platform())));
+  }
+  return *context.renderer;
 }
 
 }  // namespace surroundd::daemon

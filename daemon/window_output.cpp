@@ -8,7 +8,6 @@
 #include "daemon/built_in_outputs.hpp"
 #include "render/outputs/egl_window_sink.hpp"
 #include "render/outputs/x11_window_sink.hpp"
-#include "render/render_error.hpp"
 
 // After every other header: Xlib's macros.
 #include "render/outputs/xlib_display.hpp"
@@ -26,23 +25,17 @@ std::unique_ptr<render::FrameSink> openWindow(const OutputConfig& output,
     return queuedSink(std::make_unique<render::X11WindowSink>(std::move(settings)), context,
                       kWindowQueue);
   }
-  if (context.renderer == nullptr) {
-    throw render::RenderError("an egl window shows the surround view, and there is no renderer");
-  }
-  if (context.renderer->platform() != render::EglPlatform::kX11) {
-    throw render::RenderError(fmt::format(
-        "window on {}: present: egl needs the renderer on this X server, and it runs on the {} "
-        "platform (the log's render line says why)",
-        output.display.empty() ? "$DISPLAY" : output.display,
-        render::toString(context.renderer->platform())));
-  }
-  if (context.renderer->software()) {
+  const std::string shown =
+      fmt::format("window on {}", output.display.empty() ? "$DISPLAY" : output.display);
+  render::EglContext& gl =
+      presentingRenderer(context, render::EglPlatform::kX11, shown, "X server");
+  if (gl.software()) {
     spdlog::warn(
-        "window on {}: present: egl on a renderer that runs on the CPU, whose swap "
-        "copies each picture on the renderer's thread; present: picture is faster here",
-        output.display.empty() ? "$DISPLAY" : output.display);
+        "{}: present: egl on a renderer that runs on the CPU, whose swap copies each picture on "
+        "the renderer's thread; present: picture is faster here",
+        shown);
   }
-  return std::make_unique<render::EglWindowSink>(*context.renderer, std::move(settings));
+  return std::make_unique<render::EglWindowSink>(gl, std::move(settings));
 }
 
 // The renderer's context on the X server of a window that shows the views through EGL; it keeps
