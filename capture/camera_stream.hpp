@@ -46,6 +46,9 @@ class CameraStream {
 
   void start();
   void stop();
+  // Its frames lent the source's buffers, for a GPU to import (FrameSource::lendBuffers); why not,
+  // or nullptr. Before start(): the source is the capture thread's from then on.
+  const char* lendBuffers() { return source_->lendBuffers(); }
 
   // Waits up to `timeout` for the next frame. kEnded once the stream has ended and its queue is
   // empty.

@@ -5,6 +5,10 @@
 // the frame down the pipeline; destroying it returns the buffer to its pool, so nothing is
 // allocated per frame once a pool is built. The pool's shared state is kept alive by every
 // outstanding FrameRef, so a frame may outlive the source that produced it.
+//
+// A source may lend a frame its driver's buffer instead of copying into the frame's own picture
+// (V4l2Source::lendBuffers): then `image` views that buffer, `dmabuf` says where a GPU can import
+// it, and the buffer goes back to its driver when the frame goes back to its pool.
 
 #include <chrono>
 #include <condition_variable>
@@ -15,6 +19,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "common/dmabuf_planes.hpp"
 #include "common/pixel_format.hpp"
 
 namespace surroundd::capture {
@@ -22,6 +27,17 @@ namespace surroundd::capture {
 // Timestamps are on the source's monotonic clock (the driver's, or the file's presentation time),
 // in nanoseconds.
 using Timestamp = std::chrono::nanoseconds;
+
+// Takes back a buffer it lent to a frame, when the frame is returned (on the thread that returns
+// it, so safe to call from any).
+class BufferLender {
+ public:
+  virtual ~BufferLender() = default;
+  BufferLender() = default;
+  BufferLender(const BufferLender&) = delete;
+  BufferLender& operator=(const BufferLender&) = delete;
+  virtual void giveBack(std::uint32_t buffer) noexcept = 0;
+};
 
 struct Frame {
   // The picture as `format` holds it (common/pixel_format.hpp: BGR, or the camera's own YUYV or
@@ -35,7 +51,18 @@ struct Frame {
   bool concealedErrors = false;
   // When its source handed it over (set by CameraStream): where a replayed frame's latency starts.
   std::chrono::steady_clock::time_point arrival{};
+  // Set while `image` views a lent driver buffer (planes == 0 otherwise).
+  DmabufPlanes dmabuf;
+  struct Loan {
+    std::shared_ptr<BufferLender> lender;  // null: nothing lent
+    std::uint32_t buffer = 0;
+    cv::Mat own;  // the frame's own picture, back in `image` when the loan ends
+  } loan;
 };
+
+// Ends a frame's loan, if it has one: its own picture back in `image`, the buffer back to its
+// lender. Allocates nothing. Returning a frame to its pool does this.
+void endLoan(Frame& frame) noexcept;
 
 class FramePool;
 

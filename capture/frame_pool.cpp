@@ -2,6 +2,16 @@
 
 namespace surroundd::capture {
 
+void endLoan(Frame& frame) noexcept {
+  if (!frame.loan.lender) return;
+  // The picture first: the lender may unmap the buffer once it has it back.
+  frame.image = frame.loan.own;
+  frame.loan.own = cv::Mat();
+  frame.dmabuf = {};
+  frame.loan.lender->giveBack(frame.loan.buffer);
+  frame.loan.lender.reset();
+}
+
 namespace detail {
 struct FramePoolState {
   std::vector<std::unique_ptr<Frame>> storage;  // owns every frame for the pool's whole life
@@ -11,6 +21,7 @@ struct FramePoolState {
 };
 
 void FrameReturner::operator()(Frame* frame) const noexcept {
+  endLoan(*frame);
   {
     const std::lock_guard lock(pool->mutex);
     pool->free.push_back(frame);

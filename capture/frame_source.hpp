@@ -53,6 +53,10 @@ class FrameSource {
   // True for a source that shows one picture over and over by design (a still picture, looped):
   // its frames repeat without anything being wrong. Known once the source is constructed.
   virtual bool repeatsOnePicture() const { return false; }
+  // From the next read on, frames are lent the source's own buffers where it can, rather than
+  // copied out of them: their `dmabuf` says where a GPU can import the picture (capture/
+  // frame.hpp). Returns why it cannot; nullptr when it does. Before the source is read.
+  virtual const char* lendBuffers() { return "its frames are not in a driver's buffers"; }
 };
 
 }  // namespace surroundd::capture

@@ -40,19 +40,6 @@ const char* toString(V4l2Format format) {
   return known == kV4l2Formats.end() ? "auto" : toString(known->layout);
 }
 
-// A buffer for VIDIOC_QUERYBUF, QBUF and DQBUF of this source's type; multi-planar buffers point
-// at `planes` for their per-plane lengths, offsets and sizes.
-v4l2_buffer V4l2Source::bufferFor(std::span<v4l2_plane> planes) const {
-  v4l2_buffer buffer{};
-  buffer.type = bufferType_;
-  buffer.memory = V4L2_MEMORY_MMAP;
-  if (multiplanar_) {
-    buffer.m.planes = planes.data();
-    buffer.length = static_cast<std::uint32_t>(bytesPerLine_.size());
-  }
-  return buffer;
-}
-
 V4l2Source::V4l2Source(std::string cameraName, V4l2Settings settings,
                        std::unique_ptr<V4l2Device> device)
     : camera_(std::move(cameraName)), settings_(std::move(settings)), device_(std::move(device)) {
@@ -153,8 +140,7 @@ void V4l2Source::start() {
   }
 
   mapBuffers();
-  int type = static_cast<int>(bufferType_);
-  if (const int error = device_->ioctl(VIDIOC_STREAMON, &type); error != 0) {
+  if (const int error = buffers_->startStreaming(); error != 0) {
     throw CaptureError(fmt::format("{}: cannot start streaming: {}", where(), errorText(error)));
   }
   streaming_ = true;
@@ -212,48 +198,50 @@ void V4l2Source::mapBuffers() {
                                    error != 0 ? errorText(error) : "too few granted"));
   }
   requested_ = true;
+  buffers_ = std::make_shared<V4l2Buffers>(device_, bufferType_, bytesPerLine_.size());
   for (std::uint32_t i = 0; i < request.count; ++i) {
     std::array<v4l2_plane, VIDEO_MAX_PLANES> planes{};
-    v4l2_buffer buffer = bufferFor(planes);
+    v4l2_buffer buffer = buffers_->describe(planes);
     buffer.index = i;
     if (const int error = device_->ioctl(VIDIOC_QUERYBUF, &buffer); error != 0) {
       throw CaptureError(fmt::format("{}: buffer {}: {}", where(), i, errorText(error)));
     }
-    std::vector<MappedPlane>& mapped = buffers_.emplace_back();
+    std::vector<V4l2Buffers::Plane> mapped;
+    // Added before anything can throw, so that the buffers unmap and close what is there.
+    const auto keep = [&] { buffers_->add(std::move(mapped)); };
     for (std::size_t p = 0; p < bytesPerLine_.size(); ++p) {
       const std::size_t length = multiplanar_ ? planes[p].length : buffer.length;
       const std::int64_t offset = multiplanar_ ? planes[p].m.mem_offset : buffer.m.offset;
       void* address = device_->map(length, offset);
       if (address == nullptr) {
+        keep();
         throw CaptureError(fmt::format("{}: cannot map buffer {} plane {}", where(), i, p));
       }
-      mapped.push_back({address, length});
       v4l2_exportbuffer exported{};
       exported.type = bufferType_;
       exported.index = i;
       exported.plane = static_cast<std::uint32_t>(p);
       exported.flags = O_CLOEXEC | O_RDONLY;
-      if (device_->ioctl(VIDIOC_EXPBUF, &exported) == 0) dmabufs_.push_back(exported.fd);
+      const bool exports = device_->ioctl(VIDIOC_EXPBUF, &exported) == 0;
+      mapped.push_back({address, length, exports ? exported.fd : -1});
+      if (exports) dmabufs_.push_back(exported.fd);
     }
-    if (const int error = device_->ioctl(VIDIOC_QBUF, &buffer); error != 0) {
+    keep();
+    if (const int error = buffers_->queue(buffer); error != 0) {
       throw CaptureError(fmt::format("{}: queueing buffer {}: {}", where(), i, errorText(error)));
     }
   }
 }
 
 void V4l2Source::stop() {
-  if (streaming_) {
-    int type = static_cast<int>(bufferType_);
-    device_->ioctl(VIDIOC_STREAMOFF, &type);
-    streaming_ = false;
+  if (buffers_) {
+    buffers_->stopStreaming();
+    buffers_.reset();  // unmapped here, or once the last frame lent a buffer returns
   }
-  for (const int fd : dmabufs_) ::close(fd);
+  streaming_ = false;
   dmabufs_.clear();
-  for (const auto& planes : buffers_) {
-    for (const auto& plane : planes) device_->unmap(plane.address, plane.length);
-  }
-  buffers_.clear();
   if (requested_) {
+    // With buffers still lent the kernel keeps them (orphaned) until they are unmapped.
     v4l2_requestbuffers release{};
     release.type = bufferType_;
     release.memory = V4L2_MEMORY_MMAP;
@@ -261,6 +249,27 @@ void V4l2Source::stop() {
     requested_ = false;
   }
   device_->close();
+}
+
+const char* V4l2Source::lendBuffers() {
+  const char* refusal = lendingRefusal();
+  lend_ = refusal == nullptr;
+  return refusal;
+}
+
+const char* V4l2Source::lendingRefusal() const {
+  if (layout_ != PixelLayout::kYuyv && layout_ != PixelLayout::kUyvy &&
+      layout_ != PixelLayout::kNv12) {
+    return "its frames are converted to BGR";
+  }
+  if (bytesPerLine_.size() > 1) return "its NV12 comes in two buffers, which no picture can view";
+  if (dmabufs_.empty()) return "its driver exports no DMABUF";
+  const cv::Size held = heldSize(heldFormat(layout_), settings_.size);
+  if (bytesPerLine_[0] !=
+      static_cast<std::size_t>(held.width) * CV_ELEM_SIZE(heldType(heldFormat(layout_)))) {
+    return "its lines are padded";
+  }
+  return nullptr;
 }
 
 ReadStatus V4l2Source::fault(std::string message, bool lost) {
@@ -289,7 +298,12 @@ void V4l2Source::reopen() {
 }
 
 ReadStatus V4l2Source::read(Frame& out) {
+  endLoan(out);
   if (!streaming_) return fault(fmt::format("{}: closed; reopen it", where()), true);
+  if (const int error = buffers_->requeueError(); error != 0) {
+    return fault(fmt::format("{}: requeueing a buffer: {}; reopening", where(), errorText(error)),
+                 true);
+  }
   if (const int error = device_->waitReadable(settings_.timeout); error != 0) {
     if (error == ETIMEDOUT) {
       return fault(
@@ -299,20 +313,21 @@ ReadStatus V4l2Source::read(Frame& out) {
     return fault(fmt::format("{}: {}; reopening", where(), errorText(error)), true);
   }
   std::array<v4l2_plane, VIDEO_MAX_PLANES> planes{};
-  v4l2_buffer buffer = bufferFor(planes);
-  if (const int error = device_->ioctl(VIDIOC_DQBUF, &buffer); error != 0) {
+  v4l2_buffer buffer = buffers_->describe(planes);
+  if (const int error = buffers_->dequeue(buffer); error != 0) {
     if (error == EAGAIN) return fault(fmt::format("{}: woke without a frame", where()), false);
     return fault(fmt::format("{}: {}; reopening", where(), errorText(error)), true);
   }
-  bool good = (buffer.flags & V4L2_BUF_FLAG_ERROR) == 0 && buffer.index < buffers_.size();
+  out.timestamp = std::chrono::seconds(buffer.timestamp.tv_sec) +
+                  std::chrono::microseconds(buffer.timestamp.tv_usec);
+  bool good = (buffer.flags & V4L2_BUF_FLAG_ERROR) == 0 && buffer.index < buffers_->count();
   std::string problem = good ? "" : "the driver marked the frame corrupt";
+  if (good && lend_ && lendingRefusal() == nullptr && lend(buffer, out)) return ReadStatus::kFrame;
   if (good) {
     good = hold(buffer, out.image);
     if (!good) problem = error_;
   }
-  out.timestamp = std::chrono::seconds(buffer.timestamp.tv_sec) +
-                  std::chrono::microseconds(buffer.timestamp.tv_usec);
-  if (const int error = device_->ioctl(VIDIOC_QBUF, &buffer); error != 0) {
+  if (const int error = buffers_->queue(buffer); error != 0) {
     return fault(fmt::format("{}: requeueing a buffer: {}; reopening", where(), errorText(error)),
                  true);
   }
@@ -320,10 +335,9 @@ ReadStatus V4l2Source::read(Frame& out) {
   return ReadStatus::kFrame;
 }
 
-bool V4l2Source::hold(const v4l2_buffer& buffer, cv::Mat& held) {
-  const std::vector<MappedPlane>& mapped = buffers_[buffer.index];
-  // Each plane's bytes: what the driver filled, after the offset it starts at.
-  std::array<std::span<const std::uint8_t>, 2> data;
+bool V4l2Source::filled(const v4l2_buffer& buffer,
+                        std::array<std::span<const std::uint8_t>, 2>& data) {
+  const std::span<const V4l2Buffers::Plane> mapped = buffers_->planes(buffer.index);
   for (std::size_t p = 0; p < mapped.size() && p < data.size(); ++p) {
     const std::size_t used = multiplanar_ ? buffer.m.planes[p].bytesused : buffer.bytesused;
     const std::size_t offset = multiplanar_ ? buffer.m.planes[p].data_offset : 0;
@@ -334,11 +348,44 @@ bool V4l2Source::hold(const v4l2_buffer& buffer, cv::Mat& held) {
     }
     data[p] = std::span(static_cast<const std::uint8_t*>(mapped[p].address) + offset, end - offset);
   }
-  if (mapped.size() == 2) {
+  return true;
+}
+
+bool V4l2Source::hold(const v4l2_buffer& buffer, cv::Mat& held) {
+  std::array<std::span<const std::uint8_t>, 2> data;
+  if (!filled(buffer, data)) return false;
+  if (buffers_->planes(buffer.index).size() == 2) {
     return holdNv12Planes({data[0], bytesPerLine_[0]}, {data[1], bytesPerLine_[1]}, settings_.size,
                           held, error_);
   }
   return holdFrame(layout_, data[0], bytesPerLine_[0], jpeg_, settings_.size, held, error_);
+}
+
+// One plane whose lines are unpadded (lendingRefusal()), viewed as it is: false (to be held as a
+// copy, or found short there) when the driver filled less than a picture or no buffer can be lent.
+bool V4l2Source::lend(const v4l2_buffer& buffer, Frame& out) {
+  std::array<std::span<const std::uint8_t>, 2> data;
+  const PixelFormat format = heldFormat(layout_);
+  const cv::Size size = heldSize(format, settings_.size);
+  const auto bytes = static_cast<std::size_t>(size.area()) * CV_ELEM_SIZE(heldType(format));
+  if (!filled(buffer, data) || data[0].size() < bytes || !buffers_->lend(buffer.index)) {
+    return false;
+  }
+  const V4l2Buffers::Plane& plane = buffers_->planes(buffer.index)[0];
+  const auto offset =
+      static_cast<std::uint32_t>(data[0].data() - static_cast<const std::uint8_t*>(plane.address));
+  const auto pitch = static_cast<std::uint32_t>(bytesPerLine_[0]);
+  out.loan.own = out.image;
+  out.loan.lender = buffers_;
+  out.loan.buffer = buffer.index;
+  // cv::Mat takes a writable pointer; nothing down the pipeline writes a frame's picture.
+  out.image = cv::Mat(size, heldType(format), const_cast<std::uint8_t*>(data[0].data()));
+  out.dmabuf.fd = {plane.dmabuf, plane.dmabuf};
+  out.dmabuf.pitch = {pitch, pitch};
+  out.dmabuf.offset = {offset, offset + pitch * static_cast<std::uint32_t>(settings_.size.height)};
+  out.dmabuf.planes = format == PixelFormat::kNv12 ? 2 : 1;
+  out.dmabuf.buffer = buffers_->id(buffer.index);
+  return true;
 }
 
 }  // namespace surroundd::capture

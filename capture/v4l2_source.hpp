@@ -10,7 +10,13 @@
 // Faults at run time are read() statuses: a corrupt frame is kFault; no frame within the timeout
 // or the device gone (ENODEV, EIO) closes it and is kLost, and reopen() opens and starts it again
 // (when and how often is the recovery policy's choice, capture/source_recovery.hpp).
+//
+// Asked to (lendBuffers), it lends its frames the driver's buffers instead of copying them, where
+// a frame's picture can view one as it is: for a GPU that imports the buffers' DMABUFs (render/
+// camera_texture.hpp), so that no byte of a frame is copied on the way.
 
+#include <array>
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
@@ -23,10 +29,10 @@
 #include "capture/frame_source.hpp"
 #include "capture/jpeg_decoder.hpp"
 #include "capture/pixel_conversion.hpp"
+#include "capture/v4l2_buffers.hpp"
 #include "capture/v4l2_device.hpp"
 
 struct v4l2_buffer;
-struct v4l2_plane;
 
 namespace surroundd::capture {
 
@@ -78,24 +84,30 @@ class V4l2Source final : public FrameSource {
   // after buffer.
   std::span<const int> dmabufs() const { return dmabufs_; }
 
- private:
-  struct MappedPlane {
-    void* address = nullptr;
-    std::size_t length = 0;
-  };
+  // Where it can (lendingRefusal()), a frame is from now on the driver's buffer lent to it rather
+  // than a copy: its image views the buffer, its dmabuf says where the buffer's planes are, and
+  // the buffer goes back to the driver when the frame returns to its pool. With fewer than two
+  // other buffers left to the driver, frames are copied as before (V4l2Settings::buffers: enough
+  // for every frame the pipeline holds at once, and two more).
+  const char* lendBuffers() override;
+  // Why this source's frames cannot be lent its buffers (as negotiated); nullptr when they can.
+  const char* lendingRefusal() const;
 
+ private:
   void start();  // open, negotiate, map, stream; throws CaptureError
   void setFormat(const V4l2FormatCode& chosen, const std::function<CaptureError()>& cannot);
   void mapBuffers();
   void stop();  // stream off, unmap, close; never throws
   ReadStatus fault(std::string message, bool lost);
-  v4l2_buffer bufferFor(std::span<v4l2_plane> planes) const;
+  // Each plane's bytes, as the driver filled them; false (and error_ set) when they cannot be.
+  bool filled(const v4l2_buffer& buffer, std::array<std::span<const std::uint8_t>, 2>& data);
   bool hold(const v4l2_buffer& buffer, cv::Mat& held);
+  bool lend(const v4l2_buffer& buffer, Frame& out);
   std::string where() const;
 
   std::string camera_;
   V4l2Settings settings_;
-  std::unique_ptr<V4l2Device> device_;
+  std::shared_ptr<V4l2Device> device_;  // shared with the buffers, which frames may hold longer
   JpegDecoder jpeg_;
   V4l2Format format_ = V4l2Format::kAuto;
   PixelLayout layout_ = PixelLayout::kYuyv;
@@ -103,9 +115,10 @@ class V4l2Source final : public FrameSource {
   std::uint32_t bufferType_ = 0;           // V4L2_BUF_TYPE_VIDEO_CAPTURE or ..._MPLANE
   std::vector<std::size_t> bytesPerLine_;  // per plane
   Timestamp period_{0};
-  std::vector<std::vector<MappedPlane>> buffers_;  // per buffer, per plane
-  std::vector<int> dmabufs_;
+  std::shared_ptr<V4l2Buffers> buffers_;  // this streaming session's
+  std::vector<int> dmabufs_;              // buffers_'s exports, in order
   bool requested_ = false;  // buffers were requested (VIDIOC_REQBUFS) and must be released
+  std::atomic<bool> lend_ = false;
   bool streaming_ = false;
   std::uint64_t reopened_ = 0;
   std::string error_;

@@ -98,6 +98,7 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
     bool exportsDmabuf = false;  // VIDIOC_EXPBUF answers (with /dev/null descriptors)
     int opens = 0;
     std::uint64_t produced = 0;
+    std::uint64_t queued = 0;  // VIDIOC_QBUF calls
     std::int64_t firstTimestampUs = 1'000'000;
     std::int64_t periodUs = 33'333;
     std::function<cv::Mat(std::uint64_t frame, cv::Size size)> picture;
@@ -122,7 +123,7 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
   void close() override {
     open_ = false;
     streaming_ = false;
-    buffers_.clear();
+    retire();
     queue_.clear();
   }
   void* map(std::size_t length, std::int64_t offset) override {
@@ -208,6 +209,7 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
       case VIDIOC_REQBUFS: {
         const auto* wanted = static_cast<v4l2_requestbuffers*>(argument);
         if (wanted->type != type) return EINVAL;
+        retire();
         buffers_.assign(wanted->count, {});
         for (auto& planes : buffers_) {
           for (std::uint32_t p = 0; p < planeCount(); ++p) planes.emplace_back(planeBytes(p));
@@ -246,6 +248,7 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
           return EINVAL;
         }
         queue_.push_back(buffer->index);
+        ++state_->queued;
         return 0;
       }
       case VIDIOC_DQBUF: {
@@ -268,6 +271,13 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
   }
 
  private:
+  // Like the kernel, which keeps a mapped buffer until it is unmapped: buffers released (closed,
+  // requested anew) stay where they are for the device's life.
+  void retire() {
+    for (auto& planes : buffers_) retired_.push_back(std::move(planes));
+    buffers_.clear();
+  }
+
   std::vector<std::uint32_t> distinctFourccs() const {
     std::vector<std::uint32_t> fourccs;
     for (const auto& mode : state_->modes) {
@@ -414,6 +424,7 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
   bool streaming_ = false;
   Mode mode_{};
   std::vector<std::vector<std::vector<std::uint8_t>>> buffers_;  // per buffer, per plane
+  std::vector<std::vector<std::vector<std::uint8_t>>> retired_;
   std::deque<std::uint32_t> queue_;
 };
 

@@ -5,6 +5,7 @@
 #include "capture/v4l2_source.hpp"
 
 #include <functional>
+#include <tuple>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -249,6 +250,109 @@ TEST(V4l2Source, ExportsItsBuffersAsDmabufWhereTheDriverCan) {
   V4l2Source source = sourceOn(state);
   ASSERT_EQ(source.dmabufs().size(), 4u);
   for (const int fd : source.dmabufs()) EXPECT_GE(fd, 0);
+}
+
+// Lent, a frame is the driver's buffer: its picture, and where a GPU finds it as a DMABUF.
+void expectLent(const Frame& frame, const V4l2Source& source, int picture) {
+  ASSERT_EQ(frame.dmabuf.planes, frame.format == PixelFormat::kNv12 ? 2u : 1u);
+  EXPECT_NE(std::ranges::find(source.dmabufs(), frame.dmabuf.fd[0]), source.dmabufs().end());
+  EXPECT_NE(frame.image.data, frame.loan.own.data);
+  const auto pitch = static_cast<std::uint32_t>(
+      frame.format == PixelFormat::kNv12 ? kSize.width : kSize.width * 2);
+  EXPECT_EQ(frame.dmabuf.pitch[0], pitch);
+  EXPECT_EQ(frame.dmabuf.offset[0], 0u);
+  if (frame.dmabuf.planes == 2) {
+    EXPECT_EQ(frame.dmabuf.fd[1], frame.dmabuf.fd[0]);  // NV12 in one buffer: chroma after luma
+    EXPECT_EQ(frame.dmabuf.offset[1], pitch * static_cast<std::uint32_t>(kSize.height));
+  }
+  EXPECT_GE(cv::PSNR(bgrOf(frame), surroundd::testing::syntheticPicture(kSize, picture)), 28.0);
+}
+
+TEST(V4l2Source, LendsItsBuffersToFramesWhileTwoStayWithTheDriver) {
+  for (const auto fourcc : {V4L2_PIX_FMT_YUYV, V4L2_PIX_FMT_NV12}) {
+    SCOPED_TRACE(testing::fourccName(fourcc));
+    const auto state = deviceOffering({{fourcc, kSize}});
+    state->exportsDmabuf = true;
+    V4l2Source source = sourceOn(state);  // 4 buffers
+    EXPECT_EQ(source.lendBuffers(), nullptr);
+    FramePool pool(4, kSize, source.pixelFormat());
+    std::vector<const uchar*> own;
+    std::vector<FrameRef> held;
+    for (int k = 0; k < 3; ++k) {
+      held.push_back(pool.acquire(std::chrono::milliseconds(0)));
+      own.push_back(held.back()->image.data);
+      const std::uint64_t queued = state->queued;
+      ASSERT_EQ(source.read(*held.back()), ReadStatus::kFrame) << source.lastError();
+      if (k < 2) {
+        expectLent(*held.back(), source, k);
+        EXPECT_EQ(state->queued, queued) << "a lent buffer went back to the driver";
+      } else {  // two lent, two with the driver: copied
+        EXPECT_EQ(held.back()->dmabuf.planes, 0u);
+        EXPECT_EQ(held.back()->image.data, own.back());
+        EXPECT_EQ(state->queued, queued + 1);
+      }
+    }
+    const std::uint64_t queued = state->queued;
+    held.front().reset();  // back to the pool: its buffer back to the driver
+    EXPECT_EQ(state->queued, queued + 1);
+    FrameRef again = pool.acquire(std::chrono::milliseconds(0));
+    EXPECT_EQ(again->image.data, own.front()) << "the frame's own picture is back";
+    EXPECT_EQ(again->dmabuf.planes, 0u);
+    ASSERT_EQ(source.read(*again), ReadStatus::kFrame) << source.lastError();
+    expectLent(*again, source, 3);
+    EXPECT_NE(again->dmabuf.buffer, 0u);
+  }
+}
+
+TEST(V4l2Source, SaysWhyItsFramesCannotBeLentItsBuffersAndCopiesThem) {
+  for (const auto& [fourcc, multiplanar, exports, why] :
+       {std::tuple{V4L2_PIX_FMT_MJPEG, false, true, "its frames are converted to BGR"},
+        std::tuple{V4L2_PIX_FMT_NV12M, true, true, "its NV12 comes in two buffers"},
+        std::tuple{V4L2_PIX_FMT_YUYV, false, false, "its driver exports no DMABUF"},
+        std::tuple{V4L2_PIX_FMT_YUYV, true, true, "its lines are padded"}}) {
+    SCOPED_TRACE(testing::fourccName(fourcc));
+    const auto state = deviceOffering({{fourcc, kSize}});
+    state->exportsDmabuf = exports;
+    state->multiplanar = multiplanar;
+    state->linePadding = 64;
+    V4l2Source source = sourceOn(state);
+    const char* refusal = source.lendBuffers();
+    ASSERT_NE(refusal, nullptr);
+    EXPECT_THAT(refusal, HasSubstr(why));
+    Frame frame = frameOf(source);
+    ASSERT_EQ(source.read(frame), ReadStatus::kFrame) << source.lastError();
+    EXPECT_EQ(frame.dmabuf.planes, 0u);
+    EXPECT_FALSE(frame.loan.lender);
+  }
+}
+
+// The kernel keeps a buffer mapped until it is unmapped, whatever happens to its device; so does
+// the source, until the frame lent it lets it go.
+TEST(V4l2Source, AFrameKeepsItsLentBufferWhenTheCameraIsLostAndReopened) {
+  const auto state = deviceOffering({{V4L2_PIX_FMT_YUYV, kSize}});
+  state->exportsDmabuf = true;
+  auto source =
+      std::make_unique<V4l2Source>("front", settingsFor(), std::make_unique<FakeV4l2Device>(state));
+  ASSERT_EQ(source->lendBuffers(), nullptr);
+  FramePool pool(2, kSize, source->pixelFormat());
+  FrameRef lent = pool.acquire(std::chrono::milliseconds(0));
+  ASSERT_EQ(source->read(*lent), ReadStatus::kFrame);
+  const cv::Mat picture = lent->image.clone();
+  const std::uint64_t lentBuffer = lent->dmabuf.buffer;
+  state->plugged = false;
+  FrameRef next = pool.acquire(std::chrono::milliseconds(0));
+  EXPECT_EQ(source->read(*next), ReadStatus::kLost);
+  state->plugged = true;
+  source->reopen();
+  ASSERT_EQ(source->read(*next), ReadStatus::kFrame) << source->lastError();
+  const std::uint64_t queued = state->queued;
+  EXPECT_EQ(cv::norm(lent->image, picture, cv::NORM_INF), 0.0);
+  EXPECT_NE(next->dmabuf.buffer, lentBuffer) << "a buffer of the new session under an old name";
+  lent.reset();  // its session is over: nothing goes back to the driver
+  EXPECT_EQ(state->queued, queued);
+  next.reset();
+  source.reset();  // and a frame may outlive its source
+  EXPECT_EQ(pool.available(), 2u);
 }
 
 TEST(V4l2Source, TheKernelPathSaysWhatIsWrongWithTheNode) {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -14,6 +15,7 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include "capture/frame.hpp"
 #include "capture/v4l2_source.hpp"
 #include "common/pixel_format.hpp"
 #include "tests/support/vivid_cameras.hpp"
@@ -31,15 +33,6 @@ class VividCameras : public ::testing::Test {
     }
   }
 
-  static V4l2Settings settingsFor(const std::filesystem::path& device, V4l2Format format) {
-    V4l2Settings settings;
-    settings.device = device;
-    settings.size = {640, 360};
-    settings.format = format;
-    settings.timeout = std::chrono::milliseconds(3000);  // an emulated CPU draws the bars slowly
-    return settings;
-  }
-
   // A frame of the source's held format, read; its picture in BGR.
   static cv::Mat readPicture(V4l2Source& source, Frame& frame) {
     if (frame.image.empty()) {
@@ -55,11 +48,24 @@ class VividCameras : public ::testing::Test {
   std::vector<std::filesystem::path> cameras_;
 };
 
+// Each bar's middle, below the text vivid writes at the top, within 12 levels.
+void expectBars(const cv::Mat& picture) {
+  ASSERT_EQ(picture.size(), cv::Size(640, 360));
+  for (std::size_t bar = 0; bar < testing::kVividBars.size(); ++bar) {
+    const int x = static_cast<int>((2 * bar + 1) * 640 / 16);
+    const cv::Vec3b& shown = picture.at<cv::Vec3b>(300, x);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(shown[c], testing::kVividBars[bar][static_cast<std::size_t>(c)], 12)
+          << "bar " << bar << " channel " << c;
+    }
+  }
+}
+
 TEST_F(VividCameras, EachFormatShowsTheColourBarsThroughBothApis) {
   for (std::size_t camera = 0; camera < 2; ++camera) {  // one single-planar, one multi-planar
     for (const V4l2Format format : {V4l2Format::kYuyv, V4l2Format::kUyvy, V4l2Format::kNv12}) {
       SCOPED_TRACE(cameras_[camera].string() + " " + toString(format));
-      V4l2Source source("vivid", settingsFor(cameras_[camera], format));
+      V4l2Source source("vivid", testing::vividSettings(cameras_[camera], format));
       EXPECT_EQ(source.multiplanar(), camera == 1);
       EXPECT_EQ(source.format(), format);
       Frame frame;
@@ -70,16 +76,7 @@ TEST_F(VividCameras, EachFormatShowsTheColourBarsThroughBothApis) {
         EXPECT_GT(frame.timestamp, previous);
         previous = frame.timestamp;
       }
-      ASSERT_EQ(picture.size(), cv::Size(640, 360));
-      // Each bar's middle, below the text vivid writes at the top.
-      for (std::size_t bar = 0; bar < testing::kVividBars.size(); ++bar) {
-        const int x = static_cast<int>((2 * bar + 1) * 640 / 16);
-        const cv::Vec3b shown = picture.at<cv::Vec3b>(300, x);
-        for (int c = 0; c < 3; ++c) {
-          EXPECT_NEAR(shown[c], testing::kVividBars[bar][static_cast<std::size_t>(c)], 12)
-              << "bar " << bar << " channel " << c;
-        }
-      }
+      expectBars(picture);
     }
   }
 }
@@ -87,7 +84,7 @@ TEST_F(VividCameras, EachFormatShowsTheColourBarsThroughBothApis) {
 TEST_F(VividCameras, ItsBuffersAreExportedAsDmabufs) {
   for (std::size_t camera = 0; camera < 2; ++camera) {
     SCOPED_TRACE(cameras_[camera].string());
-    V4l2Settings settings = settingsFor(cameras_[camera], V4l2Format::kNv12);
+    V4l2Settings settings = testing::vividSettings(cameras_[camera], V4l2Format::kNv12);
     V4l2Source source("vivid", settings);
     // One per buffer: vivid offers NV12 in one buffer on both APIs, which the source takes before
     // NV12M (two).
@@ -103,11 +100,64 @@ TEST_F(VividCameras, ItsBuffersAreExportedAsDmabufs) {
   }
 }
 
+// The picture where the frame's DMABUF says it is, mapped through the descriptor.
+cv::Mat dmabufPicture(const Frame& frame) {
+  const DmabufPlanes& planes = frame.dmabuf;
+  const std::size_t rows = static_cast<std::size_t>(frame.image.rows);
+  const std::size_t bytes = planes.offset[0] + planes.pitch[0] * rows;
+  void* mapped = ::mmap(nullptr, bytes, PROT_READ, MAP_SHARED, planes.fd[0], 0);
+  if (mapped == MAP_FAILED) return {};
+  cv::Mat picture = cv::Mat(frame.image.size(), frame.image.type(),
+                            static_cast<std::uint8_t*>(mapped) + planes.offset[0], planes.pitch[0])
+                        .clone();
+  ::munmap(mapped, bytes);
+  return picture;
+}
+
+TEST_F(VividCameras, FramesLentItsBuffersAreThemAndTheStreamGoesOn) {
+  for (std::size_t camera = 0; camera < 2; ++camera) {
+    for (const V4l2Format format : {V4l2Format::kYuyv, V4l2Format::kNv12}) {
+      SCOPED_TRACE(cameras_[camera].string() + " " + toString(format));
+      V4l2Source source("vivid", testing::vividSettings(cameras_[camera], format));  // 4 buffers
+      ASSERT_EQ(source.lendBuffers(), nullptr);
+      FramePool pool(6, source.frameSize(), source.pixelFormat());
+      std::vector<FrameRef> held;
+      Timestamp previous{0};
+      const auto read = [&] {
+        held.push_back(pool.acquire(std::chrono::milliseconds(0)));
+        EXPECT_EQ(source.read(*held.back()), ReadStatus::kFrame) << source.lastError();
+        EXPECT_GT(held.back()->timestamp, previous);
+        previous = held.back()->timestamp;
+      };
+      for (int k = 0; k < 2; ++k) {
+        read();
+        const Frame& lent = *held.back();
+        ASSERT_EQ(lent.dmabuf.planes, format == V4l2Format::kNv12 ? 2u : 1u);
+        EXPECT_NE(std::ranges::find(source.dmabufs(), lent.dmabuf.fd[0]), source.dmabufs().end());
+        EXPECT_EQ(cv::norm(dmabufPicture(lent), lent.image, cv::NORM_INF), 0.0)
+            << "the DMABUF holds another picture";
+        cv::Mat bgr;
+        heldToBgr(lent.image, lent.format, bgr);
+        expectBars(bgr);
+      }
+      // Two lent: the driver keeps two, and the frames read meanwhile are copies.
+      for (int k = 0; k < 3; ++k) {
+        read();
+        EXPECT_EQ(held.back()->dmabuf.planes, 0u);
+        held.pop_back();
+      }
+      held.clear();  // the lent buffers back to the driver
+      read();
+      EXPECT_GT(held.back()->dmabuf.planes, 0u);
+    }
+  }
+}
+
 TEST_F(VividCameras, FourCamerasStreamAtOnce) {
   std::vector<std::unique_ptr<V4l2Source>> sources;
   for (const auto& camera : cameras_) {
     sources.push_back(
-        std::make_unique<V4l2Source>("vivid", settingsFor(camera, V4l2Format::kYuyv)));
+        std::make_unique<V4l2Source>("vivid", testing::vividSettings(camera, V4l2Format::kYuyv)));
   }
   std::vector<Frame> frames(sources.size());
   std::vector<Timestamp> previous(sources.size(), Timestamp{0});

@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "capture/v4l2_source.hpp"
+
 namespace surroundd::testing {
 
 // Every vivid capture device, in the order the driver made them.
@@ -29,6 +31,17 @@ inline std::vector<std::filesystem::path> vividCameras() {
   devices.reserve(found.size());
   for (const auto& [name, device] : found) devices.push_back(device);
   return devices;
+}
+
+// A vivid device's settings for a camera of `format` and `size`.
+inline capture::V4l2Settings vividSettings(const std::filesystem::path& device,
+                                           capture::V4l2Format format, cv::Size size = {640, 360}) {
+  capture::V4l2Settings settings;
+  settings.device = device;
+  settings.size = size;
+  settings.format = format;
+  settings.timeout = std::chrono::milliseconds(3000);  // an emulated CPU draws the bars slowly
+  return settings;
 }
 
 // vivid's 75% colour bars, left to right, in BGR: white, yellow, cyan, green, magenta, red, blue,
