@@ -86,6 +86,7 @@ Pipeline::Pipeline(const Config& config, RunStart start)
     stages_.push_back(std::move(stage));
     panorama->setWanted(
         [surround = surround_](FrameWork& work) { return surround->needsPanorama(work); });
+    if (surround_->stitchesOnGpu()) lendCameraBuffers(config);
   }
   if (surround_ == nullptr && config.processing.backend == ProcessingBackend::kGpu) {
     spdlog::info("processing: cpu (no surround output: the GPU stitch is for the surround views)");
@@ -94,6 +95,24 @@ Pipeline::Pipeline(const Config& config, RunStart start)
   openOutputs(config, mosaicStage, panorama);
   if (surround_ != nullptr) {
     surround_->prepare(outputs_, config.capture.pacing == capture::Pacing::kAsFastAsPossible);
+  }
+}
+
+void Pipeline::lendCameraBuffers(const Config& config) {
+  // Only for a GPU that imports them: a CPU stitch would read the driver's buffers in place,
+  // which on many embedded capture drivers are not cached.
+  const std::string& refusal = surround_->dmabufImportRefusal();
+  for (std::size_t c = 0; c < cameras_.size(); ++c) {
+    if (!config.cameras[c].device) continue;
+    const std::string& name = cameras_[c]->name();
+    const char* why = refusal.empty() ? cameras_[c]->lendBuffers() : refusal.c_str();
+    if (why == nullptr) {
+      spdlog::info("capture: camera '{}': frames lent the driver's buffers, for the GPU to import",
+                   name);
+    } else {
+      spdlog::info("capture: camera '{}': frames copied out of the driver's buffers: {}", name,
+                   why);
+    }
   }
 }
 

@@ -121,6 +121,8 @@ class Pipeline {
   using Clock = std::chrono::steady_clock;
 
   void openOutputs(const Config& config, const MosaicStage& mosaic, const PanoramaStage* panorama);
+  // The V4L2 cameras' frames lent their drivers' buffers where the GPU stitch can import them.
+  void lendCameraBuffers(const Config& config);
   void fillNeeds(const std::atomic<bool>& stop);
   // The next complete set; with latestWins_, the newest, the older ones counted as stale.
   std::optional<capture::FrameSet> nextSet(const std::atomic<bool>& stop);

@@ -57,6 +57,19 @@ CameraTexture::CameraTexture(PixelFormat format, cv::Size size)
   }
   glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
   gl::check(fmt::format("creating a {} camera texture", toString(format)).c_str());
+  shown_ = {pixels_.name(), format_ == PixelFormat::kNv12 ? chroma_.name() : 0};
+}
+
+bool CameraTexture::import(const DmabufPlanes& planes) {
+  if (!import_) import_ = std::make_unique<DmabufImport>(format_, size_);
+  const auto textures = import_->texturesOf(planes);
+  if (textures) shown_ = *textures;
+  return textures.has_value();
+}
+
+const std::string& CameraTexture::importRefusal() const {
+  static const std::string kNone;
+  return import_ ? import_->refusal() : kNone;
 }
 
 void CameraTexture::upload(const cv::Mat& held) {
@@ -111,6 +124,7 @@ void CameraTexture::commit() {
   }
   glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
   gl::check("uploading a camera frame");
+  shown_ = {pixels_.name(), format_ == PixelFormat::kNv12 ? chroma_.name() : 0};
 }
 
 }  // namespace surroundd::render

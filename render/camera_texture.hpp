@@ -10,14 +10,20 @@
 // still be reading the other, so neither waits for the other. The filling may run on any thread
 // (map() and commit() on the GL thread, the copy in between anywhere), so that a caller can copy
 // several cameras' frames at once.
+//
+// A frame that lies in a DMABUF may be imported instead (render/dmabuf_import.hpp): no copy at
+// all. The textures sampled are then the import's, until the next upload.
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 
 #include <opencv2/core.hpp>
 
+#include "common/dmabuf_planes.hpp"
 #include "common/pixel_format.hpp"
+#include "render/dmabuf_import.hpp"
 #include "render/gl_objects.hpp"
 
 namespace surroundd::render {
@@ -35,13 +41,18 @@ class CameraTexture {
   void check(const cv::Mat& held) const;
   std::span<std::uint8_t> map();
   void commit();
+  // Takes the frame from the DMABUF it lies in instead: true when it did; false, and nothing
+  // changed, when it cannot (importRefusal() says why; the import is not tried again).
+  bool import(const DmabufPlanes& planes);
+  // Why frames are not imported (empty before the first import() and while they are).
+  const std::string& importRefusal() const;
 
   PixelFormat format() const { return format_; }
   cv::Size size() const { return size_; }
-  // YUYV and BGR: the one texture; NV12: the luma.
-  GLuint pixels() const { return pixels_.name(); }
+  // The frame last uploaded or imported. YUYV and BGR: the one texture; NV12: the luma.
+  GLuint pixels() const { return shown_[0]; }
   // NV12: the chroma texture; 0 for the others.
-  GLuint chroma() const { return format_ == PixelFormat::kNv12 ? chroma_.name() : 0; }
+  GLuint chroma() const { return shown_[1]; }
 
  private:
   PixelFormat format_;
@@ -51,6 +62,8 @@ class CameraTexture {
   gl::Texture chroma_;
   std::array<gl::Buffer, 2> buffers_;
   std::size_t next_ = 0;
+  std::array<GLuint, 2> shown_{};         // the textures holding the last frame
+  std::unique_ptr<DmabufImport> import_;  // from the first import() on
 };
 
 }  // namespace surroundd::render

@@ -13,11 +13,6 @@
 #include "render/render_error.hpp"
 
 namespace surroundd::render {
-namespace {
-
-// GL_RENDERER of the renderers that run on the CPU.
-constexpr std::array<std::string_view, 4> kSoftwareRenderers{"llvmpipe", "softpipe", "swrast",
-                                                             "SwiftShader"};
 
 bool hasExtension(const char* list, std::string_view name) {
   if (list == nullptr) return false;
@@ -29,6 +24,12 @@ bool hasExtension(const char* list, std::string_view name) {
   }
   return false;
 }
+
+namespace {
+
+// GL_RENDERER of the renderers that run on the CPU.
+constexpr std::array<std::string_view, 4> kSoftwareRenderers{"llvmpipe", "softpipe", "swrast",
+                                                             "SwiftShader"};
 
 std::string eglErrorText(std::string_view call) {
   return fmt::format("{} failed (EGL error 0x{:04x})", call, eglGetError());

@@ -15,6 +15,7 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include <EGL/egl.h>
 
@@ -70,6 +71,9 @@ class EglContext {
 };
 
 const char* toString(EglPlatform platform);
+
+// Whether an extension list (eglQueryString(display, EGL_EXTENSIONS)) names `name`.
+bool hasExtension(const char* list, std::string_view name);
 
 // Whether the renderer of the context current on this thread runs on the CPU (as
 // EglContext::software() says of its own).

@@ -1,5 +1,6 @@
 #include "render/gpu_stitcher.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
@@ -7,6 +8,7 @@
 
 #include <fmt/core.h>
 #include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
 
 #include "common/work_pool.hpp"
 #include "render/render_error.hpp"
@@ -193,6 +195,8 @@ GpuStitcher::GpuStitcher(const PanoramaLut& lut, PixelFormat format, WorkPool& p
   cameras_.reserve(lut.cameraSizes.size());
   for (const cv::Size& cameraSize : lut.cameraSizes) cameras_.emplace_back(format, cameraSize);
   mapped_.resize(cameras_.size());
+  imported_.resize(cameras_.size());
+  importLogged_.resize(cameras_.size());
 
   uploadTaps(taps_.name(), size_, lut.taps.data());
   // The blend taps spread out to one per pixel (weight 0: none), so that the shader finds a
@@ -242,15 +246,17 @@ GpuStitcher::GpuStitcher(const PanoramaLut& lut, PixelFormat format, WorkPool& p
   gl::check("setting up the GPU stitch");
 }
 
-void GpuStitcher::upload(std::span<const cv::Mat> frames) {
-  if (frames.size() != cameras_.size()) {
-    throw std::invalid_argument(
-        fmt::format("the GPU stitch takes {} frames, got {}", cameras_.size(), frames.size()));
+void GpuStitcher::upload(std::span<const cv::Mat> frames, std::span<const DmabufPlanes> dmabufs) {
+  if (frames.size() != cameras_.size() || (!dmabufs.empty() && dmabufs.size() != frames.size())) {
+    throw std::invalid_argument(fmt::format("the GPU stitch takes {} frames, got {} ({} DMABUFs)",
+                                            cameras_.size(), frames.size(), dmabufs.size()));
   }
-  for (std::size_t camera = 0; camera < frames.size(); ++camera)
-    cameras_[camera].check(frames[camera]);
   for (std::size_t camera = 0; camera < frames.size(); ++camera) {
-    mapped_[camera] = cameras_[camera].map();
+    cameras_[camera].check(frames[camera]);
+    const bool inDmabuf = !dmabufs.empty() && dmabufs[camera].planes > 0;
+    imported_[camera] = static_cast<char>(inDmabuf && cameras_[camera].import(dmabufs[camera]));
+    if (inDmabuf) logImport(camera);
+    mapped_[camera] = imported_[camera] != 0 ? std::span<std::uint8_t>() : cameras_[camera].map();
   }
   // Each camera's bytes in a few pieces, so that every thread has a share whatever the count.
   constexpr int kPieces = 4;
@@ -261,10 +267,26 @@ void GpuStitcher::upload(std::span<const cv::Mat> frames) {
       const std::span<std::uint8_t> buffer = mapped_[camera];
       const std::size_t first = buffer.size() * (piece % kPieces) / kPieces;
       const std::size_t last = buffer.size() * (piece % kPieces + 1) / kPieces;
-      std::memcpy(buffer.data() + first, frames[camera].data + first, last - first);
+      if (last > first)
+        std::memcpy(buffer.data() + first, frames[camera].data + first, last - first);
     }
   });
-  for (auto& camera : cameras_) camera.commit();
+  for (std::size_t camera = 0; camera < frames.size(); ++camera) {
+    if (imported_[camera] == 0) cameras_[camera].commit();
+  }
+}
+
+void GpuStitcher::logImport(std::size_t camera) {
+  const char said = imported_[camera] != 0 ? 1 : 2;
+  if (importLogged_[camera] == said) return;
+  importLogged_[camera] = said;
+  if (said == 1) {
+    spdlog::info("processing: camera {}'s frames are taken from their DMABUFs, with no copy",
+                 camera);
+  } else {
+    spdlog::warn("processing: camera {}'s frames are uploaded through pixel buffers: {}", camera,
+                 cameras_[camera].importRefusal());
+  }
 }
 
 void GpuStitcher::correctWith(const processing::PoissonColourCorrection* correction) {
@@ -329,6 +351,15 @@ void GpuStitcher::stitch() {
   glBindVertexArray(0);
   glActiveTexture(GL_TEXTURE0);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  if (std::ranges::any_of(imported_, [](char imported) { return imported != 0; })) {
+    GLsync read = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    constexpr GLuint64 kSecond = 1'000'000'000;
+    const GLenum waited = glClientWaitSync(read, GL_SYNC_FLUSH_COMMANDS_BIT, kSecond);
+    glDeleteSync(read);
+    if (waited == GL_TIMEOUT_EXPIRED || waited == GL_WAIT_FAILED) {
+      throw RenderError("the GPU stitch of imported frames did not finish within a second");
+    }
+  }
   gl::check("stitching on the GPU");
 }
 

@@ -22,6 +22,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "common/dmabuf_planes.hpp"
 #include "common/pixel_format.hpp"
 #include "processing/colour/poisson_correction.hpp"
 #include "processing/stitch/panorama_lut.hpp"
@@ -45,13 +46,19 @@ class GpuStitcher {
   // frames[i]: camera i's frame held in format(), of the LUT's size for that camera; throws
   // std::invalid_argument otherwise. The copies into the mapped pixel buffers run on the pool
   // (one memcpy per thread cannot keep up with the bus: 12 GB/s where PCIe carries 25 or more).
-  void upload(std::span<const cv::Mat> frames);
+  // dmabufs[i], where given, says where camera i's frame lies in DMABUFs: it is imported instead
+  // (CameraTexture::import), and uploaded where it cannot be. Which way each camera's frames go is
+  // logged when it changes. Until stitch() has run, the DMABUFs must stay as they are.
+  void upload(std::span<const cv::Mat> frames, std::span<const DmabufPlanes> dmabufs = {});
+  // Whether camera i's last frame was imported rather than uploaded.
+  bool imported(std::size_t camera) const { return imported_[camera]; }
   // Applies `correction`'s field from the next stitch() on, as it stands after each update()
   // (borrowed: it must outlive its use here); nullptr: none. Set-up, not per frame: the first
   // call for a correction uploads its seam-band shares (two bytes a panorama pixel).
   void correctWith(const processing::PoissonColourCorrection* correction);
   // Writes the panorama texture from the frames last uploaded (and the correction's field as it
-  // is now). Leaves framebuffer 0 bound and texture unit 0 active.
+  // is now), and waits for the GPU to have read any imported frame: their buffers go back to the
+  // camera's driver once the set is done. Leaves framebuffer 0 bound and texture unit 0 active.
   void stitch();
 
   // RGBA8, the LUT's size, row 0 the panorama's top at texture coordinate t = 0, repeated
@@ -65,13 +72,17 @@ class GpuStitcher {
   void readPanorama(cv::Mat& bgr) const;
 
  private:
+  void logImport(std::size_t camera);
+
   cv::Size size_;
   PixelFormat format_;
   WorkPool& pool_;
   std::vector<CameraTexture> cameras_;
   std::vector<std::span<std::uint8_t>> mapped_;  // each camera's buffer while an upload fills it
-  gl::Texture taps_;                             // RG32UI: each pixel's LutTap as two words
-  gl::Texture blends_;  // the same for its blend tap; weight 0 where it has none
+  std::vector<char> imported_;                   // per camera: its last frame imported
+  std::vector<char> importLogged_;  // per camera: 0 nothing said, 1 imported, 2 uploaded
+  gl::Texture taps_;                // RG32UI: each pixel's LutTap as two words
+  gl::Texture blends_;              // the same for its blend tap; weight 0 where it has none
   const processing::PoissonColourCorrection* correction_ = nullptr;
   gl::Texture field_;   // RGB32F, the correction's block grid
   gl::Texture shares_;  // R16UI, each panorama pixel's source share 0..256

@@ -21,6 +21,7 @@ PanoramaStage::PanoramaStage(const Config& config, WorkPool& pool)
       ownership_(lut_),
       corrected_(config.cameras.size()),
       stitched_(config.cameras.size()),
+      dmabufs_(config.cameras.size()),
       panorama_(lut_.size, CV_8UC3) {
   setUpColourCorrection(config, pool);
 }
@@ -70,6 +71,7 @@ PixelFormat PanoramaStage::gatherFrames(FrameWork& work) {
     // A faulty camera's picture would pull its neighbours' colours: correction goes without it.
     corrected_[c] = image != nullptr && work.faults[c] == nullptr ? *image : cv::Mat();
     stitched_[c] = image != nullptr ? *image : blackFrame(c, format);
+    dmabufs_[c] = frame != nullptr && image == &frame->image ? frame->dmabuf : DmabufPlanes{};
   }
   return format;
 }

@@ -15,6 +15,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "common/dmabuf_planes.hpp"
 #include "common/work_pool.hpp"
 #include "daemon/config.hpp"
 #include "daemon/pipeline_stage.hpp"
@@ -49,6 +50,9 @@ class PanoramaStage final : public PipelineStage {
   // The frames of the set process() was last given, as the stitch samples them (a missing
   // camera's black), all held in frameFormat(): for a stitch elsewhere (the GPU's).
   const std::vector<cv::Mat>& frames() const { return stitched_; }
+  // Where each of those frames lies in its driver's DMABUFs, where it was lent one (planes 0
+  // where not): for a GPU to import it instead.
+  const std::vector<DmabufPlanes>& dmabufs() const { return dmabufs_; }
   PixelFormat frameFormat() const { return format_; }
   // The Poisson correction, updated by each process(); null with another colour_correction.
   const processing::PoissonColourCorrection* poisson() const { return poisson_.get(); }
@@ -100,8 +104,9 @@ class PanoramaStage final : public PipelineStage {
   processing::PanoramaOwnership ownership_;
   std::unique_ptr<processing::PoissonColourCorrection> poisson_;  // colour_correction: poisson
   std::unique_ptr<processing::GainCompensation> gains_;           // colour_correction: gain
-  std::vector<cv::Mat> corrected_;  // this set's frames (headers) that colour correction sees
-  std::vector<cv::Mat> stitched_;   // this set's frames (headers), black for missing cameras
+  std::vector<cv::Mat> corrected_;     // this set's frames (headers) that colour correction sees
+  std::vector<cv::Mat> stitched_;      // this set's frames (headers), black for missing cameras
+  std::vector<DmabufPlanes> dmabufs_;  // where those lie in DMABUFs
   PixelFormat format_ = PixelFormat::kBgr;                       // the one both hold this set
   std::array<std::vector<cv::Mat>, kPixelFormats> blackFrames_;  // per PixelFormat, per camera
   cv::Mat panorama_;

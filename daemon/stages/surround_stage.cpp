@@ -13,6 +13,7 @@
 #include "daemon/panorama_setup.hpp"
 #include "daemon/pipeline_ends.hpp"
 #include "processing/stitch/i420_picture.hpp"
+#include "render/dmabuf_import.hpp"
 #include "render/render_error.hpp"
 
 namespace surroundd::daemon {
@@ -142,6 +143,9 @@ SurroundStage::SurroundStage(const Config& config, SurroundRenderer renderer,
       why = "the GPU stitch could not be set up";
     }
   }
+  importRefusal_ =
+      gpu_ ? render::DmabufImport(cameraFormat, panorama.lut().cameraSizes.at(0)).refusal()
+           : "the panorama is stitched on the CPU";
   spdlog::info("processing: {} ({}){}", gpu_ ? "gpu" : "cpu", why,
                gpu_ ? fmt::format(", frames uploaded as {}", toString(cameraFormat)) : "");
 }
@@ -248,7 +252,7 @@ void SurroundStage::stitchOnGpu() {
   }
   {
     const render::GpuTimer::Scope timed(&gpuTimer_, render::GpuStep::kUpload);
-    gpu_->upload(panoramaStage_.frames());
+    gpu_->upload(panoramaStage_.frames(), panoramaStage_.dmabufs());
   }
   {
     const render::GpuTimer::Scope timed(&gpuTimer_, render::GpuStep::kStitch);

@@ -121,6 +121,9 @@ class SurroundStage final : public PipelineStage {
   render::EglContext& context() { return *gl_; }
   // Whether the GPU stitches the panorama (processing.backend as it came out on this renderer).
   bool stitchesOnGpu() const { return gpu_ != nullptr; }
+  // Why the GPU stitch cannot import camera frames from their DMABUFs (render/dmabuf_import.hpp);
+  // empty when it can.
+  const std::string& dmabufImportRefusal() const { return importRefusal_; }
   // The GPU's own time of each run of its steps so far (render/gpu_timer.hpp), read a set or two
   // after the run; none where the driver cannot time them (gpuTimed() false).
   const std::array<DurationHistogram, render::kGpuSteps>& gpuTimes() const { return gpuTimes_; }
@@ -184,7 +187,8 @@ class SurroundStage final : public PipelineStage {
   PanoramaStage& panoramaStage_;
   const cv::Mat& panorama_;
   std::unique_ptr<render::GpuStitcher> gpu_;  // processing.backend: gpu
-  bool panoramaOnGpu_ = false;                // the scene samples gpu_'s panorama (the last set's)
+  std::string importRefusal_;
+  bool panoramaOnGpu_ = false;  // the scene samples gpu_'s panorama (the last set's)
   bool viewLut_;
   GuidelineMode guidelineMode_;
   render::GuidelineSettings guide_;

@@ -3,7 +3,8 @@
 // through each V4L2 API), which ctest gives it on a virtual machine (LiveCameras.OnVividCameras,
 // scripts/device-vm.sh). The cameras are paced by the driver, not replayed: every camera keeps
 // streaming, frame sets are matched, and each camera's tile of a lossless video of the mosaic
-// shows its bars. Skipped, with a message, where the machine has no four vivid devices.
+// shows its bars; and the GPU stitch takes their frames lent the drivers' buffers. Skipped, with a
+// message, where the machine has no four vivid devices.
 
 #include <algorithm>
 #include <array>
@@ -12,12 +13,15 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "daemon/pipeline.hpp"
 #include "render/mosaic.hpp"
 #include "tests/daemon/replay_config.hpp"
+#include "tests/support/log_capture.hpp"
 #include "tests/support/test_support.hpp"
 #include "tests/support/vivid_cameras.hpp"
 
@@ -39,38 +43,54 @@ class StopAfter final : public PipelineObserver {
   std::uint64_t sets_;
 };
 
-TEST(LiveCameras, FourV4l2CamerasThroughTheKernelMakeTheMosaicAndMatchedSets) {
-  const auto devices = testing::vividCameras();
-  if (devices.size() < 4) {
-    GTEST_SKIP() << "no four vivid devices here (ctest runs this on a virtual machine's: "
-                    "LiveCameras.OnVividCameras)";
-  }
-  const testing::TempDir dir;
-  OutputConfig video = videoOutputAt(dir.path() / "mosaic.mkv");
-  video.stream = OutputStream::kMosaic;
-  video.crf = 0;
-  video.pixelFormat = "bgr24";
-  // The synthetic rig's calibration, at vivid's webcam size (320x180), its frames from vivid.
-  Config config = fixtureReplay("synth_small", {video});
+// The synthetic rig's calibration, at vivid's webcam size (320x180), its frames from vivid's
+// devices, camera i's in formats[i % 2].
+Config vividConfig(const std::vector<std::filesystem::path>& devices, const testing::TempDir& dir,
+                   const OutputConfig& output, std::array<capture::V4l2Format, 2> formats) {
+  Config config = fixtureReplay("synth_small", {output});
   config.capture.pacing = capture::Pacing::kRealtime;
   config.panorama.cacheDir = dir.path() / "cache";
-  std::vector<std::string> names;
   for (std::size_t i = 0; i < config.cameras.size(); ++i) {
     RigCamera& camera = config.cameras[i];
     camera.source.reset();
-    capture::V4l2Settings settings;
-    settings.device = devices[i];
-    settings.size = {320, 180};
-    settings.format = i % 2 == 0 ? capture::V4l2Format::kYuyv : capture::V4l2Format::kNv12;
-    settings.timeout = std::chrono::milliseconds(3000);  // an emulated CPU draws the bars slowly
+    capture::V4l2Settings settings = testing::vividSettings(devices[i], formats[i % 2], {320, 180});
     // 10 FPS: time for a set on the machine's emulated CPU, sanitizers and all.
     settings.fps = 10;
     camera.device = settings;
     // vivid's bars stand still (only its text at the top changes): left on, the check reports
     // every camera frozen after a second, rightly, and the mosaic dims their tiles.
     camera.frozenCheck = FrozenCheck::kOff;
-    names.push_back(camera.calibration.name);
   }
+  return config;
+}
+
+std::vector<std::string> namesOf(const Config& config) {
+  std::vector<std::string> names;
+  for (const auto& camera : config.cameras) names.push_back(camera.calibration.name);
+  return names;
+}
+
+class LiveCameras : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    devices_ = testing::vividCameras();
+    if (devices_.size() < 4) {
+      GTEST_SKIP() << "no four vivid devices here (ctest runs this on a virtual machine's: "
+                      "LiveCameras.OnVividCameras)";
+    }
+  }
+  std::vector<std::filesystem::path> devices_;
+  const testing::TempDir dir_;
+};
+
+TEST_F(LiveCameras, FourV4l2CamerasThroughTheKernelMakeTheMosaicAndMatchedSets) {
+  OutputConfig video = videoOutputAt(dir_.path() / "mosaic.mkv");
+  video.stream = OutputStream::kMosaic;
+  video.crf = 0;
+  video.pixelFormat = "bgr24";
+  const Config config =
+      vividConfig(devices_, dir_, video, {capture::V4l2Format::kYuyv, capture::V4l2Format::kNv12});
+  const std::vector<std::string> names = namesOf(config);
   std::atomic<bool> stop{false};
   StopAfter observer(stop, 15);
   Pipeline pipeline(config);
@@ -115,6 +135,58 @@ TEST(LiveCameras, FourV4l2CamerasThroughTheKernelMakeTheMosaicAndMatchedSets) {
     };
     EXPECT_TRUE(std::ranges::any_of(frames, showsTheBars)) << names[camera];
   }
+}
+
+// The GPU stitch on live cameras: their frames lent the drivers' buffers, which the stitch
+// imports where the driver can and uploads where not (this machine's llvmpipe refuses vivid's
+// DMABUFs), saying which; the buffers go back to the drivers as the sets end, so that every
+// camera streams on.
+TEST_F(LiveCameras, TheGpuStitchTakesFramesLentTheDriversBuffers) {
+  OutputConfig video = videoOutputAt(dir_.path() / "surround.mkv");
+  video.stream = OutputStream::kSurround;
+  Config config =
+      vividConfig(devices_, dir_, video, {capture::V4l2Format::kYuyv, capture::V4l2Format::kYuyv});
+  config.processing.backend = ProcessingBackend::kGpu;
+  config.render.widthPx = 320;
+  config.render.heightPx = 180;
+  config.panorama.widthPx = 512;  // the LUT built in a second on the emulated CPU
+  config.panorama.heightPx = 256;
+  const std::vector<std::string> names = namesOf(config);
+  const testing::LogCapture log;
+  std::atomic<bool> stop{false};
+  StopAfter observer(stop, 10);
+  RunSummary summary;
+  {
+    Pipeline pipeline(config);
+    summary = pipeline.run(stop, &observer);
+  }
+  ASSERT_GE(summary.frameSets, 10U);
+  EXPECT_EQ(summary.failedSets, 0U);
+  for (std::size_t camera = 0; camera < 4; ++camera) {
+    EXPECT_GE(summary.cameras[camera].frames, summary.frameSets) << names[camera];
+    EXPECT_EQ(summary.cameras[camera].faults, 0U) << names[camera];
+  }
+  const auto lines = log.lines();
+  const auto said = [&](const std::string& text) {
+    return std::ranges::count_if(
+        lines, [&](const std::string& line) { return line.find(text) != std::string::npos; });
+  };
+  for (const auto& name : names) {
+    EXPECT_EQ(said(fmt::format("camera '{}': frames lent the driver's buffers", name)), 1) << name;
+  }
+  // Each camera whose lent frame reached a GPU stitch (a set with a camera late or lost is
+  // stitched on the CPU, and an emulated CPU makes them late) says once which way its frames go.
+  std::size_t saidWhichWay = 0;
+  for (std::size_t camera = 0; camera < 4; ++camera) {
+    const auto ways =
+        said(fmt::format("camera {}'s frames are taken from their DMABUFs", camera)) +
+        said(fmt::format("camera {}'s frames are uploaded through pixel buffers: the driver "
+                         "refused to import a DMABUF",
+                         camera));
+    EXPECT_LE(ways, 1) << camera;
+    saidWhichWay += static_cast<std::size_t>(ways);
+  }
+  EXPECT_GE(saidWhichWay, 1U) << fmt::format("{}", fmt::join(lines, "\n"));
 }
 
 }  // namespace
