@@ -16,7 +16,6 @@
 // camera_texture.hpp), so that no byte of a frame is copied on the way.
 
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
@@ -118,7 +117,7 @@ class V4l2Source final : public FrameSource {
   std::shared_ptr<V4l2Buffers> buffers_;  // this streaming session's
   std::vector<int> dmabufs_;              // buffers_'s exports, in order
   bool requested_ = false;  // buffers were requested (VIDIOC_REQBUFS) and must be released
-  std::atomic<bool> lend_ = false;
+  bool lend_ = false;       // set before the source is read (FrameSource::lendBuffers)
   bool streaming_ = false;
   std::uint64_t reopened_ = 0;
   std::string error_;
