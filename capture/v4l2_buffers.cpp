@@ -25,6 +25,11 @@ V4l2Buffers::~V4l2Buffers() {
   }
 }
 
+void V4l2Buffers::add(std::vector<Plane> planes) {
+  buffers_.push_back(std::move(planes));
+  lent_.push_back(0);
+}
+
 v4l2_buffer V4l2Buffers::describe(std::span<v4l2_plane> planes) const {
   v4l2_buffer buffer{};
   buffer.type = type_;
@@ -65,8 +70,11 @@ void V4l2Buffers::stopStreaming() noexcept {
 bool V4l2Buffers::lend(std::uint32_t buffer) {
   const std::lock_guard lock(mutex_);
   // This one and two more would leave the driver nothing to fill while the next is read.
-  if (buffer >= buffers_.size() || lent_ + 3 > buffers_.size()) return false;
-  ++lent_;
+  if (buffer >= buffers_.size() || lent_[buffer] != 0 || lentCount_ + 3 > buffers_.size()) {
+    return false;
+  }
+  lent_[buffer] = 1;
+  ++lentCount_;
   return true;
 }
 
@@ -75,7 +83,9 @@ void V4l2Buffers::giveBack(std::uint32_t buffer) noexcept {
   v4l2_buffer queued = describe(planes);
   queued.index = buffer;
   const std::lock_guard lock(mutex_);
-  --lent_;
+  if (buffer >= lent_.size() || lent_[buffer] == 0) return;
+  lent_[buffer] = 0;
+  --lentCount_;
   if (!streaming_) return;
   if (const int error = device_->ioctl(VIDIOC_QBUF, &queued); error != 0) requeueError_ = error;
 }

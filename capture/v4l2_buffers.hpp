@@ -32,11 +32,11 @@ class V4l2Buffers final : public BufferLender {
   ~V4l2Buffers() override;  // unmaps, closes the exports
 
   // Set-up, before streaming.
-  void add(std::vector<Plane> planes) { buffers_.push_back(std::move(planes)); }
+  void add(std::vector<Plane> planes);
   std::span<const Plane> planes(std::uint32_t buffer) const { return buffers_[buffer]; }
   std::size_t count() const { return buffers_.size(); }
-  // Names `buffer` for as long as it exists, never another (DmabufPlanes::buffer).
-  std::uint64_t id(std::uint32_t buffer) const { return session_ * kMaxBuffers + buffer; }
+  // This process's streaming sessions, numbered from 1 (DmabufPlanes::session).
+  std::uint64_t session() const { return session_; }
   // A buffer of the session's type for QUERYBUF, QBUF and DQBUF; a multi-planar one points at
   // `planes` for its per-plane fields.
   v4l2_buffer describe(std::span<v4l2_plane> planes) const;
@@ -50,14 +50,13 @@ class V4l2Buffers final : public BufferLender {
   // Marks dequeued `buffer` lent when at least two others stay with the driver (so that it always
   // has one to fill while the next is read); false, and nothing lent, otherwise.
   bool lend(std::uint32_t buffer);
-  // Queues it again while the session streams. A refusal is kept for requeueError().
+  // Queues it again while the session streams; a buffer not lent is left alone (a frame given
+  // back twice must not queue it twice). A refusal is kept for requeueError().
   void giveBack(std::uint32_t buffer) noexcept override;
   // The errno of a give-back the driver refused since the last call, or 0.
   int requeueError();
 
  private:
-  static constexpr std::uint64_t kMaxBuffers = 64;  // VIDEO_MAX_FRAME is 32
-
   std::shared_ptr<V4l2Device> device_;
   std::uint64_t session_;  // this process's streaming sessions, counted from 1
   std::uint32_t type_;
@@ -65,7 +64,8 @@ class V4l2Buffers final : public BufferLender {
   std::vector<std::vector<Plane>> buffers_;
   std::mutex mutex_;  // the device's streaming calls, and what follows, from any thread
   bool streaming_ = false;
-  std::size_t lent_ = 0;
+  std::vector<char> lent_;  // per buffer
+  std::size_t lentCount_ = 0;
   int requeueError_ = 0;
 };
 

@@ -198,6 +198,7 @@ void V4l2Source::mapBuffers() {
                                    error != 0 ? errorText(error) : "too few granted"));
   }
   requested_ = true;
+  orphans_ = (request.capabilities & V4L2_BUF_CAP_SUPPORTS_ORPHANED_BUFS) != 0;
   buffers_ = std::make_shared<V4l2Buffers>(device_, bufferType_, bytesPerLine_.size());
   for (std::uint32_t i = 0; i < request.count; ++i) {
     std::array<v4l2_plane, VIDEO_MAX_PLANES> planes{};
@@ -264,6 +265,12 @@ const char* V4l2Source::lendingRefusal() const {
   }
   if (bytesPerLine_.size() > 1) return "its NV12 comes in two buffers, which no picture can view";
   if (dmabufs_.empty()) return "its driver exports no DMABUF";
+  if (dmabufs_.size() < buffers_->count()) return "its driver exported only some of its buffers";
+  // This one and two more, since two always stay with the driver (V4l2Buffers::lend).
+  if (buffers_->count() < 3) return "it has fewer than three buffers (capture.buffers)";
+  // Without, a camera lost while a frame holds a buffer could not be opened again until the frame
+  // let go of it (REQBUFS would be refused).
+  if (!orphans_) return "its driver cannot free buffers that a frame still holds";
   const cv::Size held = heldSize(heldFormat(layout_), settings_.size);
   if (bytesPerLine_[0] !=
       static_cast<std::size_t>(held.width) * CV_ELEM_SIZE(heldType(heldFormat(layout_)))) {
@@ -384,7 +391,8 @@ bool V4l2Source::lend(const v4l2_buffer& buffer, Frame& out) {
   out.dmabuf.pitch = {pitch, pitch};
   out.dmabuf.offset = {offset, offset + pitch * static_cast<std::uint32_t>(settings_.size.height)};
   out.dmabuf.planes = format == PixelFormat::kNv12 ? 2 : 1;
-  out.dmabuf.buffer = buffers_->id(buffer.index);
+  out.dmabuf.session = buffers_->session();
+  out.dmabuf.index = buffer.index;
   return true;
 }
 

@@ -117,6 +117,7 @@ class V4l2Source final : public FrameSource {
   std::shared_ptr<V4l2Buffers> buffers_;  // this streaming session's
   std::vector<int> dmabufs_;              // buffers_'s exports, in order
   bool requested_ = false;  // buffers were requested (VIDIOC_REQBUFS) and must be released
+  bool orphans_ = false;    // V4L2_BUF_CAP_SUPPORTS_ORPHANED_BUFS: buffers may outlive their stream
   bool lend_ = false;       // set before the source is read (FrameSource::lendBuffers)
   bool streaming_ = false;
   std::uint64_t reopened_ = 0;

@@ -12,9 +12,13 @@ struct DmabufPlanes {
   std::array<int, 2> fd{-1, -1};
   std::array<std::uint32_t, 2> offset{};  // bytes from the buffer's start
   std::array<std::uint32_t, 2> pitch{};   // bytes a line
-  // Names the buffer while it exists and is never given to another (descriptors are reused): what
-  // a GPU keeps an import under.
-  std::uint64_t buffer = 0;
+  // The buffer's name, which descriptors are not (they are reused): its driver's streaming
+  // session, numbered from 1 and growing in this process, and its index there. A GPU keeps an
+  // import under it, and lets the imports of a session go once a later one's buffers come.
+  std::uint64_t session = 0;
+  std::uint32_t index = 0;
+
+  bool operator==(const DmabufPlanes&) const = default;
 };
 
 }  // namespace surroundd

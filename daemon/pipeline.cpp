@@ -99,8 +99,10 @@ Pipeline::Pipeline(const Config& config, RunStart start)
 }
 
 void Pipeline::lendCameraBuffers(const Config& config) {
-  // Only for a GPU that imports them: a CPU stitch would read the driver's buffers in place,
-  // which on many embedded capture drivers are not cached.
+  // Only for a GPU that imports them: a CPU stitch would gather its pixels from the driver's
+  // buffers in place, which on many embedded capture drivers are not cached. The GPU path reads
+  // a lent frame once, in order, where the driver will not import it after all (its upload's
+  // copy, in place of capture's); colour correction reads only its seam samples.
   const std::string& refusal = surround_->dmabufImportRefusal();
   for (std::size_t c = 0; c < cameras_.size(); ++c) {
     if (!config.cameras[c].device) continue;

@@ -98,6 +98,12 @@ std::span<std::uint8_t> CameraTexture::map() {
   return {static_cast<std::uint8_t*>(mapped), bytes_};
 }
 
+void CameraTexture::unmap() {
+  glBindBuffer(GL_PIXEL_UNPACK_BUFFER, buffers_[next_].name());
+  glUnmapBuffer(GL_PIXEL_UNPACK_BUFFER);
+  glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+}
+
 void CameraTexture::commit() {
   glBindBuffer(GL_PIXEL_UNPACK_BUFFER, buffers_[next_].name());
   next_ = (next_ + 1) % buffers_.size();

@@ -41,6 +41,8 @@ class CameraTexture {
   void check(const cv::Mat& held) const;
   std::span<std::uint8_t> map();
   void commit();
+  // Gives a mapped buffer back unfilled: the textures keep the last frame.
+  void unmap();
   // Takes the frame from the DMABUF it lies in instead: true when it did; false, and nothing
   // changed, when it cannot (importRefusal() says why; the import is not tried again).
   bool import(const DmabufPlanes& planes);

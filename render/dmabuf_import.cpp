@@ -55,28 +55,48 @@ void DmabufImport::destroy(Imported& imported) {
   }
 }
 
+template <typename Drop>
+void DmabufImport::forget(Drop drop) {
+  const auto gone =
+      std::stable_partition(kept_.begin(), kept_.end(), [&](Imported& i) { return !drop(i); });
+  for (auto it = gone; it != kept_.end(); ++it) destroy(*it);
+  kept_.erase(gone, kept_.end());
+}
+
 std::optional<std::array<GLuint, 2>> DmabufImport::texturesOf(const DmabufPlanes& planes) {
   if (!refusal_.empty() || planes.planes == 0) return std::nullopt;
-  const auto known = std::ranges::find(kept_, planes.buffer, &Imported::buffer);
-  if (known != kept_.end()) {
-    return std::array{known->textures[0].name(), planes.planes > 1 ? known->textures[1].name() : 0};
+  const auto texturesIn = [&](const Imported& imported) {
+    return std::array{imported.textures[0].name(),
+                      planes.planes > 1 ? imported.textures[1].name() : 0};
+  };
+  const auto known = std::ranges::find(kept_, planes, &Imported::planes);
+  if (known != kept_.end()) return texturesIn(*known);
+  if (planes.session > session_) {
+    session_ = planes.session;
+    forget([&](const Imported& i) { return i.planes.session < session_; });
   }
+  // The same buffer laid out otherwise (a driver may move a plane's start), or the oldest.
+  forget([&](const Imported& i) {
+    return i.planes.session == planes.session && i.planes.index == planes.index;
+  });
   if (kept_.size() == kKept) {
     destroy(kept_.front());
     kept_.erase(kept_.begin());
   }
   Imported& imported = kept_.emplace_back();
-  imported.buffer = planes.buffer;
+  imported.planes = planes;
   if (!import(planes, imported)) {
     destroy(imported);
     kept_.pop_back();
     return std::nullopt;
   }
-  return std::array{imported.textures[0].name(),
-                    planes.planes > 1 ? imported.textures[1].name() : 0};
+  return texturesIn(imported);
 }
 
 bool DmabufImport::import(const DmabufPlanes& planes, Imported& imported) {
+  // An error left by earlier GL calls is not this import's.
+  while (glGetError() != GL_NO_ERROR) {
+  }
   const bool nv12 = format_ == PixelFormat::kNv12;
   if (planes.planes != (nv12 ? 2U : 1U)) {
     refusal_ = fmt::format("a {} picture in {} planes", toString(format_), planes.planes);

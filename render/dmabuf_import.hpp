@@ -4,8 +4,10 @@
 // is imported once, an EGLImage of each plane bound to a texture, in the layouts CameraTexture's
 // uploads have (YUYV and UYVY: four-byte texels of half the width; NV12: one-byte luma, two-byte
 // chroma of half the width and height), so that the stitch samples either the same way. Imports
-// are kept under the buffer's name (DmabufPlanes::buffer), the last kKept of them: the buffers a
-// camera cycles through are imported once, and those of a camera reopened since fall out.
+// are kept under the buffer's name and layout (DmabufPlanes), the last kKept of them: the buffers
+// a camera cycles through are imported once. An import holds its buffer's memory, so those of a
+// streaming session are let go as soon as a later session's buffer comes (the camera was reopened:
+// the driver has freed the old buffers, but for the references imports hold).
 //
 // Set-up and use on the thread of the current EglContext; texturesOf() allocates only when it
 // imports a buffer it has not seen.
@@ -42,15 +44,20 @@ class DmabufImport {
   // The textures holding the picture: its pixels (or luma) and its chroma (or 0), imported the
   // first time its buffer is seen; nullopt, with refusal() saying why, when it cannot be.
   std::optional<std::array<GLuint, 2>> texturesOf(const DmabufPlanes& planes);
+  // How many buffers are imported now.
+  std::size_t imports() const { return kept_.size(); }
 
  private:
   struct Imported {
-    std::uint64_t buffer = 0;
+    DmabufPlanes planes;
     std::array<EGLImageKHR, 2> images{EGL_NO_IMAGE_KHR, EGL_NO_IMAGE_KHR};
     std::array<gl::Texture, 2> textures;
   };
   bool import(const DmabufPlanes& planes, Imported& imported);
   void destroy(Imported& imported);
+  // Destroys and forgets the imports `drop` picks.
+  template <typename Drop>
+  void forget(Drop drop);
 
   PixelFormat format_;
   cv::Size size_;
@@ -59,6 +66,7 @@ class DmabufImport {
   PFNEGLDESTROYIMAGEKHRPROC destroyImage_ = nullptr;
   void (*targetTexture_)(GLenum, void*) = nullptr;  // glEGLImageTargetTexture2DOES
   std::vector<Imported> kept_;                      // oldest first
+  std::uint64_t session_ = 0;                       // the latest streaming session seen
   std::string refusal_;
 };
 

@@ -251,12 +251,24 @@ void GpuStitcher::upload(std::span<const cv::Mat> frames, std::span<const Dmabuf
     throw std::invalid_argument(fmt::format("the GPU stitch takes {} frames, got {} ({} DMABUFs)",
                                             cameras_.size(), frames.size(), dmabufs.size()));
   }
+  // Every frame checked before any buffer is mapped: a buffer left mapped would fail every later
+  // upload.
   for (std::size_t camera = 0; camera < frames.size(); ++camera) {
     cameras_[camera].check(frames[camera]);
+  }
+  for (std::size_t camera = 0; camera < frames.size(); ++camera) {
     const bool inDmabuf = !dmabufs.empty() && dmabufs[camera].planes > 0;
     imported_[camera] = static_cast<char>(inDmabuf && cameras_[camera].import(dmabufs[camera]));
     if (inDmabuf) logImport(camera);
-    mapped_[camera] = imported_[camera] != 0 ? std::span<std::uint8_t>() : cameras_[camera].map();
+    mapped_[camera] = {};
+    try {
+      if (imported_[camera] == 0) mapped_[camera] = cameras_[camera].map();
+    } catch (...) {
+      for (std::size_t earlier = 0; earlier < camera; ++earlier) {
+        if (!mapped_[earlier].empty()) cameras_[earlier].unmap();
+      }
+      throw;
+    }
   }
   // Each camera's bytes in a few pieces, so that every thread has a share whatever the count.
   constexpr int kPieces = 4;
@@ -357,6 +369,7 @@ void GpuStitcher::stitch() {
     const GLenum waited = glClientWaitSync(read, GL_SYNC_FLUSH_COMMANDS_BIT, kSecond);
     glDeleteSync(read);
     if (waited == GL_TIMEOUT_EXPIRED || waited == GL_WAIT_FAILED) {
+      glFinish();  // the set's end gives the frames' buffers back to their driver
       throw RenderError("the GPU stitch of imported frames did not finish within a second");
     }
   }

@@ -48,7 +48,9 @@ class PanoramaStage final : public PipelineStage {
   const processing::Rig& rig() const { return rig_; }
   WorkPool& pool() const { return pool_; }
   // The frames of the set process() was last given, as the stitch samples them (a missing
-  // camera's black), all held in frameFormat(): for a stitch elsewhere (the GPU's).
+  // camera's black), all held in frameFormat(): for a stitch elsewhere (the GPU's). Views into the
+  // set's frames, to be read only while that set is processed: a frame lent a driver's buffer
+  // gives it back when the set ends.
   const std::vector<cv::Mat>& frames() const { return stitched_; }
   // Where each of those frames lies in its driver's DMABUFs, where it was lent one (planes 0
   // where not): for a GPU to import it instead.

@@ -10,14 +10,17 @@
 // unplugAtFrame), so that a test can leave the device to a capture thread without touching it.
 //
 // The test keeps a FakeV4l2Device::State to steer the device after handing the device to a
-// source.
+// source. Like a driver, the device may be called from several threads at once (a frame lent a
+// buffer gives it back on the thread that lets it go): every call is under one lock.
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <deque>
 #include <functional>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include <fcntl.h>
@@ -95,7 +98,10 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
     // fail, and the one after plugs it back.
     std::uint64_t unplugAtFrame = std::numeric_limits<std::uint64_t>::max();
     int failedOpens = 0;
-    bool exportsDmabuf = false;  // VIDIOC_EXPBUF answers (with /dev/null descriptors)
+    bool exportsDmabuf = false;         // VIDIOC_EXPBUF answers (with /dev/null descriptors)
+    int failedExports = 0;              // the next this many VIDIOC_EXPBUF calls fail (EMFILE)
+    std::uint32_t grantedBuffers = 32;  // VIDIOC_REQBUFS grants at most this many
+    bool orphanedBuffers = true;        // V4L2_BUF_CAP_SUPPORTS_ORPHANED_BUFS
     int opens = 0;
     std::uint64_t produced = 0;
     std::uint64_t queued = 0;  // VIDIOC_QBUF calls
@@ -107,6 +113,7 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
   explicit FakeV4l2Device(std::shared_ptr<State> state) : state_(std::move(state)) {}
 
   int open(const std::string&) override {
+    const std::lock_guard lock(mutex_);
     if (!state_->plugged && state_->failedOpens > 0) {
       --state_->failedOpens;
       if (state_->failedOpens == 0 && state_->unplugAtFrame == state_->produced) {
@@ -121,12 +128,14 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
     return 0;
   }
   void close() override {
+    const std::lock_guard lock(mutex_);
     open_ = false;
     streaming_ = false;
     retire();
     queue_.clear();
   }
   void* map(std::size_t length, std::int64_t offset) override {
+    const std::lock_guard lock(mutex_);
     const auto index = static_cast<std::size_t>(offset >> 16);
     const auto plane = static_cast<std::size_t>((offset >> 12) & 0xf);
     if (index >= buffers_.size() || plane >= buffers_[index].size() ||
@@ -137,6 +146,7 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
   }
   void unmap(void*, std::size_t) override {}
   int waitReadable(std::chrono::milliseconds) override {
+    const std::lock_guard lock(mutex_);
     if (!state_->plugged) return ENODEV;
     if (state_->stalledPolls > 0) {
       --state_->stalledPolls;
@@ -146,6 +156,7 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
   }
 
   int ioctl(unsigned long request, void* argument) override {
+    const std::lock_guard lock(mutex_);
     if (!open_) return EBADF;
     if (!state_->plugged) return ENODEV;
     const std::uint32_t type =
@@ -207,9 +218,12 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
         state_->controlsSet.push_back(*static_cast<v4l2_control*>(argument));
         return 0;
       case VIDIOC_REQBUFS: {
-        const auto* wanted = static_cast<v4l2_requestbuffers*>(argument);
+        auto* wanted = static_cast<v4l2_requestbuffers*>(argument);
         if (wanted->type != type) return EINVAL;
         retire();
+        wanted->count = std::min(wanted->count, state_->grantedBuffers);
+        wanted->capabilities = V4L2_BUF_CAP_SUPPORTS_MMAP |
+                               (state_->orphanedBuffers ? V4L2_BUF_CAP_SUPPORTS_ORPHANED_BUFS : 0);
         buffers_.assign(wanted->count, {});
         for (auto& planes : buffers_) {
           for (std::uint32_t p = 0; p < planeCount(); ++p) planes.emplace_back(planeBytes(p));
@@ -236,6 +250,10 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
       }
       case VIDIOC_EXPBUF: {
         if (!state_->exportsDmabuf) return ENOTTY;
+        if (state_->failedExports > 0) {
+          --state_->failedExports;
+          return EMFILE;
+        }
         auto* exported = static_cast<v4l2_exportbuffer*>(argument);
         if (exported->type != type || exported->plane >= planeCount()) return EINVAL;
         exported->fd = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
@@ -245,6 +263,11 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
         const auto* buffer = static_cast<v4l2_buffer*>(argument);
         if (buffer->type != type) return EINVAL;
         if (state_->multiplanar && (buffer->m.planes == nullptr || buffer->length < planeCount())) {
+          return EINVAL;
+        }
+        // Like videobuf2: a buffer that is not there, or queued already, is refused.
+        if (buffer->index >= buffers_.size() ||
+            std::ranges::find(queue_, buffer->index) != queue_.end()) {
           return EINVAL;
         }
         queue_.push_back(buffer->index);
@@ -420,6 +443,7 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
   }
 
   std::shared_ptr<State> state_;
+  std::mutex mutex_;
   bool open_ = false;
   bool streaming_ = false;
   Mode mode_{};

@@ -10,6 +10,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "capture/camera_stream.hpp"
 #include "tests/capture/fake_v4l2_device.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -300,21 +301,38 @@ TEST(V4l2Source, LendsItsBuffersToFramesWhileTwoStayWithTheDriver) {
     EXPECT_EQ(again->dmabuf.planes, 0u);
     ASSERT_EQ(source.read(*again), ReadStatus::kFrame) << source.lastError();
     expectLent(*again, source, 3);
-    EXPECT_NE(again->dmabuf.buffer, 0u);
+    EXPECT_NE(again->dmabuf.session, 0u);
   }
 }
 
 TEST(V4l2Source, SaysWhyItsFramesCannotBeLentItsBuffersAndCopiesThem) {
-  for (const auto& [fourcc, multiplanar, exports, why] :
-       {std::tuple{V4L2_PIX_FMT_MJPEG, false, true, "its frames are converted to BGR"},
-        std::tuple{V4L2_PIX_FMT_NV12M, true, true, "its NV12 comes in two buffers"},
-        std::tuple{V4L2_PIX_FMT_YUYV, false, false, "its driver exports no DMABUF"},
-        std::tuple{V4L2_PIX_FMT_YUYV, true, true, "its lines are padded"}}) {
-    SCOPED_TRACE(testing::fourccName(fourcc));
+  using State = FakeV4l2Device::State;
+  struct Case {
+    std::uint32_t fourcc;
+    const char* why;
+    std::function<void(State&)> device;
+  };
+  for (const auto& [fourcc, why, device] :
+       {Case{V4L2_PIX_FMT_MJPEG, "its frames are converted to BGR", [](State&) {}},
+        Case{V4L2_PIX_FMT_NV12M, "its NV12 comes in two buffers",
+             [](State& s) { s.multiplanar = true; }},
+        Case{V4L2_PIX_FMT_YUYV, "its driver exports no DMABUF",
+             [](State& s) { s.exportsDmabuf = false; }},
+        Case{V4L2_PIX_FMT_YUYV, "its lines are padded",
+             [](State& s) {
+               s.multiplanar = true;
+               s.linePadding = 64;
+             }},
+        Case{V4L2_PIX_FMT_YUYV, "its driver exported only some of its buffers",
+             [](State& s) { s.failedExports = 1; }},
+        Case{V4L2_PIX_FMT_YUYV, "it has fewer than three buffers",
+             [](State& s) { s.grantedBuffers = 2; }},
+        Case{V4L2_PIX_FMT_YUYV, "its driver cannot free buffers that a frame still holds",
+             [](State& s) { s.orphanedBuffers = false; }}}) {
+    SCOPED_TRACE(why);
     const auto state = deviceOffering({{fourcc, kSize}});
-    state->exportsDmabuf = exports;
-    state->multiplanar = multiplanar;
-    state->linePadding = 64;
+    state->exportsDmabuf = true;
+    device(*state);
     V4l2Source source = sourceOn(state);
     const char* refusal = source.lendBuffers();
     ASSERT_NE(refusal, nullptr);
@@ -324,6 +342,57 @@ TEST(V4l2Source, SaysWhyItsFramesCannotBeLentItsBuffersAndCopiesThem) {
     EXPECT_EQ(frame.dmabuf.planes, 0u);
     EXPECT_FALSE(frame.loan.lender);
   }
+}
+
+// A frame is a plain struct and may be copied, loan and all: its buffer goes back to the driver
+// once, however many copies end their loan, and the count of buffers lent stays right.
+TEST(V4l2Source, ABufferGivenBackTwiceGoesBackToTheDriverOnce) {
+  const auto state = deviceOffering({{V4L2_PIX_FMT_YUYV, kSize}});
+  state->exportsDmabuf = true;
+  V4l2Source source = sourceOn(state);  // 4 buffers: two may be lent at once
+  ASSERT_EQ(source.lendBuffers(), nullptr);
+  FramePool pool(4, kSize, source.pixelFormat());
+  FrameRef lent = pool.acquire(std::chrono::milliseconds(0));
+  ASSERT_EQ(source.read(*lent), ReadStatus::kFrame);
+  ASSERT_EQ(lent->dmabuf.planes, 1u);
+  Frame copy = *lent;
+  const std::uint64_t queued = state->queued;
+  endLoan(copy);
+  EXPECT_EQ(state->queued, queued + 1);
+  lent.reset();
+  EXPECT_EQ(state->queued, queued + 1) << "one buffer queued twice";
+  std::vector<FrameRef> held;
+  for (int k = 0; k < 3; ++k) {
+    held.push_back(pool.acquire(std::chrono::milliseconds(0)));
+    ASSERT_EQ(source.read(*held.back()), ReadStatus::kFrame) << source.lastError();
+    EXPECT_EQ(held.back()->dmabuf.planes, k < 2 ? 1u : 0u) << "frame " << k;
+  }
+}
+
+// The capture thread lends the buffers; the consumer lets the frames go on its own thread, as the
+// pipeline does (run under ThreadSanitizer in CI).
+TEST(V4l2Source, FramesLetGoOnAnotherThreadGiveTheirBuffersBack) {
+  const auto state = deviceOffering({{V4L2_PIX_FMT_NV12, kSize}});
+  state->exportsDmabuf = true;
+  CameraStream camera(
+      "front",
+      std::make_unique<V4l2Source>("front", settingsFor(), std::make_unique<FakeV4l2Device>(state)),
+      4);
+  ASSERT_EQ(camera.lendBuffers(), nullptr);
+  camera.start();
+  int lent = 0;
+  for (int k = 0; k < 40; ++k) {
+    FrameRef frame;
+    ASSERT_EQ(camera.next(frame, std::chrono::seconds(5)), CameraStream::Next::kFrame);
+    lent += frame->dmabuf.planes > 0 ? 1 : 0;
+    const auto us = std::chrono::duration_cast<std::chrono::microseconds>(frame->timestamp);
+    const auto picture = static_cast<int>((us.count() - state->firstTimestampUs) / state->periodUs);
+    EXPECT_GE(cv::PSNR(bgrOf(*frame), surroundd::testing::syntheticPicture(kSize, picture)), 28.0)
+        << "frame " << k;
+  }
+  camera.stop();
+  EXPECT_GT(lent, 0);
+  EXPECT_EQ(camera.stats().faults, 0u) << "a buffer the driver refused back";
 }
 
 // The kernel keeps a buffer mapped until it is unmapped, whatever happens to its device; so does
@@ -338,7 +407,7 @@ TEST(V4l2Source, AFrameKeepsItsLentBufferWhenTheCameraIsLostAndReopened) {
   FrameRef lent = pool.acquire(std::chrono::milliseconds(0));
   ASSERT_EQ(source->read(*lent), ReadStatus::kFrame);
   const cv::Mat picture = lent->image.clone();
-  const std::uint64_t lentBuffer = lent->dmabuf.buffer;
+  const std::uint64_t lentSession = lent->dmabuf.session;
   state->plugged = false;
   FrameRef next = pool.acquire(std::chrono::milliseconds(0));
   EXPECT_EQ(source->read(*next), ReadStatus::kLost);
@@ -347,7 +416,7 @@ TEST(V4l2Source, AFrameKeepsItsLentBufferWhenTheCameraIsLostAndReopened) {
   ASSERT_EQ(source->read(*next), ReadStatus::kFrame) << source->lastError();
   const std::uint64_t queued = state->queued;
   EXPECT_EQ(cv::norm(lent->image, picture, cv::NORM_INF), 0.0);
-  EXPECT_NE(next->dmabuf.buffer, lentBuffer) << "a buffer of the new session under an old name";
+  EXPECT_GT(next->dmabuf.session, lentSession) << "a buffer of the new session under an old name";
   lent.reset();  // its session is over: nothing goes back to the driver
   EXPECT_EQ(state->queued, queued);
   next.reset();

@@ -59,7 +59,7 @@ TEST(DmabufImport, SaysWhyItImportsNothing) {
   DmabufPlanes planes;
   EXPECT_FALSE(yuyv.texturesOf(planes)) << "a picture in no DMABUF";
   planes.planes = 2;  // YUYV comes in one
-  planes.buffer = 1;
+  planes.session = 1;
   EXPECT_FALSE(yuyv.texturesOf(planes));
   EXPECT_THAT(yuyv.refusal(), AnyOf(HasSubstr("a YUYV picture in 2 planes"),
                                     HasSubstr("no EGL_EXT_image_dma_buf_import")));
@@ -115,6 +115,31 @@ TEST_F(VividImport, AnImportedFrameIsTheUploadedOne) {
                 0.0);
     }
   }
+}
+
+// An import holds its buffer's memory: once a camera is opened again, the imports of its earlier
+// buffers are let go, though a frame still holds one.
+TEST_F(VividImport, TheImportsOfAReopenedCamerasEarlierBuffersAreLetGo) {
+  const EglContext context;
+  const auto settings = testing::vividSettings(cameras_.front(), capture::V4l2Format::kYuyv);
+  auto first = std::make_unique<capture::V4l2Source>("vivid", settings);
+  ASSERT_EQ(first->lendBuffers(), nullptr);
+  capture::FramePool pool(2, first->frameSize(), first->pixelFormat());
+  const capture::FrameRef early = pool.acquire(std::chrono::milliseconds(0));
+  ASSERT_EQ(first->read(*early), capture::ReadStatus::kFrame) << first->lastError();
+  DmabufImport import(first->pixelFormat(), first->frameSize());
+  if (!import.texturesOf(early->dmabuf)) {
+    GTEST_SKIP() << "this machine's EGL (" << context.description()
+                 << ") does not import vivid's DMABUFs: " << import.refusal();
+  }
+  EXPECT_EQ(import.imports(), 1u);
+  first.reset();  // closed, a frame still holding one of its buffers
+  capture::V4l2Source second("vivid", settings);
+  ASSERT_EQ(second.lendBuffers(), nullptr);
+  const capture::FrameRef late = pool.acquire(std::chrono::milliseconds(0));
+  ASSERT_EQ(second.read(*late), capture::ReadStatus::kFrame) << second.lastError();
+  ASSERT_TRUE(import.texturesOf(late->dmabuf)) << import.refusal();
+  EXPECT_EQ(import.imports(), 1u) << "the closed camera's buffer is still imported";
 }
 
 }  // namespace

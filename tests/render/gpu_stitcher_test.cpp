@@ -317,7 +317,8 @@ TEST_F(GpuStitcherTest, FramesInBuffersTheGpuCannotImportAreUploadedInstead) {
     dmabufs[c].planes = 1;
     dmabufs[c].fd[0] = fd;
     dmabufs[c].pitch[0] = static_cast<std::uint32_t>(frames[c].step[0]);
-    dmabufs[c].buffer = c + 1;
+    dmabufs[c].session = 1;
+    dmabufs[c].index = static_cast<std::uint32_t>(c);
   }
   GpuStitcher gpu(*lut, PixelFormat::kYuyv, *pool);
   const testing::LogCapture log;
@@ -352,6 +353,19 @@ TEST_F(GpuStitcherTest, FramesThatDoNotMatchAreRefused) {
   auto frames = held(PixelFormat::kNv12);
   frames.pop_back();
   EXPECT_THROW(gpu.upload(frames), std::invalid_argument);
+  // One camera's frame amiss after others that are right: nothing is left half done, and the
+  // next frames go through.
+  auto mixed = held(PixelFormat::kNv12);
+  mixed.back() = cv::Mat(4, 4, mixed.back().type());
+  EXPECT_THROW(gpu.upload(mixed), std::invalid_argument);
+  frames = held(PixelFormat::kNv12);
+  gpu.upload(frames);
+  gpu.stitch();
+  cv::Mat panorama;
+  gpu.readPanorama(panorama);
+  cv::Mat cpu;
+  processing::Stitcher(*lut, *pool).stitch(frames, PixelFormat::kNv12, cpu);
+  expectWithinRounding(panorama, cpu);
 }
 
 // Every view drawn from the GPU panorama in place against the same view drawn from the CPU
