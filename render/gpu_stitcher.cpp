@@ -196,7 +196,6 @@ GpuStitcher::GpuStitcher(const PanoramaLut& lut, PixelFormat format, WorkPool& p
   for (const cv::Size& cameraSize : lut.cameraSizes) cameras_.emplace_back(format, cameraSize);
   mapped_.resize(cameras_.size());
   imported_.resize(cameras_.size());
-  importLogged_.resize(cameras_.size());
 
   uploadTaps(taps_.name(), size_, lut.taps.data());
   // The blend taps spread out to one per pixel (weight 0: none), so that the shader finds a
@@ -259,7 +258,6 @@ void GpuStitcher::upload(std::span<const cv::Mat> frames, std::span<const Dmabuf
   for (std::size_t camera = 0; camera < frames.size(); ++camera) {
     const bool inDmabuf = !dmabufs.empty() && dmabufs[camera].planes > 0;
     imported_[camera] = static_cast<char>(inDmabuf && cameras_[camera].import(dmabufs[camera]));
-    if (inDmabuf) logImport(camera);
     mapped_[camera] = {};
     try {
       if (imported_[camera] == 0) mapped_[camera] = cameras_[camera].map();
@@ -285,19 +283,6 @@ void GpuStitcher::upload(std::span<const cv::Mat> frames, std::span<const Dmabuf
   });
   for (std::size_t camera = 0; camera < frames.size(); ++camera) {
     if (imported_[camera] == 0) cameras_[camera].commit();
-  }
-}
-
-void GpuStitcher::logImport(std::size_t camera) {
-  const char said = imported_[camera] != 0 ? 1 : 2;
-  if (importLogged_[camera] == said) return;
-  importLogged_[camera] = said;
-  if (said == 1) {
-    spdlog::info("processing: camera {}'s frames are taken from their DMABUFs, with no copy",
-                 camera);
-  } else {
-    spdlog::warn("processing: camera {}'s frames are uploaded through pixel buffers: {}", camera,
-                 cameras_[camera].importRefusal());
   }
 }
 

@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -47,11 +48,16 @@ class GpuStitcher {
   // std::invalid_argument otherwise. The copies into the mapped pixel buffers run on the pool
   // (one memcpy per thread cannot keep up with the bus: 12 GB/s where PCIe carries 25 or more).
   // dmabufs[i], where given, says where camera i's frame lies in DMABUFs: it is imported instead
-  // (CameraTexture::import), and uploaded where it cannot be. Which way each camera's frames go is
-  // logged when it changes. Until stitch() has run, the DMABUFs must stay as they are.
+  // (CameraTexture::import), and uploaded where it cannot be (imported() and importRefusal() say
+  // which way each camera's went). Until stitch() has run, the DMABUFs must stay as they are.
   void upload(std::span<const cv::Mat> frames, std::span<const DmabufPlanes> dmabufs = {});
   // Whether camera i's last frame was imported rather than uploaded.
   bool imported(std::size_t camera) const { return imported_[camera]; }
+  // Why camera i's frames are not imported (empty until the first import is tried, and while
+  // they are).
+  const std::string& importRefusal(std::size_t camera) const {
+    return cameras_[camera].importRefusal();
+  }
   // Applies `correction`'s field from the next stitch() on, as it stands after each update()
   // (borrowed: it must outlive its use here); nullptr: none. Set-up, not per frame: the first
   // call for a correction uploads its seam-band shares (two bytes a panorama pixel).
@@ -72,17 +78,14 @@ class GpuStitcher {
   void readPanorama(cv::Mat& bgr) const;
 
  private:
-  void logImport(std::size_t camera);
-
   cv::Size size_;
   PixelFormat format_;
   WorkPool& pool_;
   std::vector<CameraTexture> cameras_;
   std::vector<std::span<std::uint8_t>> mapped_;  // each camera's buffer while an upload fills it
   std::vector<char> imported_;                   // per camera: its last frame imported
-  std::vector<char> importLogged_;  // per camera: 0 nothing said, 1 imported, 2 uploaded
-  gl::Texture taps_;                // RG32UI: each pixel's LutTap as two words
-  gl::Texture blends_;              // the same for its blend tap; weight 0 where it has none
+  gl::Texture taps_;                             // RG32UI: each pixel's LutTap as two words
+  gl::Texture blends_;  // the same for its blend tap; weight 0 where it has none
   const processing::PoissonColourCorrection* correction_ = nullptr;
   gl::Texture field_;   // RGB32F, the correction's block grid
   gl::Texture shares_;  // R16UI, each panorama pixel's source share 0..256

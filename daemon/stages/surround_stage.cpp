@@ -143,6 +143,7 @@ SurroundStage::SurroundStage(const Config& config, SurroundRenderer renderer,
       why = "the GPU stitch could not be set up";
     }
   }
+  importSaid_.resize(panorama.lut().cameraSizes.size());
   importRefusal_ =
       gpu_ ? render::DmabufImport(cameraFormat, panorama.lut().cameraSizes.at(0)).refusal()
            : "the panorama is stitched on the CPU";
@@ -254,12 +255,30 @@ void SurroundStage::stitchOnGpu() {
     const render::GpuTimer::Scope timed(&gpuTimer_, render::GpuStep::kUpload);
     gpu_->upload(panoramaStage_.frames(), panoramaStage_.dmabufs());
   }
+  sayHowFramesReachTheGpu();
   {
     const render::GpuTimer::Scope timed(&gpuTimer_, render::GpuStep::kStitch);
     gpu_->stitch();
   }
   scene_->samplePanoramaFrom(gpu_->panorama());
   panoramaOnGpu_ = true;
+}
+
+void SurroundStage::sayHowFramesReachTheGpu() {
+  const auto& dmabufs = panoramaStage_.dmabufs();
+  for (std::size_t c = 0; c < dmabufs.size(); ++c) {
+    if (dmabufs[c].planes == 0) continue;
+    const char way = gpu_->imported(c) ? 1 : 2;
+    if (importSaid_[c] == way) continue;
+    importSaid_[c] = way;
+    const std::string& name = panoramaStage_.rig().cameras[c].name;
+    if (way == 1) {
+      spdlog::info("processing: camera '{}': frames taken from their DMABUFs, with no copy", name);
+    } else {
+      spdlog::warn("processing: camera '{}': frames uploaded through pixel buffers: {}", name,
+                   gpu_->importRefusal(c));
+    }
+  }
 }
 
 void SurroundStage::uploadPanorama() {

@@ -173,6 +173,9 @@ class SurroundStage final : public PipelineStage {
   // The set's panorama into the texture the scene samples: stitched on the GPU, or the CPU's
   // uploaded.
   void stitchOnGpu();
+  // Which way each camera's lent frames reached the GPU (imported, or uploaded and why), when it
+  // changes.
+  void sayHowFramesReachTheGpu();
   void uploadPanorama();
   // The GPU times of the runs finished since the last call into gpuTimes_.
   void collectGpuTimes();
@@ -188,7 +191,8 @@ class SurroundStage final : public PipelineStage {
   const cv::Mat& panorama_;
   std::unique_ptr<render::GpuStitcher> gpu_;  // processing.backend: gpu
   std::string importRefusal_;
-  bool panoramaOnGpu_ = false;  // the scene samples gpu_'s panorama (the last set's)
+  std::vector<char> importSaid_;  // per camera: 0 nothing said, 1 imported, 2 uploaded
+  bool panoramaOnGpu_ = false;    // the scene samples gpu_'s panorama (the last set's)
   bool viewLut_;
   GuidelineMode guidelineMode_;
   render::GuidelineSettings guide_;

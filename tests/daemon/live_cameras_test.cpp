@@ -181,13 +181,13 @@ TEST_F(LiveCameras, TheGpuStitchTakesFramesLentTheDriversBuffers) {
   // Each camera whose lent frame reached a GPU stitch (a set with a camera late or lost is
   // stitched on the CPU, and an emulated CPU makes them late) says once which way its frames go.
   std::size_t saidWhichWay = 0;
-  for (std::size_t camera = 0; camera < 4; ++camera) {
+  for (const auto& name : names) {
     const auto ways =
-        said(fmt::format("camera {}'s frames are taken from their DMABUFs", camera)) +
-        said(fmt::format("camera {}'s frames are uploaded through pixel buffers: the driver "
+        said(fmt::format("camera '{}': frames taken from their DMABUFs", name)) +
+        said(fmt::format("camera '{}': frames uploaded through pixel buffers: the driver "
                          "refused to import a DMABUF",
-                         camera));
-    EXPECT_LE(ways, 1) << camera;
+                         name));
+    EXPECT_LE(ways, 1) << name;
     saidWhichWay += static_cast<std::size_t>(ways);
   }
   EXPECT_GE(saidWhichWay, 1U) << fmt::format("{}", fmt::join(lines, "\n"));
