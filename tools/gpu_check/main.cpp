@@ -12,16 +12,23 @@
 // any driver, and the GPU's own time of each where GL_EXT_disjoint_timer_query is there. Each
 // chain runs as the daemon's pipeline does: the next set's frames uploaded (GPU path) or stitched
 // (CPU path) while the GPU draws and reads back the current picture, its only wait the read-back.
+// For a view that does not move (top, 360, rear), also the alternative with no panorama at all
+// (issue 20 point 3): the GPU stitch run on the view's own LUT (processing/stitch/view_lut.hpp,
+// the table the CPU path gathers such views with), one pass at the picture's size sampling the
+// cameras straight into the picture, timed the same way; and how far its picture is from the view
+// drawn from the GPU panorama, where the view shows the panorama.
 //
 // Exit codes: 0 measured, 1 failed (named on stderr), 2 bad command line.
 
 #include <algorithm>
 #include <charconv>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string_view>
 #include <thread>
 #include <vector>
@@ -34,6 +41,7 @@
 #include "common/work_pool.hpp"
 #include "processing/stitch/panorama_lut_cache.hpp"
 #include "processing/stitch/stitcher.hpp"
+#include "processing/stitch/view_lut.hpp"
 #include "processing/surround_mesh.hpp"
 #include "render/egl_context.hpp"
 #include "render/gpu_stitcher.hpp"
@@ -139,6 +147,45 @@ Agreement compare(const cv::Mat& a, const cv::Mat& b) {
   return agreement;
 }
 
+// PSNR in dB of `a` against `b` where `mask` is set.
+double psnrWhere(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
+  cv::Mat difference;
+  cv::absdiff(a, b, difference);
+  difference.convertTo(difference, CV_32F);
+  const cv::Scalar squared = cv::mean(difference.mul(difference), mask);
+  const double mse = (squared[0] + squared[1] + squared[2]) / 3;
+  return mse == 0 ? 99.0 : 10 * std::log10(255.0 * 255.0 / mse);
+}
+
+// The view drawn with no panorama: its own LUT stitched straight into the picture.
+struct ViewTable {
+  processing::PanoramaLut lut;
+  cv::Mat shown;  // where the view shows the panorama (the rest is the car and background)
+};
+
+void checkViewTable(const ViewTable& table, PixelFormat format, const std::vector<cv::Mat>& held,
+                    const cv::Mat& drawn, WorkPool& pool, int frames) {
+  render::GpuStitcher direct(table.lut, format, pool);
+  cv::Mat picture;
+  direct.upload(held);
+  direct.stitch();
+  direct.readPanorama(picture);
+  const double stitchMs = medianMs(frames, [&](int) {
+    direct.stitch();
+    glFinish();
+  });
+  const double chainMs = medianMs(frames, [&](int) {
+    direct.stitch();
+    direct.upload(held);
+    direct.readPanorama(picture);
+  });
+  fmt::print(
+      "        no panorama (the view's LUT, {}x{}): stitch {:.3f} ms, chain {:.3f} ms = {:.1f} "
+      "fps; vs the view drawn from the panorama {:.1f} dB\n",
+      table.lut.size.width, table.lut.size.height, stitchMs, chainMs, 1000.0 / chainMs,
+      psnrWhere(picture, drawn, table.shown));
+}
+
 void checkKit(const std::filesystem::path& kit, const Options& options) {
   auto lookup = processing::PanoramaLutCache::loadFile(kit / "panorama.lut");
   if (!lookup.lut) {
@@ -161,6 +208,12 @@ void checkKit(const std::filesystem::path& kit, const Options& options) {
     view.collect();
   };
   render::GpuTimer gpuTimer;
+  std::optional<ViewTable> viewTable;
+  if (!view.moves()) {
+    const cv::Mat positions = view.panoramaPositions(0);
+    viewTable = ViewTable{processing::composeViewLut(lut, positions, pool),
+                          render::SurroundView::panoramaShown(positions)};
+  }
 
   fmt::print("{}: {} cameras of {}x{}, panorama {}x{}, {} view {}x{}, {} frame sets a figure\n",
              kit.filename().string(), lut.cameraSizes.size(), lut.cameraSizes.front().width,
@@ -236,6 +289,15 @@ void checkKit(const std::filesystem::path& kit, const Options& options) {
         static_cast<double>(bytes) / (uploadMs * 1e6), stitchMs, drawMs, chainMs, 1000.0 / chainMs,
         cpuChainMs / chainMs);
     fmt::print("        GPU time: {}\n", gpuTimes);
+    if (viewTable) {
+      gpu.upload(held);
+      gpu.stitch();
+      scene.samplePanoramaFrom(gpu.panorama());
+      view.draw(0);
+      const cv::Mat drawn = view.collect().clone();
+      scene.samplePanoramaFrom(0);
+      checkViewTable(*viewTable, format, held, drawn, pool, frames);
+    }
   }
 }
 
