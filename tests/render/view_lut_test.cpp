@@ -19,6 +19,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/masked_psnr.hpp"
 #include "common/work_pool.hpp"
 #include "processing/colour/gain_compensation.hpp"
 #include "processing/colour/poisson_correction.hpp"
@@ -171,15 +172,6 @@ Pictures drawBoth(RigScene& rig, ViewKind view, double timeS, Correction correct
   return pictures;
 }
 
-double psnrWhere(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
-  cv::Mat difference;
-  cv::absdiff(a, b, difference);
-  difference.convertTo(difference, CV_32F);
-  const cv::Scalar squared = cv::mean(difference.mul(difference), mask);
-  const double mse = (squared[0] + squared[1] + squared[2]) / 3;
-  return 10 * std::log10(255.0 * 255.0 / std::max(mse, 1e-10));
-}
-
 // With each colour correction: the view's picture corrected through the view (the field sampled
 // where each pixel samples the panorama, the gains by the view LUT's cameras) against the render
 // of the corrected panorama; and what each correction changes in the view, both ways. One camera
@@ -214,7 +206,7 @@ TEST_F(ViewLutTest, EachFixedViewMatchesTheRenderer) {
         const Pictures pictures = drawBoth(*scene, view, timeS, correction);
         // Most of each view is panorama, so the comparison covers it.
         EXPECT_GT(cv::countNonZero(pictures.panoramaShown), pictures.panoramaShown.total() / 2);
-        EXPECT_GE(psnrWhere(pictures.rendered, pictures.direct, pictures.panoramaShown),
+        EXPECT_GE(maskedPsnr(pictures.rendered, pictures.direct, pictures.panoramaShown),
                   minimumPsnr);
         if (correction == Correction::kNone) {
           uncorrected.push_back(pictures);

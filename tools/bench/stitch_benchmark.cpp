@@ -1,6 +1,5 @@
 #include "tools/bench/stitch_benchmark.hpp"
 
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <numbers>
@@ -14,6 +13,7 @@
 #include <unistd.h>
 
 #include "common/ffmpeg_util.hpp"
+#include "common/masked_psnr.hpp"
 #include "common/work_pool.hpp"
 #include "processing/colour/poisson_correction.hpp"
 #include "processing/stitch/panorama_lut_cache.hpp"
@@ -187,11 +187,7 @@ TopViewTiming measureTopView(const processing::Rig& rig,
     timing.formats.push_back({format, formatMedians[0], formatMedians[1]});
   }
   const cv::Mat shown = render::SurroundView::panoramaShown(positions);
-  cv::Mat difference;
-  cv::absdiff(directPicture, rendered, difference);
-  difference.convertTo(difference, CV_32F);
-  const cv::Scalar squared = cv::mean(difference.mul(difference), shown);
-  timing.psnr = 10 * std::log10(255.0 * 255.0 * 3 / (squared[0] + squared[1] + squared[2]));
+  timing.psnr = maskedPsnr(directPicture, rendered, shown);
   return timing;
 }
 

@@ -23,7 +23,6 @@
 #include <algorithm>
 #include <charconv>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -37,6 +36,7 @@
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
 
+#include "common/masked_psnr.hpp"
 #include "common/pixel_format.hpp"
 #include "common/work_pool.hpp"
 #include "processing/stitch/panorama_lut_cache.hpp"
@@ -147,16 +147,6 @@ Agreement compare(const cv::Mat& a, const cv::Mat& b) {
   return agreement;
 }
 
-// PSNR in dB of `a` against `b` where `mask` is set.
-double psnrWhere(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
-  cv::Mat difference;
-  cv::absdiff(a, b, difference);
-  difference.convertTo(difference, CV_32F);
-  const cv::Scalar squared = cv::mean(difference.mul(difference), mask);
-  const double mse = (squared[0] + squared[1] + squared[2]) / 3;
-  return mse == 0 ? 99.0 : 10 * std::log10(255.0 * 255.0 / mse);
-}
-
 // The view drawn with no panorama: its own LUT stitched straight into the picture.
 struct ViewTable {
   processing::PanoramaLut lut;
@@ -183,7 +173,7 @@ void checkViewTable(const ViewTable& table, PixelFormat format, const std::vecto
       "        no panorama (the view's LUT, {}x{}): stitch {:.3f} ms, chain {:.3f} ms = {:.1f} "
       "fps; vs the view drawn from the panorama {:.1f} dB\n",
       table.lut.size.width, table.lut.size.height, stitchMs, chainMs, 1000.0 / chainMs,
-      psnrWhere(picture, drawn, table.shown));
+      maskedPsnr(picture, drawn, table.shown));
 }
 
 void checkKit(const std::filesystem::path& kit, const Options& options) {
