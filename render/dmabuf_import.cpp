@@ -94,8 +94,9 @@ std::optional<std::array<GLuint, 2>> DmabufImport::texturesOf(const DmabufPlanes
 }
 
 bool DmabufImport::import(const DmabufPlanes& planes, Imported& imported) {
-  // An error left by earlier GL calls is not this import's.
-  while (glGetError() != GL_NO_ERROR) {
+  // An error left by earlier GL calls is not this import's. (A few flags at most; bounded, as a
+  // lost context may answer with an error every time.)
+  for (int flag = 0; flag < 8 && glGetError() != GL_NO_ERROR; ++flag) {
   }
   const bool nv12 = format_ == PixelFormat::kNv12;
   if (planes.planes != (nv12 ? 2U : 1U)) {
