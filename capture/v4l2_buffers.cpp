@@ -1,5 +1,6 @@
 #include "capture/v4l2_buffers.hpp"
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cerrno>
@@ -70,11 +71,9 @@ void V4l2Buffers::stopStreaming() noexcept {
 bool V4l2Buffers::lend(std::uint32_t buffer) {
   const std::lock_guard lock(mutex_);
   // This one and two more would leave the driver nothing to fill while the next is read.
-  if (buffer >= buffers_.size() || lent_[buffer] != 0 || lentCount_ + 3 > buffers_.size()) {
-    return false;
-  }
+  const auto lent = static_cast<std::size_t>(std::ranges::count(lent_, 1));
+  if (buffer >= buffers_.size() || lent_[buffer] != 0 || lent + 3 > buffers_.size()) return false;
   lent_[buffer] = 1;
-  ++lentCount_;
   return true;
 }
 
@@ -85,7 +84,6 @@ void V4l2Buffers::giveBack(std::uint32_t buffer) noexcept {
   const std::lock_guard lock(mutex_);
   if (buffer >= lent_.size() || lent_[buffer] == 0) return;
   lent_[buffer] = 0;
-  --lentCount_;
   if (!streaming_) return;
   if (const int error = device_->ioctl(VIDIOC_QBUF, &queued); error != 0) requeueError_ = error;
 }

@@ -65,7 +65,6 @@ class V4l2Buffers final : public BufferLender {
   std::mutex mutex_;  // the device's streaming calls, and what follows, from any thread
   bool streaming_ = false;
   std::vector<char> lent_;  // per buffer
-  std::size_t lentCount_ = 0;
   int requeueError_ = 0;
 };
 

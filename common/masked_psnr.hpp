@@ -10,7 +10,8 @@
 namespace surroundd {
 
 // `a` and `b`: 8-bit pictures of one size and type; `mask`: CV_8U of that size, non-zero where
-// compared. In dB, over every channel; 100 dB where they agree exactly.
+// compared. In dB, over every channel; 148 dB (a mean squared error of 1e-10) where they agree
+// exactly.
 inline double maskedPsnr(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
   cv::Mat difference;
   cv::absdiff(a, b, difference);
