@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <poll.h>
 #include <spdlog/spdlog.h>
+#include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -88,6 +89,25 @@ void ControlServer::serve(const Handler& handle) {
     for (auto& answer : answers) answered_.push_back(std::move(answer));
   }
   wake();
+}
+
+// The client that makes room for a new one at kMaxClients: the longest connected of those that
+// have sent nothing yet (no byte read, none waiting to be), else the longest still sending its
+// request line (clients are in arrival order); none when every one waits on the pipeline. Idle
+// clients that connect again as soon as they are put out once took the place of the one client
+// with a request on its way, which had come last: every `status` failed.
+std::vector<ControlServer::Client>::iterator ControlServer::clientToPutOut(
+    std::vector<Client>& clients) {
+  const auto sentNothing = [](const Client& c) {
+    int waiting = 0;
+    return c.phase == Client::Phase::kReading && c.line.empty() &&
+           ::ioctl(c.socket.fd(), FIONREAD, &waiting) == 0 && waiting == 0;
+  };
+  if (const auto idle = std::ranges::find_if(clients, sentNothing); idle != clients.end()) {
+    return idle;
+  }
+  return std::ranges::find_if(clients,
+                              [](const Client& c) { return c.phase == Client::Phase::kReading; });
 }
 
 void ControlServer::run() {
@@ -222,11 +242,13 @@ void ControlServer::run() {
     }
     std::erase_if(clients, [](const Client& c) { return c.done; });
     if (polled[0].revents != 0) {
-      while (auto socket = listener_.accept()) {
+      // A bounded number per round: clients that connect again as fast as they are put out
+      // kept this loop accepting, and no request was read or answered.
+      for (std::size_t accepted = 0; accepted < kAcceptsPerRound; ++accepted) {
+        auto socket = listener_.accept();
+        if (!socket) break;
         if (clients.size() >= kMaxClients) {
-          // The longest still sending its request line makes room (clients are in arrival order).
-          const auto oldest = std::ranges::find_if(
-              clients, [](const Client& c) { return c.phase == Client::Phase::kReading; });
+          const auto oldest = clientToPutOut(clients);
           const std::string reply = encodeReply(ControlReply::failure(
               fmt::format("too many clients ({} at once); try again", kMaxClients)));
           const int fd = oldest != clients.end() ? oldest->socket.fd() : socket->fd();

@@ -5,12 +5,12 @@
 // request line within kRequestTimeout, the pipeline's answer within kAnswerTimeout ("busy"
 // otherwise), the reply drained within kReplyTimeout (else the client is dropped). No client can
 // hold up another or the pipeline: idle, slow and never-reading clients only cost their own
-// connection; at kMaxClients a new client takes the place of the one that has been sending its
-// request line longest (told "too many clients"), so idle connections cannot lock others out. Lines
-// may end in "\n" or
-// "\r\n". A good request goes to the pipeline thread, which answers it in serve() between frame
-// sets; anything slow in an answer (a snapshot's PNG encoding) is handed back as `encode` and
-// runs on the server's thread.
+// connection; at kMaxClients a new client takes the place of the longest connected one that has
+// sent nothing yet, else of the one that has been sending its request line longest (told "too
+// many clients"), so idle connections, even ones that connect again as soon as they are put out,
+// cannot lock others out. Lines may end in "\n" or "\r\n". A good request goes to the pipeline
+// thread, which answers it in serve() between frame sets; anything slow in an answer (a
+// snapshot's PNG encoding) is handed back as `encode` and runs on the server's thread.
 //
 // The two threads share only the mailbox below (requests waiting, answers given), under its
 // mutex; the pipeline and its GL context stay on their own thread.
@@ -53,6 +53,7 @@ class ControlServer {
   static constexpr std::chrono::seconds kAnswerTimeout{10};
   static constexpr std::chrono::seconds kReplyTimeout{5};
   static constexpr std::size_t kMaxClients = 256;
+  static constexpr std::size_t kAcceptsPerRound = 32;  // then every client is served once
 
   // Listens on `path` (mode 0660: the service's user and group).
   explicit ControlServer(std::filesystem::path path);
@@ -66,6 +67,7 @@ class ControlServer {
 
  private:
   struct Client;
+  static std::vector<Client>::iterator clientToPutOut(std::vector<Client>& clients);
   void run();
   void wake();
 

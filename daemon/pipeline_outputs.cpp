@@ -51,7 +51,9 @@ bool PipelineOutputs::shows(OutputStream stream) const {
 
 void PipelineOutputs::drop(PictureOutput& output, const std::exception& error) {
   output.sink.reset();
-  output.retryDelay = kFirstOutputRetry;
+  output.retryDelay =
+      output.onTrialSince ? std::min(2 * output.retryDelay, kLastOutputRetry) : kFirstOutputRetry;
+  output.onTrialSince.reset();
   output.nextRetry = Clock::now() + output.retryDelay;
   spdlog::error("output failed, dropping it: {}; trying it again in {} s", error.what(),
                 output.retryDelay.count());
@@ -72,6 +74,10 @@ void PipelineOutputs::deliver(PictureOutput& output, std::chrono::nanoseconds st
     latency_.record(now - origin);
     if (!firstPictureAt_) firstPictureAt_ = now;
     if (drawn) timeSwitch(output, *drawn, now);
+    if (output.onTrialSince && now - *output.onTrialSince >= kOutputTrial) {
+      output.onTrialSince.reset();
+      spdlog::info("output {} works again", output.sink->describe());
+    }
   });
 }
 
@@ -152,7 +158,9 @@ void PipelineOutputs::retry(Clock::time_point now) {
     if (output.sink || now < output.nextRetry) continue;
     try {
       open(output);
-      spdlog::info("output {} works again", output.sink->describe());
+      output.onTrialSince = now;
+      spdlog::info("output {} opened again: it works again once it has taken pictures for {} s",
+                   output.sink->describe(), kOutputTrial.count());
     } catch (const std::exception& e) {
       output.retryDelay = std::min(2 * output.retryDelay, kLastOutputRetry);
       output.nextRetry = now + output.retryDelay;
@@ -210,7 +218,8 @@ void PipelineOutputs::finish(std::chrono::nanoseconds lastTime,
 }
 
 bool PipelineOutputs::anyWorks() const {
-  return std::ranges::any_of(pictures_, [](const PictureOutput& o) { return o.sink != nullptr; }) ||
+  return std::ranges::any_of(pictures_,
+                             [](const PictureOutput& o) { return o.sink && !o.onTrialSince; }) ||
          std::ranges::any_of(recordings_, [](const auto& r) { return r != nullptr; });
 }
 

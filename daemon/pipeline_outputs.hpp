@@ -3,7 +3,11 @@
 // take a picture per frame set (a stream's picture, or a surround view rendered for the output)
 // and those that record the camera frames. One output's failure never stops the others: it is
 // logged and the output dropped, then opened again after kFirstOutputRetry, then after twice as
-// long each time, up to kLastOutputRetry (a disk with room again, a display plugged back in).
+// long each time, up to kLastOutputRetry (a disk with room again, a display plugged back in). An
+// output opened again works again only once it has taken pictures for kOutputTrial without
+// failing: until then it counts as failed (anyWorks(), and so the service's watchdog), and a
+// failure keeps the retries' growing delay. An output opened on a full disk fails at its first
+// writes: it did look healthy, and was opened every few seconds, while it recorded nothing.
 //
 // Error policy: adding an output throws what its factory throws (at start-up, naming the output);
 // after that nothing here throws. Pipeline thread only.
@@ -35,6 +39,7 @@ class PipelineOutputs {
   using Clock = std::chrono::steady_clock;
   static constexpr std::chrono::seconds kFirstOutputRetry{1};
   static constexpr std::chrono::seconds kLastOutputRetry{60};
+  static constexpr std::chrono::seconds kOutputTrial{2};
 
   // An output of pictures: a stream's picture, made by a stage, or a surround view of its own.
   struct PictureOutput {
@@ -45,9 +50,10 @@ class PipelineOutputs {
     std::unique_ptr<render::FrameSink> sink;     // null while it has failed
     Clock::time_point nextRetry{};               // when failed: when it is opened again
     std::chrono::seconds retryDelay{0};
-    std::chrono::nanoseconds pendingTime{0};  // stream time of the view's pending picture
-    Clock::time_point pendingOrigin{};        // capture time of the pending picture's set
-    cv::Mat latest;                           // header over the picture last handed over, BGR
+    std::optional<Clock::time_point> onTrialSince;  // opened again, not yet working again
+    std::chrono::nanoseconds pendingTime{0};        // stream time of the view's pending picture
+    Clock::time_point pendingOrigin{};              // capture time of the pending picture's set
+    cv::Mat latest;                                 // header over the picture last handed over, BGR
     // The current switch of view: whether the output shows it settled (or was spared it), and
     // whether it has had any picture since (an output that takes none, a snapshot after its
     // time, does not hold the switch's end back).

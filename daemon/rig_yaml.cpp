@@ -255,6 +255,34 @@ void emitLensFields(YAML::Emitter& out, const processing::Intrinsics& lens) {
   }
 }
 
+namespace {
+
+// Where in `node` (a key path, "cameras[1].mount.yaw_deg") the first number that is not finite
+// is; none when every number is.
+std::optional<std::string> firstNonFiniteNumber(const YAML::Node& node, const std::string& path) {
+  if (node.IsScalar()) {
+    double value = 0;
+    const bool number = YAML::convert<double>::decode(node, value);
+    return number && !std::isfinite(value) ? std::optional(path) : std::nullopt;
+  }
+  if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      if (auto found = firstNonFiniteNumber(node[i], fmt::format("{}[{}]", path, i))) return found;
+    }
+  }
+  if (node.IsMap()) {
+    for (const auto& entry : node) {
+      const std::string key = entry.first.Scalar();
+      if (auto found = firstNonFiniteNumber(entry.second, path.empty() ? key : path + "." + key)) {
+        return found;
+      }
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 void writeRigFile(const std::filesystem::path& file, std::span<const RigCamera> cameras,
                   std::string_view headerComment, const VehicleConfig* vehicle) {
   YAML::Emitter out;
@@ -268,6 +296,12 @@ void writeRigFile(const std::filesystem::path& file, std::span<const RigCamera> 
   if (!out.good())
     throw ConfigError(
         {fmt::format("{}: cannot write the rig: {}", file.string(), out.GetLastError())});
+  // A calibration that went wrong upstream (a NaN from a degenerate fit or an imported file) is
+  // never written: the daemon would refuse the rig at its next start, far from the cause.
+  if (const auto where = firstNonFiniteNumber(YAML::Load(out.c_str()), "")) {
+    throw ConfigError({fmt::format("{}: not written: {} is not a finite number (NaN or infinite)",
+                                   file.string(), *where)});
+  }
   // Written beside and renamed, so a reader never sees half a rig.
   const auto partial = std::filesystem::path(file.string() + ".part");
   {

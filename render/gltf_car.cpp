@@ -12,8 +12,19 @@
 #include <opencv2/imgproc.hpp>
 #include <tiny_gltf.h>
 
+#include "common/nesting_depth.hpp"
+#include "common/regular_file.hpp"
+
 namespace surroundd::render {
 namespace {
+
+// Bounds a car model must keep (docs/robustness.md): a file, and each file it names, of at most
+// 256 MiB; JSON nested at most 64 levels; nodes nested at most 64; at most 4 million vertices
+// (a detailed car has a few hundred thousand; each costs ~100 bytes while it loads).
+constexpr std::size_t kMaxCarModelFileBytes = std::size_t{256} << 20;
+constexpr std::size_t kMaxJsonDepth = 64;
+constexpr int kMaxNodeDepth = 64;
+constexpr std::size_t kMaxVertices = std::size_t{4} << 20;
 
 // glTF (+Y up, front +Z, so +X left) to the vehicle frame (x forward, y left, z up): a cyclic
 // permutation, so no mirror and the triangles keep their winding.
@@ -137,6 +148,12 @@ cv::Matx44d localTransform(const tinygltf::Node& node) {
   return t * r * s;
 }
 
+// `v` made unit length; divided by its largest component first, so that no square overflows.
+cv::Vec3d direction(const cv::Vec3d& v) {
+  const double largest = std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
+  return largest > 0 ? cv::normalize(v / largest) : v;
+}
+
 // Base colour factors are linear; the car's colours are as shown, as its textures are (sRGB).
 float shown(double linear) {
   return static_cast<float>(std::pow(std::clamp(linear, 0.0, 1.0), 1 / 2.2));
@@ -148,9 +165,22 @@ class CarLoader {
 
   void node(int index, const cv::Matx44d& parent, int depth) {
     const auto& nodes = reader_.model().nodes;
-    if (index < 0 || static_cast<std::size_t>(index) >= nodes.size() || depth > 64) {
-      reader_.fail(fmt::format("node {} does not exist or is its own ancestor", index));
+    if (index < 0 || static_cast<std::size_t>(index) >= nodes.size()) {
+      reader_.fail(fmt::format("node {} does not exist", index));
     }
+    // glTF's nodes form trees (a node has one parent). A node reached twice would be walked again
+    // with everything below it: 12 levels of 8 children naming one node took all memory.
+    visited_.resize(nodes.size());
+    if (visited_[static_cast<std::size_t>(index)]) {
+      reader_.fail(
+          fmt::format("node {} has more than one parent, or is its own ancestor "
+                      "(glTF's nodes form trees)",
+                      index));
+    }
+    if (depth > kMaxNodeDepth) {
+      reader_.fail(fmt::format("node {} lies deeper than {} levels", index, kMaxNodeDepth));
+    }
+    visited_[static_cast<std::size_t>(index)] = true;
     const tinygltf::Node& n = nodes[static_cast<std::size_t>(index)];
     const cv::Matx44d transform = parent * localTransform(n);
     if (n.mesh >= 0) mesh(n.mesh, transform);
@@ -163,28 +193,40 @@ class CarLoader {
     cv::Vec3d lo(std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
                  std::numeric_limits<double>::max());
     cv::Vec3d hi = -lo;
-    for (const cv::Vec3d& p : positions_) {
+    // NaN in a file, or a transform that overflows, would leave the car drawn nowhere.
+    const auto finite = [](const cv::Vec3d& v) {
+      return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+    };
+    for (std::size_t i = 0; i < positions_.size(); ++i) {
+      if (!finite(positions_[i]) || !finite(normals_[i])) {
+        reader_.fail("its vertices or normals are not all finite numbers");
+      }
       for (int k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], p[k]);
-        hi[k] = std::max(hi[k], p[k]);
+        lo[k] = std::min(lo[k], positions_[i][k]);
+        hi[k] = std::max(hi[k], positions_[i][k]);
       }
     }
+    if (!finite(hi - lo)) reader_.fail("it is too large to measure (its size overflows)");
     const cv::Vec3d target(car.lengthM, car.widthM, car.heightM);
     const cv::Vec3d targetLow(car.centreXM - car.lengthM / 2, car.centreYM - car.widthM / 2, 0);
+    const cv::Vec3d extent = hi - lo;
+    const double largest = std::max({extent[0], extent[1], extent[2], 1e-9});
     cv::Vec3d scale;
+    cv::Vec3d normalScale;  // the inverse of `scale`, up to a factor, finite for any extent
     for (int k = 0; k < 3; ++k) {
       // A flat model (a picture on a plane) keeps its thickness of zero.
-      scale[k] = hi[k] - lo[k] > 1e-9 ? target[k] / (hi[k] - lo[k]) : 1.0;
+      const bool flat = extent[k] <= 1e-9;
+      scale[k] = flat ? 1.0 : target[k] / extent[k];
+      normalScale[k] = flat ? 1.0 / largest : extent[k] / largest / target[k];
     }
     for (std::size_t i = 0; i < model_.vertices.size(); ++i) {
       CarVertex& v = model_.vertices[i];
-      cv::Vec3d normal = normals_[i];
+      // Normals take the inverse transpose of the scaling.
+      const cv::Vec3d normal = direction(direction(normals_[i]).mul(normalScale));
       for (int k = 0; k < 3; ++k) {
         v.position[k] = static_cast<float>(targetLow[k] + (positions_[i][k] - lo[k]) * scale[k]);
-        normal[k] /= scale[k];  // normals take the inverse transpose of the scaling
+        v.normal[k] = static_cast<float>(normal[k]);
       }
-      normal = cv::normalize(normal);
-      for (int k = 0; k < 3; ++k) v.normal[k] = static_cast<float>(normal[k]);
     }
     return std::move(model_);
   }
@@ -230,6 +272,10 @@ class CarLoader {
         for (std::size_t i = 0; i < count; ++i) indices.push_back(i);
       }
       const std::size_t first = model_.vertices.size();
+      // Meshes may be shared by nodes: the bound is on what all of them add up to.
+      if (first + indices.size() > kMaxVertices) {
+        reader_.fail(fmt::format("more than {} vertices in its default scene", kMaxVertices));
+      }
       for (std::size_t t = 0; t + 3 <= indices.size(); t += 3) {
         std::array<cv::Vec3d, 3> corner;
         for (int k = 0; k < 3; ++k) {
@@ -342,29 +388,83 @@ class CarLoader {
   std::vector<cv::Vec3d> positions_;  // per vertex, vehicle axes, before the fit to the box
   std::vector<cv::Vec3d> normals_;
   std::vector<int> textureSources_;  // the glTF image of each of model_.textures
+  std::vector<bool> visited_;        // per glTF node
 };
+
+// What tinygltf reads besides the model file (external buffers and images) goes through
+// readRegularFile: a `uri` naming a FIFO hung --check-config and stalled a reload for 76 s, one
+// naming /dev/zero would never end.
+bool readReferencedFile(std::vector<unsigned char>* out, std::string* error,
+                        const std::string& path, void* /*userData*/) {
+  try {
+    const std::string bytes = readRegularFile(path, kMaxCarModelFileBytes);
+    out->assign(bytes.begin(), bytes.end());
+    return true;
+  } catch (const FileReadError& e) {
+    *error += std::string(e.what()) + "\n";
+    return false;
+  }
+}
+
+bool referencedFileExists(const std::string& path, void* /*userData*/) {
+  std::error_code ignored;
+  return std::filesystem::exists(path, ignored);
+}
+
+std::string pathAsWritten(const std::string& path, void* /*userData*/) { return path; }
+
+bool writeNothing(std::string* error, const std::string& /*path*/,
+                  const std::vector<unsigned char>& /*bytes*/, void* /*userData*/) {
+  *error = "the car model is only read";
+  return false;
+}
+
+// The JSON of a .gltf file, or of a .glb's first chunk (its binary chunk may hold any bytes).
+std::string_view jsonOf(std::string_view bytes, bool binary) {
+  if (!binary) return bytes;
+  constexpr std::size_t kHeaderBytes = 20;  // magic, version, length; chunk length and type
+  if (bytes.size() < kHeaderBytes) return {};
+  std::uint32_t length = 0;
+  std::memcpy(&length, bytes.data() + 12, sizeof length);
+  return bytes.substr(kHeaderBytes, length);
+}
 
 }  // namespace
 
 CarModel loadGltfCar(const std::filesystem::path& file, const CarDimensions& car) {
-  tinygltf::TinyGLTF loader;
-  tinygltf::Model model;
-  std::string error;
-  std::string warning;
-  std::error_code status;
-  if (!std::filesystem::is_regular_file(file, status)) {
-    throw CarModelError(fmt::format("car model '{}': not a file", file.string()));
-  }
   const std::string extension = file.extension().string();
-  bool loaded = false;
-  if (extension == ".glb") {
-    loaded = loader.LoadBinaryFromFile(&model, &error, &warning, file.string());
-  } else if (extension == ".gltf") {
-    loaded = loader.LoadASCIIFromFile(&model, &error, &warning, file.string());
-  } else {
+  if (extension != ".glb" && extension != ".gltf") {
     throw CarModelError(
         fmt::format("car model '{}': expected a .glb or .gltf file", file.string()));
   }
+  const bool binary = extension == ".glb";
+  std::string bytes;
+  try {
+    bytes = readRegularFile(file, kMaxCarModelFileBytes);
+  } catch (const FileReadError& e) {
+    throw CarModelError(fmt::format("car model {}", e.what()));
+  }
+  // tinygltf's JSON parser recurses per level: 20 000 nested '[' overflowed the stack. A car
+  // model's JSON nests a handful of levels (extras included, a few dozen).
+  if (const std::size_t depth = nestingDepth(jsonOf(bytes, binary)); depth > kMaxJsonDepth) {
+    throw CarModelError(
+        fmt::format("car model '{}': its JSON nests {} levels deep, more than "
+                    "the {} a glTF file needs",
+                    file.string(), depth, kMaxJsonDepth));
+  }
+  tinygltf::TinyGLTF loader;
+  loader.SetFsCallbacks(
+      {&referencedFileExists, &pathAsWritten, &readReferencedFile, &writeNothing, nullptr});
+  tinygltf::Model model;
+  std::string error;
+  std::string warning;
+  const std::string folder = file.parent_path().string();
+  const bool loaded =
+      binary ? loader.LoadBinaryFromMemory(&model, &error, &warning,
+                                           reinterpret_cast<const unsigned char*>(bytes.data()),
+                                           static_cast<unsigned int>(bytes.size()), folder)
+             : loader.LoadASCIIFromString(&model, &error, &warning, bytes.data(),
+                                          static_cast<unsigned int>(bytes.size()), folder);
   if (!loaded) {
     while (!error.empty() && (error.back() == '\n' || error.back() == ' ')) error.pop_back();
     throw CarModelError(fmt::format("car model '{}': not glTF 2.0 that can be read: {}",

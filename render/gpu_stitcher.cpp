@@ -286,18 +286,17 @@ void GpuStitcher::upload(std::span<const cv::Mat> frames, std::span<const Dmabuf
   }
 }
 
-void GpuStitcher::correctWith(const processing::PoissonColourCorrection* correction) {
-  correction_ = correction;
+void GpuStitcher::correctWith(const std::optional<processing::ColourField>& field) {
+  fieldValues_ = field ? field->values : nullptr;
   glUseProgram(program_.name());
-  if (correction == nullptr) {
+  if (!field) {
     glUniform1i(correctionUniform_, 0);
     return;
   }
-  const processing::CorrectionDomain& domain = correction->domain();
-  if (domain.share.size() != static_cast<std::size_t>(size_.area())) {
+  if (field->shares.size() != static_cast<std::size_t>(size_.area())) {
     throw std::invalid_argument("the correction was set up for another panorama");
   }
-  const cv::Size grid = correction->field().size();
+  const cv::Size grid = field->values->size();
   field_ = gl::Texture();
   glBindTexture(GL_TEXTURE_2D, field_.name());
   glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGB32F, grid.width, grid.height);
@@ -306,22 +305,21 @@ void GpuStitcher::correctWith(const processing::PoissonColourCorrection* correct
   glTexStorage2D(GL_TEXTURE_2D, 1, GL_R16UI, size_.width, size_.height);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 2);
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, size_.width, size_.height, GL_RED_INTEGER,
-                  GL_UNSIGNED_SHORT, domain.share.data());
+                  GL_UNSIGNED_SHORT, field->shares.data());
   for (const GLuint texture : {field_.name(), shares_.name()}) {
     glBindTexture(GL_TEXTURE_2D, texture);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   }
-  glUniform1i(correctionUniform_,
-              correction->settings().field == processing::CorrectionField::kAdditive ? 2 : 1);
-  glUniform1i(blockUniform_, domain.block);
+  glUniform1i(correctionUniform_, field->additive ? 2 : 1);
+  glUniform1i(blockUniform_, field->block);
   gl::check("setting up the GPU colour correction");
 }
 
 void GpuStitcher::stitch() {
-  if (correction_ != nullptr) {
+  if (fieldValues_ != nullptr) {
     // The field as the last update() left it: a few thousand blocks, uploaded as they are.
-    const cv::Mat& field = correction_->field();
+    const cv::Mat& field = *fieldValues_;
     glBindTexture(GL_TEXTURE_2D, field_.name());
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, field.cols, field.rows, GL_RGB, GL_FLOAT, field.data);

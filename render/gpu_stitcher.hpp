@@ -8,15 +8,17 @@
 // neighbourhood interpolated bilinearly in the frame's own format and converted to colour with
 // cv::cvtColor's BT.601 constants, its blend tap mixed in by its weight, the unseen colour where
 // no camera sees; in floating point rather than in Stitcher's fixed point, so the two agree
-// within rounding (tested: gpu_stitcher_test). With a Poisson colour correction it applies its
-// field in the same pass as PoissonColourCorrection::apply() does (the block grid upsampled with
-// the same Catmull-Rom weights, the same multiplicative or additive rule and seam-band shares):
-// the correction's solve stays on the CPU, and only its small field is uploaded per frame.
+// within rounding (tested: gpu_stitcher_test). With a colour correction it applies its field
+// (processing/colour_field.hpp) in the same pass as PoissonColourCorrection::apply() does (the
+// block grid upsampled with the same Catmull-Rom weights, the same multiplicative or additive rule
+// and seam-band shares): the correction's solve stays on the CPU, and only its small field is
+// uploaded per frame.
 //
 // Built at start-up on the thread of the current EglContext; upload() and stitch() are the
 // per-frame calls and allocate nothing.
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -25,7 +27,7 @@
 
 #include "common/dmabuf_planes.hpp"
 #include "common/pixel_format.hpp"
-#include "processing/colour/poisson_correction.hpp"
+#include "processing/colour_field.hpp"
 #include "processing/stitch/panorama_lut.hpp"
 #include "render/camera_texture.hpp"
 #include "render/gl_objects.hpp"
@@ -58,10 +60,10 @@ class GpuStitcher {
   const std::string& importRefusal(std::size_t camera) const {
     return cameras_[camera].importRefusal();
   }
-  // Applies `correction`'s field from the next stitch() on, as it stands after each update()
-  // (borrowed: it must outlive its use here); nullptr: none. Set-up, not per frame: the first
-  // call for a correction uploads its seam-band shares (two bytes a panorama pixel).
-  void correctWith(const processing::PoissonColourCorrection* correction);
+  // Applies `field` from the next stitch() on, its values as they stand at each stitch (borrowed:
+  // its correction must outlive its use here); none: no correction. Set-up, not per frame: it
+  // uploads the field's shares (two bytes a panorama pixel).
+  void correctWith(const std::optional<processing::ColourField>& field);
   // Writes the panorama texture from the frames last uploaded (and the correction's field as it
   // is now), and waits for the GPU to have read any imported frame: their buffers go back to the
   // camera's driver once the set is done. Leaves framebuffer 0 bound and texture unit 0 active.
@@ -85,10 +87,10 @@ class GpuStitcher {
   std::vector<std::span<std::uint8_t>> mapped_;  // each camera's buffer while an upload fills it
   std::vector<char> imported_;                   // per camera: its last frame imported
   gl::Texture taps_;                             // RG32UI: each pixel's LutTap as two words
-  gl::Texture blends_;  // the same for its blend tap; weight 0 where it has none
-  const processing::PoissonColourCorrection* correction_ = nullptr;
-  gl::Texture field_;   // RGB32F, the correction's block grid
-  gl::Texture shares_;  // R16UI, each panorama pixel's source share 0..256
+  gl::Texture blends_;                    // the same for its blend tap; weight 0 where it has none
+  const cv::Mat* fieldValues_ = nullptr;  // the correction's block grid, null with none
+  gl::Texture field_;                     // RGB32F, its copy uploaded per stitch
+  gl::Texture shares_;                    // R16UI, each panorama pixel's source share 0..256
   gl::Texture panorama_;
   gl::Framebuffer framebuffer_;
   gl::VertexArray emptyArray_;  // the full-screen triangle makes its vertices from gl_VertexID

@@ -27,7 +27,7 @@ cmake --preset fuzz >/dev/null
 cmake --build --preset fuzz -j"${FUZZ_JOBS:-2}"
 
 build=build/fuzz
-targets="${FUZZ_TARGETS:-config_fuzz rig_fuzz control_fuzz http_host_fuzz http_server_fuzz lut_cache_fuzz jpeg_fuzz}"
+targets="${FUZZ_TARGETS:-config_fuzz rig_fuzz control_fuzz http_host_fuzz http_server_fuzz lut_cache_fuzz jpeg_fuzz dbc_fuzz gltf_fuzz import_fuzz}"
 mkdir -p "$build/findings"
 # Leaks count as findings; UB stops the run with a stack like ASan's. ASan's freed-memory quarantine
 # is 16 MB, not 256: an input's use after free is caught within its own run, and the default made

@@ -1,9 +1,9 @@
 #include "vehicle/can_database.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <limits>
-#include <regex>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -38,19 +38,145 @@ std::uint64_t rawMask(int length) {
   return length >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << length) - 1;
 }
 
-double number(const std::string& text, std::string_view origin, int line, const char* what) {
-  std::size_t used = 0;
+double number(std::string_view text, std::string_view origin, int line, const char* what) {
+  // from_chars reads no sign '+', which DBC writers put before factors and offsets.
+  const std::string_view written = text.starts_with('+') ? text.substr(1) : text;
   double value = 0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != text.size() || !std::isfinite(value)) {
+  const auto [end, error] = std::from_chars(written.data(), written.data() + written.size(), value);
+  if (error != std::errc{} || end != written.data() + written.size() || !std::isfinite(value)) {
     throw CanDatabaseError(
         fmt::format("{}:{}: {}: expected a number, got '{}'", origin, line, what, text));
   }
   return value;
+}
+
+// A whole number of at most `highest` (digits only, as DBC writes ids, lengths and bits).
+std::uint32_t wholeNumber(std::string_view digits, std::uint32_t highest, std::string_view origin,
+                          int line, const char* what) {
+  std::uint64_t value = 0;
+  const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+  if (error != std::errc{} || end != digits.data() + digits.size() || value > highest) {
+    throw CanDatabaseError(fmt::format("{}:{}: {}: expected a whole number of at most {}, got '{}'",
+                                       origin, line, what, highest, digits));
+  }
+  return static_cast<std::uint32_t>(value);
+}
+
+// One DBC line, read left to right in a single pass. std::regex read these lines before: its
+// matcher recurses once per character, and a line of ~40 KB overflowed the stack.
+class LineScanner {
+ public:
+  explicit LineScanner(std::string_view line) : rest_(line) {}
+
+  void skipSpace() {
+    while (!rest_.empty() && isSpace(rest_.front())) rest_.remove_prefix(1);
+  }
+  // `word` at the start of the line (after blanks) and at least one blank after it.
+  bool keyword(std::string_view word) {
+    skipSpace();
+    if (!rest_.starts_with(word) || rest_.size() == word.size() || !isSpace(rest_[word.size()])) {
+      return false;
+    }
+    rest_.remove_prefix(word.size());
+    skipSpace();
+    return true;
+  }
+  // The character `c` next, with no blanks before it unless `blanksBefore`.
+  bool literal(char c, bool blanksBefore = true) {
+    if (blanksBefore) skipSpace();
+    if (rest_.empty() || rest_.front() != c) return false;
+    rest_.remove_prefix(1);
+    return true;
+  }
+  // The longest run (at least one character) of characters that `accepts`; empty when none.
+  template <class Accepts>
+  std::string_view run(Accepts&& accepts) {
+    std::size_t length = 0;
+    while (length < rest_.size() && accepts(rest_[length])) ++length;
+    const std::string_view taken = rest_.substr(0, length);
+    rest_.remove_prefix(length);
+    return taken;
+  }
+  std::string_view digits() {
+    return run([](char c) { return c >= '0' && c <= '9'; });
+  }
+  std::string_view identifier() {
+    return run([](char c) {
+      return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_';
+    });
+  }
+  // Characters up to a blank or `stop`.
+  std::string_view until(char stop) {
+    return run([stop](char c) { return c != stop && !isSpace(c); });
+  }
+  char peek() const { return rest_.empty() ? '\0' : rest_.front(); }
+
+ private:
+  static bool isSpace(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f';
+  }
+
+  std::string_view rest_;
+};
+
+// BO_ <id> <name>: <length> <sender>
+struct MessageLine {
+  std::string_view id, name, length;
+};
+std::optional<MessageLine> readMessageLine(std::string_view line) {
+  LineScanner scan(line);
+  MessageLine read;
+  if (!scan.keyword("BO_") || (read.id = scan.digits()).empty()) return std::nullopt;
+  scan.skipSpace();
+  if ((read.name = scan.identifier()).empty() || !scan.literal(':')) return std::nullopt;
+  scan.skipSpace();
+  if ((read.length = scan.digits()).empty()) return std::nullopt;
+  return read;
+}
+
+// "M" (the multiplexor) or "m<n>" / "m<n>M" (multiplexed by the multiplexor's value n).
+bool isMultiplexIndicator(std::string_view word) {
+  if (word == "M") return true;
+  if (!word.starts_with('m')) return false;
+  word.remove_prefix(1);
+  if (word.ends_with('M')) word.remove_suffix(1);
+  return !word.empty() && word.find_first_not_of("0123456789") == std::string_view::npos;
+}
+
+// SG_ <name> [M|m<n>[M]] : <start>|<length>@<order><sign> (<factor>,<offset>) ...
+struct SignalLine {
+  std::string_view name, multiplex, start, length, factor, offset;
+  char order = 0, sign = 0;
+};
+std::optional<SignalLine> readSignalLine(std::string_view line) {
+  LineScanner scan(line);
+  SignalLine read;
+  if (!scan.keyword("SG_") || (read.name = scan.identifier()).empty()) return std::nullopt;
+  scan.skipSpace();
+  if (scan.peek() != ':') {
+    read.multiplex = scan.identifier();
+    if (!isMultiplexIndicator(read.multiplex)) return std::nullopt;
+  }
+  if (!scan.literal(':')) return std::nullopt;
+  scan.skipSpace();
+  if ((read.start = scan.digits()).empty() || !scan.literal('|', false) ||
+      (read.length = scan.digits()).empty() || !scan.literal('@', false)) {
+    return std::nullopt;
+  }
+  read.order = scan.peek();
+  if ((read.order != '0' && read.order != '1') || !scan.literal(read.order, false)) {
+    return std::nullopt;
+  }
+  read.sign = scan.peek();
+  if ((read.sign != '+' && read.sign != '-') || !scan.literal(read.sign, false)) {
+    return std::nullopt;
+  }
+  if (!scan.literal('(')) return std::nullopt;
+  scan.skipSpace();
+  if ((read.factor = scan.until(',')).empty() || !scan.literal(',')) return std::nullopt;
+  scan.skipSpace();
+  if ((read.offset = scan.until(')')).empty() || !scan.literal(')')) return std::nullopt;
+  return read;
 }
 
 }  // namespace
@@ -110,11 +236,6 @@ void CanSignal::encode(double physical, std::span<std::uint8_t> data) const {
 }
 
 CanDatabase CanDatabase::fromDbc(std::string_view text, std::string_view origin) {
-  // BO_ <id> <name>: <length> <sender>
-  static const std::regex kMessage(R"(^\s*BO_\s+(\d+)\s+(\w+)\s*:\s*(\d+))");
-  // SG_ <name> [M|m<n>] : <start>|<length>@<order><sign> (<factor>,<offset>) ...
-  static const std::regex kSignal(
-      R"(^\s*SG_\s+(\w+)\s*(M|m\d+M?)?\s*:\s*(\d+)\|(\d+)@([01])([+-])\s*\(\s*([^,\s]+)\s*,\s*([^)\s]+)\s*\))");
   // The pseudo-message DBC editors keep signals that belong to no message in.
   constexpr std::uint32_t kIndependentSignals = 0xC0000000U;
 
@@ -131,39 +252,41 @@ CanDatabase CanDatabase::fromDbc(std::string_view text, std::string_view origin)
   std::size_t at = 0;
   while (at <= text.size()) {
     const std::size_t end = std::min(text.find('\n', at), text.size());
-    const std::string line(text.substr(at, end - at));
+    const std::string_view line = text.substr(at, end - at);
     at = end + 1;
     ++lineNumber;
-    std::smatch match;
-    if (std::regex_search(line, match, kMessage)) {
-      const auto id =
-          static_cast<std::uint32_t>(number(match[1].str(), origin, lineNumber, "message id"));
-      message = Message{id & 0x1FFFFFFFU, (id & 0x80000000U) != 0,
-                        static_cast<int>(number(match[3].str(), origin, lineNumber, "length")),
-                        id == kIndependentSignals, match[2].str()};
+    if (const auto read = readMessageLine(line)) {
+      const std::uint32_t id = wholeNumber(read->id, 0xFFFFFFFFU, origin, lineNumber, "message id");
+      message =
+          Message{id & 0x1FFFFFFFU, (id & 0x80000000U) != 0,
+                  static_cast<int>(wholeNumber(read->length, 0xFFFF, origin, lineNumber, "length")),
+                  id == kIndependentSignals, std::string(read->name)};
       if (!message->independent && (message->bytes < 1 || message->bytes > 64)) {
         throw CanDatabaseError(fmt::format("{}:{}: message '{}' of {} bytes, expected 1..64",
                                            origin, lineNumber, message->name, message->bytes));
       }
       continue;
     }
-    if (std::regex_search(line, match, kSignal)) {
+    if (const auto read = readSignalLine(line)) {
       if (!message) {
         throw CanDatabaseError(fmt::format("{}:{}: signal '{}' before any message (BO_)", origin,
-                                           lineNumber, match[1].str()));
+                                           lineNumber, read->name));
       }
       // A multiplexed signal means something only with its multiplexor's value: not read.
-      if (message->independent || (match[2].matched && match[2].str()[0] == 'm')) continue;
+      if (message->independent || read->multiplex.starts_with('m')) continue;
       CanSignal signal;
-      signal.name = match[1].str();
+      signal.name = std::string(read->name);
       signal.messageId = message->id;
       signal.extended = message->extended;
-      signal.startBit = static_cast<int>(number(match[3].str(), origin, lineNumber, "start bit"));
-      signal.length = static_cast<int>(number(match[4].str(), origin, lineNumber, "length"));
-      signal.order = match[5].str() == "1" ? ByteOrder::kIntel : ByteOrder::kMotorola;
-      signal.isSigned = match[6].str() == "-";
-      signal.factor = number(match[7].str(), origin, lineNumber, "factor");
-      signal.offset = number(match[8].str(), origin, lineNumber, "offset");
+      // Past 64 bytes' bits a start or length is refused by problem() below.
+      signal.startBit =
+          static_cast<int>(wholeNumber(read->start, 0xFFFF, origin, lineNumber, "start bit"));
+      signal.length =
+          static_cast<int>(wholeNumber(read->length, 0xFFFF, origin, lineNumber, "length"));
+      signal.order = read->order == '1' ? ByteOrder::kIntel : ByteOrder::kMotorola;
+      signal.isSigned = read->sign == '-';
+      signal.factor = number(read->factor, origin, lineNumber, "factor");
+      signal.offset = number(read->offset, origin, lineNumber, "offset");
       if (const auto problem = signal.problem(message->bytes)) {
         throw CanDatabaseError(
             fmt::format("{}:{}: message '{}': {}", origin, lineNumber, message->name, *problem));
@@ -172,9 +295,8 @@ CanDatabase CanDatabase::fromDbc(std::string_view text, std::string_view origin)
       database.signals_.push_back(std::move(signal));
       continue;
     }
-    const std::size_t first = line.find_first_not_of(" \t");
-    if (first != std::string::npos && line.compare(first, 3, "SG_") == 0 &&
-        first + 3 < line.size() && (line[first + 3] == ' ' || line[first + 3] == '\t')) {
+    LineScanner scan(line);
+    if (scan.keyword("SG_")) {
       throw CanDatabaseError(
           fmt::format("{}:{}: a signal line (SG_) that does not read as "
                       "'SG_ NAME : START|LENGTH@ORDER SIGN (FACTOR,OFFSET)'",

@@ -9,6 +9,7 @@
 #include <functional>
 #include <future>
 #include <memory>
+#include <optional>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -57,7 +58,10 @@ class PanoramaStage final : public PipelineStage {
   const std::vector<DmabufPlanes>& dmabufs() const { return dmabufs_; }
   PixelFormat frameFormat() const { return format_; }
   // The Poisson correction, updated by each process(); null with another colour_correction.
-  const processing::PoissonColourCorrection* poisson() const { return poisson_.get(); }
+  // The Poisson correction's field, for a stitcher to apply; none with another method or none.
+  std::optional<processing::ColourField> colourField() const {
+    return poisson_ ? std::optional(poisson_->asColourField()) : std::nullopt;
+  }
 
   // A view that does not move, made the way the panorama is made but through the view's own LUT
   // (processing/stitch/view_lut.hpp): gathered from the set's frames straight into the view's

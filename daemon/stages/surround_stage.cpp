@@ -136,7 +136,7 @@ SurroundStage::SurroundStage(const Config& config, SurroundRenderer renderer,
   if (gpu) {
     try {
       gpu_ = std::make_unique<render::GpuStitcher>(panorama.lut(), cameraFormat, panorama.pool());
-      gpu_->correctWith(panorama.poisson());
+      gpu_->correctWith(panorama.colourField());
     } catch (const render::RenderError& e) {
       spdlog::warn("processing: the GPU cannot stitch the panorama: {}", e.what());
       gpu_.reset();
@@ -249,7 +249,7 @@ void SurroundStage::stitchOnGpu() {
                  toString(format), toString(gpu_->format()));
     gpu_ =
         std::make_unique<render::GpuStitcher>(panoramaStage_.lut(), format, panoramaStage_.pool());
-    gpu_->correctWith(panoramaStage_.poisson());
+    gpu_->correctWith(panoramaStage_.colourField());
   }
   {
     const render::GpuTimer::Scope timed(&gpuTimer_, render::GpuStep::kUpload);

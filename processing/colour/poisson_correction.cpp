@@ -110,6 +110,11 @@ const std::vector<std::string>& PoissonColourCorrection::notes() const {
 
 const CorrectionDomain& PoissonColourCorrection::domain() const { return active_->domain; }
 
+ColourField PoissonColourCorrection::asColourField() const {
+  const CorrectionDomain& shape = domain();
+  return {&field_, shape.share, shape.block, settings_.field == CorrectionField::kAdditive};
+}
+
 // Which cameras are present is a bitmask (configurationFor's key); the rig's LUT holds at most
 // kMaxCameras (buildPanoramaLut), so every camera has its bit.
 static_assert(kMaxCameras <= 32, "a std::uint32_t camera bitmask holds every camera");

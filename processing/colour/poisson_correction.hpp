@@ -43,6 +43,7 @@
 #include "processing/colour/correction_domain.hpp"
 #include "processing/colour/poisson_solver.hpp"
 #include "processing/colour/seam_statistics.hpp"
+#include "processing/colour_field.hpp"
 #include "processing/stitch/kernel_path.hpp"
 
 namespace surroundd {
@@ -145,6 +146,8 @@ class PoissonColourCorrection {
   // The field at block resolution, CV_32FC3: the levels it adds to a pixel at 255, the most it
   // changes any pixel (0 outside the regions' reach). Additive: simply the levels it adds.
   const cv::Mat& field() const { return field_; }
+  // The field as a stitcher applies it (processing/colour_field.hpp), borrowing this correction's.
+  ColourField asColourField() const;
 
  private:
   struct RegionState;

@@ -29,6 +29,9 @@ constexpr AVRational kMicroseconds{1, 1'000'000};
 // MP4 writes a first timestamp other than zero as an edit list in the movie timescale, which
 // defaults to milliseconds: the whole file would then be shifted by up to 1 ms.
 constexpr const char* kMp4MovieTimescale = "1000000";
+constexpr const char* kMp4FragmentMicroseconds = "1000000";
+// A few seconds of a 1080p stream.
+constexpr std::uintmax_t kMinFreeBytes = std::uintmax_t{8} << 20;
 
 bool takes(const AVCodec* encoder, AVPixelFormat format) {
   // An encoder that lists none (v4l2m2m) learns its device's formats only when it opens.
@@ -66,6 +69,7 @@ struct VideoEncoder::Impl {
   // Set by any thread (a viewer joining), taken by the one that writes.
   std::atomic<bool> keyframeWanted{false};
   std::uint64_t framesWritten = 0;
+  std::uint64_t packetsWritten = 0;  // into the file, as far as the muxer was concerned
   std::optional<std::int64_t> lastPts;
   bool closed = false;
 
@@ -84,12 +88,24 @@ struct VideoEncoder::Impl {
 
   void open();
   void openContainer();
+  // A file is not begun on a disk that is all but full: it would fail at its first writes.
+  void refuseAFullDisk() const;
   void openCodec(AVPixelFormat pixelFormat);
   // Empty when `encoder` opened; else why not (and nothing of it kept).
   std::string tryCodec(const AVCodec* encoder, AVPixelFormat pixelFormat);
   std::string useHardwareFrames();
   void drain(bool flushing);
   void handOver(const AVPacket& encoded) const;
+  // After a failure (a full disk, a failed encode): closes the file where it stands and gives it
+  // its name, or removes it when no packet reached it. Says which, for the error message.
+  std::string endFile();
+  // Fails as fail() does; a file is ended first (endFile()) and the encoder writes no more.
+  [[noreturn]] void failAndEndFile(std::string_view what, int error) {
+    if (live()) fail(what, error);
+    closed = true;
+    const std::string ended = endFile();
+    fail(fmt::format("{}: {}; {}", what, ffmpeg::errorText(error), ended));
+  }
 };
 
 void VideoEncoder::Impl::open() {
@@ -125,6 +141,12 @@ void VideoEncoder::Impl::open() {
     AVDictionary* muxerOptions = nullptr;
     if (settings.path.extension() == ".mp4" && settings.url.empty()) {
       av_dict_set(&muxerOptions, "movie_timescale", kMp4MovieTimescale, 0);
+      // Fragments of at most a second, each playable alone: a file cut short (a full disk, a
+      // kill, a power loss) plays up to its last whole fragment, where a plain MP4 keeps its
+      // index for the end and plays nothing. The index is written with the first fragment
+      // (delay_moov), when the stream's start is known, so that timestamps stay as given.
+      av_dict_set(&muxerOptions, "movflags", "+frag_keyframe+delay_moov+default_base_moof", 0);
+      av_dict_set(&muxerOptions, "frag_duration", kMp4FragmentMicroseconds, 0);
     }
     if (!settings.url.empty()) {
       // Each picture leaves whole as soon as it is encoded: its last datagram is not held for the
@@ -170,6 +192,7 @@ void VideoEncoder::Impl::openContainer() {
   // A file is written under a temporary name until it is finalized; a stream has no name to keep.
   std::string destination = settings.url;
   if (!network) {
+    refuseAFullDisk();
     partPath = settings.path;
     partPath += ".part";
     destination = partPath.string();
@@ -188,6 +211,20 @@ void VideoEncoder::Impl::openContainer() {
   if (const int error = avio_open(&format->pb, destination.c_str(), AVIO_FLAG_WRITE); error < 0) {
     fail(network ? std::string("cannot open") : fmt::format("cannot create '{}'", destination),
          error);
+  }
+}
+
+void VideoEncoder::Impl::refuseAFullDisk() const {
+  const auto folder = settings.path.parent_path().empty() ? std::filesystem::path(".")
+                                                          : settings.path.parent_path();
+  std::error_code error;
+  const std::filesystem::space_info space = std::filesystem::space(folder, error);
+  // A folder that cannot be asked is left to the file's creation to name what is wrong.
+  if (!error && space.available < kMinFreeBytes) {
+    fail(
+        fmt::format("the disk is full: {} KiB free in '{}', less than the {} MiB a video starts "
+                    "with",
+                    space.available >> 10, folder.string(), kMinFreeBytes >> 20));
   }
 }
 
@@ -342,7 +379,7 @@ void VideoEncoder::Impl::drain(bool flushing) {
   while (true) {
     const int status = avcodec_receive_packet(codec.get(), packet.get());
     if (status == AVERROR(EAGAIN) || (flushing && status == AVERROR_EOF)) return;
-    if (status < 0) fail("encoding failed", status);
+    if (status < 0) failAndEndFile("encoding failed", status);
     if (handedOver()) {
       handOver(*packet);
       av_packet_unref(packet.get());
@@ -350,10 +387,28 @@ void VideoEncoder::Impl::drain(bool flushing) {
     }
     av_packet_rescale_ts(packet.get(), codec->time_base, stream->time_base);
     packet->stream_index = stream->index;
+    // A full disk: what reached the file stays, playable, and this encoder writes no more.
     if (const int error = av_interleaved_write_frame(format.get(), packet.get()); error < 0) {
-      fail(live() ? "cannot send" : "cannot write to the file", error);
+      failAndEndFile(live() ? "cannot send" : "cannot write to the file", error);
     }
+    ++packetsWritten;
   }
+}
+
+std::string VideoEncoder::Impl::endFile() {
+  format.reset();  // closes the file; what its buffer still held may not reach the disk
+  std::error_code error;
+  if (packetsWritten == 0) {
+    std::filesystem::remove(partPath, error);
+    return "no file made";
+  }
+  std::filesystem::rename(partPath, settings.path, error);
+  if (error) {
+    return fmt::format("'{}' keeps what was written before, under that name ({})",
+                       partPath.string(), error.message());
+  }
+  return fmt::format("'{}' keeps what was written before ({} of {} frames encoded), playable",
+                     settings.path.string(), packetsWritten, framesWritten);
 }
 
 void VideoEncoder::Impl::handOver(const AVPacket& encoded) const {
@@ -444,28 +499,21 @@ void VideoEncoder::close() {
   auto& s = *impl_;
   if (s.closed || (!s.format && !s.handedOver())) return;
   s.closed = true;
-  const auto discard = [&s] {
-    s.format.reset();
-    std::error_code ignored;
-    std::filesystem::remove(s.partPath, ignored);
-  };
   if (s.framesWritten == 0) {
-    discard();
+    s.format.reset();
     if (s.live()) return;  // nothing was sent; nothing is lost
+    s.endFile();
     s.fail("no frames written; no file made");
   }
-  try {
-    if (const int error = avcodec_send_frame(s.codec.get(), nullptr); error < 0)
-      s.fail("flushing failed", error);
-    s.drain(true);
-    if (s.handedOver()) return;
-    if (const int error = av_write_trailer(s.format.get()); error < 0)
-      s.fail("cannot finalize the file", error);
-    s.format.reset();  // closes the file
-  } catch (...) {
-    discard();
-    throw;
+  if (const int error = avcodec_send_frame(s.codec.get(), nullptr); error < 0) {
+    s.failAndEndFile("flushing failed", error);
   }
+  s.drain(true);
+  if (s.handedOver()) return;
+  if (const int error = av_write_trailer(s.format.get()); error < 0) {
+    s.failAndEndFile(s.live() ? "cannot finish the stream" : "cannot finalize the file", error);
+  }
+  s.format.reset();  // closes the file
   if (s.live()) return;
   std::error_code renamed;
   std::filesystem::rename(s.partPath, s.settings.path, renamed);

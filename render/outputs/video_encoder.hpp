@@ -6,10 +6,13 @@
 // that a receiver can join any time, sooner on request (requestKeyframe()), and, with
 // stampCaptureTime, each picture's capture time in it (capture_time_sei.hpp).
 //
-// The file is written as "<path>.part" and renamed to <path> only when it has been finalized
-// (trailer written), so a finished name always plays and nothing half-written carries it. close()
-// finalizes; the destructor finalizes too if close() was not called (an exception or a signal on
-// the way out still leaves a playable file).
+// The file is written as "<path>.part" and renamed to <path> when it has been finalized (trailer
+// written). close() finalizes; the destructor finalizes too if close() was not called (an
+// exception or a signal on the way out still leaves a playable file). A failure once frames have
+// reached the file (a full disk, a failed encode) ends the file where it stands and renames it
+// too, saying so in the error: Matroska, and MP4 written in fragments of at most a second, play
+// up to where they were cut, so nothing written is lost. Only a file with no frame is removed. A
+// file is not begun on a disk with less than 8 MiB free.
 //
 // A ".part" left by an earlier crash is overwritten. If construction fails, nothing is left behind.
 //

@@ -12,7 +12,8 @@ namespace {
 constexpr std::int64_t kMaxSegment = 999'999'999'999;
 
 // The highest N of the <stem>-N<ext> files next to `path` (or their .part files: a segment a
-// killed run left unfinished is kept too), or 0.
+// killed run left unfinished is kept too), or 0; any N past kMaxSegment counts as kMaxSegment (a
+// stray "seg-9223372036854775807" made the next number wrap to a negative one).
 std::int64_t lastSegmentIn(const std::filesystem::path& path) {
   const auto folder = path.parent_path().empty() ? std::filesystem::path(".") : path.parent_path();
   const std::string stem = path.stem().string();
@@ -25,11 +26,15 @@ std::int64_t lastSegmentIn(const std::filesystem::path& path) {
     if (!name.starts_with(stem + "-") || !name.ends_with(extension)) continue;
     const std::string_view digits(name.data() + stem.size() + 1,
                                   name.size() - stem.size() - 1 - extension.size());
-    std::int64_t number = 0;
+    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string_view::npos) {
+      continue;
+    }
+    std::uint64_t number = 0;
     const auto [end, failed] =
         std::from_chars(digits.data(), digits.data() + digits.size(), number);
-    if (failed == std::errc() && end == digits.data() + digits.size())
-      last = std::max(last, number);
+    const bool past = failed == std::errc::result_out_of_range ||
+                      number > static_cast<std::uint64_t>(kMaxSegment);
+    last = std::max(last, past ? kMaxSegment : static_cast<std::int64_t>(number));
   }
   return last;
 }

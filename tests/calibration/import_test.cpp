@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <sys/stat.h>
 
 #include "daemon/rig_yaml.hpp"
 #include "processing/camera_model.hpp"
@@ -484,6 +485,50 @@ TEST(Import, BadInputIsRefusedNamingTheFileAndKey) {
               HasSubstr("left-handed"));
   EXPECT_THAT(importError({"--pjlab", dir.path().string(), "--out", "x.yaml"}),
               HasSubstr("no folder 'intrinsic'"));
+}
+
+// Issue 51: files that crashed or hung the importer, or had it write a rig the daemon refuses.
+// Each is refused naming the file, before OpenCV's reader sees it.
+TEST(Import, FilesMadeToBreakTheReadersAreRefusedNamingTheFile) {
+  const TempDir dir;
+  const auto refused = [&](const std::filesystem::path& file, const std::string& why) {
+    EXPECT_THAT(
+        importError({"--camera", "front=" + file.string(), "--out", (dir / "rig.yaml").string()}),
+        AllOf(HasSubstr(file.string()), HasSubstr(why)))
+        << why;
+  };
+  // Nested 100 000 deep: a stack overflow in OpenCV's JSON parser.
+  refused(dir.write("deep.json",
+                    "{\"K\": " + std::string(100000, '[') + std::string(100000, ']') + "}"),
+          "nests 100001 levels deep; a calibration file needs at most 64");
+  std::string xml = "<?xml version=\"1.0\"?>\n<opencv_storage>";
+  for (int i = 0; i < 5000; ++i) xml += "<a>";
+  refused(dir.write("deep.xml", xml), "nests 5001 levels deep");
+  // A base64 block whose header OpenCV's decoder loops on (found by mutating one it wrote).
+  refused(dir.write("binary.yml",
+                    "%YAML:1.0\n---\nv: !!binary |\n -  "
+                    "MWkgICAgICAgICAgICAgICAgICAgICAgdAQAAAAIAAAADAAAA\n"),
+          "holds base64-coded data (!!binary or $base64$), which is not read");
+  // A results file that is /dev/zero, and a FIFO named as a calibration.
+  const auto zero = dir / "calib_results.txt";
+  std::filesystem::create_symlink("/dev/zero", zero);
+  refused(zero, "a character device, not a file");
+  const auto fifo = dir / "fifo.yml";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  refused(fifo, "a FIFO, not a file");
+  // NaN and infinity in a matrix, and an image size past an int.
+  refused(dir.write("nan.yml", "%YAML:1.0\nK: [300, 0, .nan, 0, 300, 240, 0, 0, 1]\n"),
+          ": K: expected a 3x3 camera matrix or [fx, fy, cx, cy], got a value that is not a "
+          "finite number");
+  refused(dir.write("inf.yml",
+                    "%YAML:1.0\nK: [300, 0, 320, 0, 300, 240, 0, 0, 1]\n"
+                    "D: [0, 0, 0, 0, 0]\nrvec: [0, 0, 0]\ntvec: [0, -.inf, 1]\n"),
+          ": tvec: expected a translation of 3 numbers, got a value that is not a finite number");
+  refused(dir.write("size.yml",
+                    "%YAML:1.0\nK: [300, 0, 320, 0, 300, 240, 0, 0, 1]\n"
+                    "image_size: [1e300, 480]\n"),
+          ": image_size: expected an image size of 1 to 65536 pixels a side");
+  EXPECT_FALSE(std::filesystem::exists(dir / "rig.yaml"));
 }
 
 }  // namespace

@@ -188,6 +188,41 @@ TEST_F(ControlServerTest, IdleAndSlowClientsHoldUpNobody) {
   ::close(slow);
 }
 
+// Issue 51: 500 idle clients that connect again as soon as they are put out made `surroundctl
+// status` fail 14 times in 14 ("no reply in time"): past kMaxClients the client put out was the
+// one with a request on its way, accepted last. Idle ones make room now; every request is answered.
+TEST_F(ControlServerTest, IdleClientsThatReconnectLockNobodyOut) {
+  // Stopped and joined however the test ends.
+  const std::jthread attacker([this](const std::stop_token& stop) {
+    std::vector<int> idle(ControlServer::kMaxClients + 244, -1);
+    while (!stop.stop_requested()) {
+      for (int& fd : idle) {
+        // One put out (told so, or closed) connects again at once.
+        pollfd told{fd, POLLIN, 0};
+        if (fd >= 0 && ::poll(&told, 1, 0) == 0) continue;
+        if (fd >= 0) ::close(fd);
+        fd = connectRaw(path_);
+      }
+    }
+    for (const int fd : idle) {
+      if (fd >= 0) ::close(fd);
+    }
+  });
+  // The attack under way: the server is full and putting clients out.
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  int answered = 0;
+  for (int i = 0; i < 14; ++i) {
+    try {
+      const auto reply = sendControlRequest(path_, "status", std::chrono::seconds(5));
+      answered += reply.ok ? 1 : 0;
+      EXPECT_TRUE(reply.ok) << i << ": " << reply.body;
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << i << ": " << e.what();
+    }
+  }
+  EXPECT_EQ(answered, 14);
+}
+
 // A client that asks for a big reply and never reads it holds up no other client, and the slow
 // part of an answer runs on the server's thread, not the pipeline's.
 TEST_F(ControlServerTest, AClientThatNeverReadsHoldsUpNobody) {

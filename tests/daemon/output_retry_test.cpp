@@ -90,17 +90,31 @@ TEST(OutputRetry, AnOutputStillFailingIsTriedAfterTwiceThePauseEachTimeUpToAMinu
     now = output.nextRetry;
   }
 
-  // Once it opens, it works, and a later failure starts again from 1 s.
+  // Once it opens it is on trial (issue 51: an output opened on a full disk fails at its first
+  // writes): it counts as failed, and failing then keeps the pause as long as it was.
   flaky() = {false, false, 0};
   outputs.retry(now);
   ASSERT_TRUE(output.sink);
-  EXPECT_TRUE(outputs.anyWorks());
+  EXPECT_FALSE(outputs.anyWorks());
+  flaky().consumeFails = true;
   outputs.handOver(output, picture, {}, Clock::now());
+  ASSERT_FALSE(output.sink);
+  EXPECT_EQ(output.retryDelay, PipelineOutputs::kLastOutputRetry);
+
+  // Opened kOutputTrial ago and taking pictures: it works again, and a later failure starts the
+  // pauses again from 1 s.
+  flaky() = {false, false, 0};
+  output.nextRetry = {};
+  outputs.retry(Clock::now() - PipelineOutputs::kOutputTrial);
+  ASSERT_TRUE(output.sink);
+  EXPECT_FALSE(outputs.anyWorks());
+  outputs.handOver(output, picture, {}, Clock::now());
+  EXPECT_TRUE(outputs.anyWorks());
   flaky().consumeFails = true;
   outputs.handOver(output, picture, {}, Clock::now());
   ASSERT_FALSE(output.sink);
   EXPECT_EQ(output.retryDelay, PipelineOutputs::kFirstOutputRetry);
-  EXPECT_EQ(outputs.failures(), 2u);
+  EXPECT_EQ(outputs.failures(), 3u);
 }
 
 // Takes the second segment's name once the first is being written, watches whether some output

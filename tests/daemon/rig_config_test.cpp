@@ -2,6 +2,7 @@
 // sizes, body masks) and the lens models (OCamCalib, a field cut by a lens's polynomial), read
 // from the config with one message per mistake.
 
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -11,6 +12,7 @@
 
 #include "daemon/config.hpp"
 #include "tests/daemon/config_test_support.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -205,6 +207,29 @@ TEST_F(ConfigTest, ALensFieldCutByItsPolynomialIsNamedWithItsCameraAndAngle) {
             "camera 'left': the lens's distortion polynomial stops increasing 87.3 degrees off "
             "axis, so its field is cut there (field_of_view_deg asks for 190.0 degrees); the "
             "picture beyond that circle is not used");
+}
+
+// Issue 51: an import gave a calibration a NaN and wrote it, exiting 0; the daemon refused the rig
+// at its next start. writeRigFile refuses it, naming where, and leaves the file as it was.
+TEST_F(ConfigTest, ARigWithANumberThatIsNotFiniteIsNotWritten) {
+  const Config config = loadConfig(configWith(kFisheyeLens, std::string(kOcamLens)));
+  writeRigFile(dir_ / "rig.yaml", config.cameras, "good");
+  const std::string before = testing::fileBytes(dir_ / "rig.yaml");
+  for (const double bad :
+       {std::numeric_limits<double>::quiet_NaN(), -std::numeric_limits<double>::infinity()}) {
+    auto cameras = config.cameras;
+    cameras[1].calibration.intrinsics.ocam.worldToImage[3] = bad;
+    EXPECT_THAT([&] { writeRigFile(dir_ / "rig.yaml", cameras, "bad"); },
+                ::testing::ThrowsMessage<ConfigError>(
+                    HasSubstr("rig.yaml: not written: cameras[1].lens.world_to_image[3] is not a "
+                              "finite number")));
+    cameras = config.cameras;
+    cameras[0].calibration.pose.position[2] = bad;
+    EXPECT_THAT([&] { writeRigFile(dir_ / "rig.yaml", cameras, "bad"); },
+                ::testing::ThrowsMessage<ConfigError>(HasSubstr("cameras[0].mount.z_m")));
+  }
+  EXPECT_EQ(testing::fileBytes(dir_ / "rig.yaml"), before);
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "rig.yaml.part"));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <ostream>
 #include <span>
 #include <string>
 #include <string_view>
@@ -39,6 +40,12 @@ inline const std::filesystem::path& scratchFolder() {
 }
 
 inline void quietLogs() { spdlog::set_level(spdlog::level::off); }
+
+// A stream that drops what a command prints (its log of what it did).
+inline std::ostream& discardedLog() {
+  static std::ostream nowhere(nullptr);
+  return nowhere;
+}
 
 inline std::string_view asText(const std::uint8_t* data, std::size_t size) {
   return {reinterpret_cast<const char*>(data), size};

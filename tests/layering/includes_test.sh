@@ -1,44 +1,73 @@
 #!/bin/sh
 # The parts' includes form a stack (docs/architecture.md, "The parts"): each folder may include
-# only its own headers and those of the folders below it. Prints every include that runs the
-# wrong way, with its file and line, and fails if there is one.
+# only its own headers and those of the folders below it. Reads every header and source of every
+# folder of code under ROOT (tests/ and build folders aside), prints each include that runs the
+# wrong way with its file and line, and fails if there is one, or if a folder of code has no rule
+# here (a new part must say where it stands). tests/layering/includes_self_test.sh plants wrong
+# includes in a tree of its own and checks that this script fails on each.
+#
+# Usage: includes_test.sh ROOT
 set -eu
 root="$1"
 cd "$root"
 
+# shellcheck disable=SC2116 # echo joins the lines into one list of words
+libraries=$(echo common capture vehicle processing processing/stitch processing/colour \
+  processing/calibration render render/outputs daemon daemon/stages)
+
 # folder: the folders its headers and sources may include from (besides its own).
 allowed() {
   case "$1" in
-    common) echo "common" ;;
-    capture) echo "common capture" ;;
-    vehicle) echo "common vehicle" ;;
-    processing) echo "common processing" ;;
-    processing/stitch) echo "common processing processing/stitch" ;;
-    processing/colour) echo "common processing processing/stitch processing/colour" ;;
-    processing/calibration) echo "common processing processing/stitch processing/calibration" ;;
-    render) echo "common processing render" ;;
-    render/outputs) echo "common render render/outputs" ;;
+    common) echo "" ;;
+    capture | vehicle | processing) echo "common" ;;
+    processing/stitch) echo "common processing" ;;
+    processing/colour | processing/calibration) echo "common processing processing/stitch" ;;
+    render) echo "common processing processing/stitch" ;;
+    render/outputs) echo "common render" ;;
+    # The daemon wires every part together; its stages and the rest of it are one part.
+    daemon | daemon/stages) echo "$libraries" ;;
+    # The tools use the libraries, never one another, but the benchmark measures on the
+    # generator's recordings.
+    tools/bench) echo "$libraries tools/synth" ;;
+    tools/*) echo "$libraries" ;;
     *) return 1 ;;
   esac
 }
 
 report=$(mktemp)
 trap 'rm -f "$report"' EXIT
-for folder in common capture vehicle processing processing/stitch processing/colour \
-              processing/calibration render render/outputs; do
-  permitted=$(allowed "$folder")
-  # Each project include "a/b/c.hpp" belongs to folder "a/b".
+# Every folder that holds C++ code, wherever it is, except the tests and build trees.
+folders=$(find . -path ./tests -prune -o -path ./build -prune -o -path ./.git -prune -o \
+  -path '*/node_modules' -prune -o -type f \( -name '*.hpp' -o -name '*.cpp' \) -print |
+  sed 's|^\./||; s|/[^/]*$||' | sort -u)
+if [ -z "$folders" ]; then
+  echo "includes: no C++ code under $root" >&2
+  exit 1
+fi
+files=0
+for folder in $folders; do
+  if ! permitted=$(allowed "$folder"); then
+    echo "$folder: a folder of code with no rule in tests/layering/includes_test.sh" >>"$report"
+    continue
+  fi
   for file in "$folder"/*.hpp "$folder"/*.cpp; do
-    [ -e "$file" ] && grep -Hn '^#include "[a-z_/]*\.hpp"' "$file"
-  done | awk -v folder="$folder" -v permitted=" $permitted " '{
-    split($0, at, ":"); header = $0; sub(/^[^"]*"/, "", header); sub(/".*$/, "", header)
-    owner = header; sub(/\/[^\/]*$/, "", owner)
-    if (index(permitted, " " owner " ") == 0)
-      printf "%s:%s: includes %s: %s may include only from:%s\n", at[1], at[2], header, folder, permitted
-  }'
-done > "$report"
+    [ -e "$file" ] || continue
+    files=$((files + 1))
+    # Each project include "a/b/c.hpp" belongs to folder "a/b". No include at all is no match:
+    # grep's status is not the loop's.
+    { grep -Hn '^#include "[A-Za-z0-9_/]*\.hpp"' "$file" || true; } |
+      awk -v folder="$folder" -v permitted=" $permitted " '{
+        split($0, at, ":"); header = $0; sub(/^[^"]*"/, "", header); sub(/".*$/, "", header)
+        owner = header; sub(/\/[^\/]*$/, "", owner)
+        if (owner != folder && index(permitted, " " owner " ") == 0)
+          printf "%s:%s: includes %s: %s may include only from itself and:%s\n", at[1], at[2],
+                 header, folder, permitted
+      }' >>"$report"
+  done
+done
 if [ -s "$report" ]; then
   cat "$report"
   exit 1
 fi
-echo "includes: every part includes only from itself and the parts below it"
+echo "includes: all $files files of $(echo "$folders" | wc -l) folders include only from their" \
+  "own part and the parts below it"

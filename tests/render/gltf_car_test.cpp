@@ -12,6 +12,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include "processing/surround_mesh.hpp"
 #include "render/egl_context.hpp"
@@ -102,7 +103,7 @@ TEST(GltfCar, AFileThatIsNoUsableGltfIsOneClearError) {
                 ThrowsMessage<CarModelError>(AllOf(HasSubstr(file.string()), HasSubstr(why))))
         << why;
   };
-  refuses(dir / "none.glb", "not a file");
+  refuses(dir / "none.glb", "does not exist");
   refuses(dir.write("car.obj", "v 0 0 0\n"), "expected a .glb or .gltf file");
   refuses(dir.write("text.gltf", "a car\n"), "not glTF 2.0 that can be read");
   refuses(dir.write("truncated.glb", "glTF\x02"), "not glTF 2.0 that can be read");
@@ -122,6 +123,66 @@ TEST(GltfCar, AFileThatIsNoUsableGltfIsOneClearError) {
   ASSERT_NE(badIndex.find(roofIndices), std::string::npos);
   badIndex.replace(badIndex.find(roofIndices), roofIndices.size(), "\"indices\": 1,");
   refuses(dir.write("index.gltf", badIndex), "an index past its vertices");
+}
+
+// Issue 51: files made to exhaust the loader. Each is refused with the file named, in bounded time
+// and memory: a node tree that names one node many times (12 levels of 8 took all memory), JSON
+// nested 20 000 deep (a stack overflow in tinygltf), a FIFO or a device where a file is expected
+// (--check-config hung on a FIFO named by a buffer's uri).
+TEST(GltfCar, FilesMadeToExhaustTheLoaderAreRefused) {
+  const testing::TempDir dir;
+  const auto refuses = [](const std::filesystem::path& file, const std::string& why) {
+    EXPECT_THAT([&] { loadGltfCar(file, {}); },
+                ThrowsMessage<CarModelError>(AllOf(HasSubstr(file.string()), HasSubstr(why))))
+        << why;
+  };
+  std::ifstream in(testCar());
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto edited = [&](const std::string& from, const std::string& to) {
+    std::string copy = text;
+    const auto at = copy.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return copy.replace(at, from.size(), to);
+  };
+
+  // The body's node made the child of the marker's and the roof's, each twice.
+  refuses(dir.write("shared.gltf",
+                    edited("\"name\": \"marker\",", "\"name\": \"marker\", \"children\": [0, 0],")),
+          "node 0 has more than one parent");
+  refuses(dir.write("cycle.gltf",
+                    edited("\"name\": \"body\",", "\"name\": \"body\", \"children\": [0],")),
+          "node 0 has more than one parent, or is its own ancestor");
+
+  const std::string deep = std::string(20000, '[') + std::string(20000, ']');
+  refuses(dir.write("deep.gltf", edited("\"asset\": {", "\"extras\": " + deep + ", \"asset\": {")),
+          "its JSON nests 20001 levels deep");
+  // The same in a .glb's JSON chunk; the binary chunk's bytes are not JSON and are not counted.
+  const std::string json = "{\"a\": " + deep + "}";
+  std::string glb = "glTF";
+  const auto word = [&](std::uint32_t value) {
+    glb.append(reinterpret_cast<const char*>(&value), sizeof value);
+  };
+  word(2);
+  word(static_cast<std::uint32_t>(20 + json.size()));
+  word(static_cast<std::uint32_t>(json.size()));
+  word(0x4E4F534A);
+  glb += json;
+  refuses(dir.write("deep.glb", glb), "its JSON nests 20001 levels deep");
+
+  // A FIFO as the model, and as a buffer's file; a link to /dev/zero as a buffer's file.
+  const auto fifo = dir / "fifo.glb";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  refuses(fifo, "a FIFO, not a file");
+  const std::string dataUri = R"("uri": "data:application/octet-stream;base64,)";
+  const auto external = [&](const std::string& uri) {
+    std::string copy = text;
+    const auto at = copy.find(dataUri);
+    const auto end = copy.find('"', at + dataUri.size());
+    return copy.replace(at, end + 1 - at, "\"uri\": \"" + uri + "\"");
+  };
+  refuses(dir.write("fifo-buffer.gltf", external("fifo.glb")), "a FIFO, not a file");
+  std::filesystem::create_symlink("/dev/zero", dir / "zero.bin");
+  refuses(dir.write("zero-buffer.gltf", external("zero.bin")), "a character device, not a file");
 }
 
 // Drawn from above: the roof shows its texture the right way round (front up, left on the left),

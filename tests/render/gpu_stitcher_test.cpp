@@ -189,14 +189,14 @@ TEST_F(GpuStitcherTest, BothCorrectionFieldsAreAppliedAsTheCpuAppliesThem) {
       ASSERT_GT(cv::norm(cpu, uncorrected, cv::NORM_L1) / static_cast<double>(cpu.total()), 3.0);
 
       GpuStitcher gpu(*lut, format, *pool);
-      gpu.correctWith(&correction);
+      gpu.correctWith(correction.asColourField());
       gpu.upload(frames);
       gpu.stitch();
       cv::Mat corrected;
       gpu.readPanorama(corrected);
       expectWithinRounding(corrected, cpu);
 
-      gpu.correctWith(nullptr);  // and back to none
+      gpu.correctWith(std::nullopt);  // and back to none
       gpu.stitch();
       gpu.readPanorama(corrected);
       EXPECT_LE(cv::norm(corrected, uncorrected, cv::NORM_L1) /
@@ -220,7 +220,7 @@ TEST_F(GpuStitcherTest, AfterACameraIsLostTheFieldIsAppliedOnTheDomainOfThoseLef
                                                  *lut, {}, *pool);
   correction.update(frames, kFormat);
   GpuStitcher gpu(*lut, kFormat, *pool);
-  gpu.correctWith(&correction);
+  gpu.correctWith(correction.asColourField());
   gpu.upload(frames);
   gpu.stitch();
   const processing::CorrectionDomain& everyCamera = correction.domain();
@@ -256,7 +256,7 @@ TEST_F(GpuStitcherTest, UploadAndStitchAllocateNothing) {
                                                  *lut, {}, *pool);
   correction.update(frames, PixelFormat::kNv12);
   GpuStitcher gpu(*lut, PixelFormat::kNv12, *pool);
-  gpu.correctWith(&correction);
+  gpu.correctWith(correction.asColourField());
   GpuTimer timer;
   const auto frameSet = [&] {
     {

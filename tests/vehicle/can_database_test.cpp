@@ -183,5 +183,73 @@ TEST(CanDatabase, ABadLineIsNamedWithItsFileAndLine) {
   refused("VERSION \"\"\n", "car.dbc: no signals");
 }
 
+// Issue 51: a line of ~40 KB overflowed the stack of the recursive std::regex that read lines, in
+// --check-config and on a reload, which ended the daemon. Lines of a few megabytes of every shape
+// the reader meets are now read, or refused naming the line.
+TEST(CanDatabase, LinesOfMegabytesAreReadOrRefusedWithoutCrashing) {
+  constexpr std::size_t kLong = 4 << 20;
+  const std::string message = "BO_ 1 A: 8 X\n";
+  const std::string signal = " SG_ S : 0|8@1+ (1,0) [0|0] \"\" Y\n";
+  // A comment, blanks before a keyword, a signal's long name and long factor, a long id.
+  const std::string comment = "CM_ \"" + std::string(kLong, 'c') + "\";\n";
+  EXPECT_EQ(CanDatabase::fromDbc(comment + message + signal, "car.dbc").signals().size(), 1u);
+  EXPECT_EQ(
+      CanDatabase::fromDbc(message + std::string(kLong, ' ') + signal, "car.dbc").signals().size(),
+      1u);
+  const std::string name(kLong, 'N');
+  const CanDatabase longName =
+      CanDatabase::fromDbc(message + " SG_ " + name + " : 0|8@1+ (1,0)\n", "car.dbc");
+  ASSERT_EQ(longName.signals().size(), 1u);
+  EXPECT_EQ(longName.signals()[0].name, name);
+  EXPECT_THAT(
+      [&] {
+        CanDatabase::fromDbc(message + " SG_ S : 0|8@1+ (" + std::string(kLong, '1') + ",0)\n",
+                             "car.dbc");
+      },
+      ::testing::ThrowsMessage<CanDatabaseError>(
+          HasSubstr("car.dbc:2: factor: expected a number")));
+  EXPECT_THAT(
+      [&] { CanDatabase::fromDbc("BO_ " + std::string(kLong, '9') + " A: 8 X\n", "car.dbc"); },
+      ::testing::ThrowsMessage<CanDatabaseError>(
+          HasSubstr("car.dbc:1: message id: expected a whole number of at most 4294967295")));
+  EXPECT_THAT(
+      [&] { CanDatabase::fromDbc(message + " SG_ " + std::string(kLong, '(') + "\n", "car.dbc"); },
+      ::testing::ThrowsMessage<CanDatabaseError>(
+          HasSubstr("car.dbc:2: a signal line (SG_) that does not read as")));
+}
+
+// What the regular expressions took, the line reader takes alike: blanks where DBC writers put
+// them, multiplex indicators, a '+' before numbers, CRLF line ends; numbers past their field's
+// range are refused rather than cast.
+TEST(CanDatabase, ReadsTheLineShapesDbcWritersUse) {
+  const CanDatabase database = CanDatabase::fromDbc(
+      "BO_ 2147484672 Ext : 8 X\r\n"
+      "\tSG_ Mux M : 0|4@1+ (1,0) [0|15] \"\" Y\r\n"
+      " SG_ Muxed m3 : 8|8@1+ (1,0) [0|0] \"\" Y\r\n"
+      " SG_ Both m1M : 16|8@1+ (1,0) [0|0] \"\" Y\r\n"
+      " SG_ Plain:24|16@0-(+0.5 , -3e1) [0|0] \"\" Y\r\n",
+      "car.dbc");
+  ASSERT_EQ(database.signals().size(), 2u);
+  EXPECT_EQ(database.signals()[0].name, "Mux");
+  const CanSignal& plain = database.signals()[1];
+  EXPECT_EQ(plain.name, "Plain");
+  EXPECT_TRUE(plain.extended);
+  EXPECT_EQ(plain.messageId, 1024u);
+  EXPECT_EQ(plain.startBit, 24);
+  EXPECT_EQ(plain.length, 16);
+  EXPECT_EQ(plain.order, ByteOrder::kMotorola);
+  EXPECT_TRUE(plain.isSigned);
+  EXPECT_DOUBLE_EQ(plain.factor, 0.5);
+  EXPECT_DOUBLE_EQ(plain.offset, -30);
+  EXPECT_THAT([] { CanDatabase::fromDbc("BO_ 1 A: 8 X\n SG_ S x : 0|8@1+ (1,0)\n", "car.dbc"); },
+              ::testing::ThrowsMessage<CanDatabaseError>(HasSubstr("car.dbc:2: a signal line")));
+  EXPECT_THAT(
+      [] { CanDatabase::fromDbc("BO_ 1 A: 8 X\n SG_ S : 99999999999|8@1+ (1,0)\n", "car.dbc"); },
+      ::testing::ThrowsMessage<CanDatabaseError>(
+          HasSubstr("car.dbc:2: start bit: expected a whole")));
+  EXPECT_THAT([] { CanDatabase::fromDbc("BO_ 4294967296 A: 8 X\n", "car.dbc"); },
+              ::testing::ThrowsMessage<CanDatabaseError>(HasSubstr("car.dbc:1: message id")));
+}
+
 }  // namespace
 }  // namespace surroundd::vehicle

@@ -8,12 +8,19 @@
 #include <fmt/ranges.h>
 #include <opencv2/calib3d.hpp>
 
+#include "common/nesting_depth.hpp"
+#include "common/regular_file.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 
 namespace surroundd::calibrate {
 namespace {
 
 using Keys = std::initializer_list<const char*>;
+
+// docs/robustness.md: an imported calibration file of at most 16 MiB, nested at most 64 levels.
+constexpr std::size_t kMaxCalibrationFileBytes = std::size_t{16} << 20;
+constexpr std::size_t kMaxCalibrationDepth = 64;
+constexpr double kMaxImageSide = 65536;
 
 constexpr Keys kCameraMatrixKeys{"camera_matrix", "cameraMatrix", "K", "cam_K", "intrinsic_matrix"};
 constexpr Keys kDistortionKeys{"dist_coeffs", "distCoeffs", "distortion_coefficients",
@@ -80,6 +87,12 @@ Found<cv::Mat> requireMatrix(const std::filesystem::path& file,
                                  matrix ? fmt::format("{} numbers", matrix->total())
                                         : std::string("something that is not a matrix")));
   }
+  if (!cv::checkRange(*matrix)) {
+    throw UsageError(
+        fmt::format("{}: expected {}, got a value that is not a finite number (NaN "
+                    "or infinite)",
+                    origin, what));
+  }
   // Every key of 9 numbers is a 3x3 matrix (camera, rotation, homography), however the file wrote
   // it: as 3 rows or as one flat list (read as one row, whose (1, 1) lay past its end).
   return {matrix->total() == 9 ? matrix->reshape(1, 3) : *matrix, origin};
@@ -136,6 +149,34 @@ std::optional<cv::Mat> matrixFromNode(const cv::FileNode& node) {
   return matrix.empty() ? std::nullopt : std::optional(matrix);
 }
 
+namespace {
+
+// OpenCV's FileStorage reader is not made for files from anywhere: its parsers recurse per level
+// (100 000 nested '[' overflowed the stack), and a malformed base64 block (YAML `!!binary`, JSON
+// and XML `$base64$`) can loop forever. Refused here before it reads them, with what to change;
+// real calibrations are a few kilobytes of plain numbers nested a few levels. The file is then
+// opened again by name, as OpenCV tells YAML, JSON and XML apart by the name and the content.
+void refuseWhatOpenCvCannotReadSafely(const std::filesystem::path& file) {
+  std::string text;
+  try {
+    text = readRegularFile(file, kMaxCalibrationFileBytes);
+  } catch (const FileReadError& error) {
+    throw UsageError(error.what());
+  }
+  if (const std::size_t depth = nestingDepth(text); depth > kMaxCalibrationDepth) {
+    throw UsageError(fmt::format("{}: nests {} levels deep; a calibration file needs at most {}",
+                                 file.string(), depth, kMaxCalibrationDepth));
+  }
+  if (text.find("!!binary") != std::string::npos || text.find("$base64$") != std::string::npos) {
+    throw UsageError(fmt::format(
+        "{}: holds base64-coded data (!!binary or $base64$), which is not read: write the "
+        "calibration as plain numbers (cv::FileStorage without FileStorage::BASE64)",
+        file.string()));
+  }
+}
+
+}  // namespace
+
 CameraFromSource cameraFromSource(const cv::Matx33d& rotation, const cv::Vec3d& translation,
                                   PoseDirection direction) {
   if (direction == PoseDirection::kToCamera) return {rotation, translation};
@@ -144,9 +185,7 @@ CameraFromSource cameraFromSource(const cv::Matx33d& rotation, const cv::Vec3d& 
 
 void readOpenCvCalibration(const std::filesystem::path& file, PoseDirection direction,
                            ForeignCalibration& into) {
-  if (!std::filesystem::is_regular_file(file)) {
-    throw UsageError(fmt::format("{}: no such file", file.string()));
-  }
+  refuseWhatOpenCvCannotReadSafely(file);
   cv::FileStorage storage;
   try {
     storage.open(file.string(), cv::FileStorage::READ);
@@ -195,10 +234,18 @@ void readOpenCvCalibration(const std::filesystem::path& file, PoseDirection dire
       }
     }
     if (const auto size = findKey(root, {"image_size", "imageSize"}, 2); !into.imageSize && size) {
-      const auto m = *matrixFromNode(size->first);
+      const auto m = requireMatrix(file, *size, {2}, "an image size: width and height");
+      const double width = m.value.at<double>(0);
+      const double height = m.value.at<double>(1);
+      // Checked before the cast: a size of 1e300 pixels does not fit an int.
+      if (!(width >= 1 && width <= kMaxImageSide && height >= 1 && height <= kMaxImageSide)) {
+        throw UsageError(
+            fmt::format("{}: expected an image size of 1 to {} pixels a side, got "
+                        "{} x {}",
+                        m.origin, kMaxImageSide, width, height));
+      }
       into.imageSize =
-          Found<cv::Size>{{static_cast<int>(m.at<double>(0)), static_cast<int>(m.at<double>(1))},
-                          fmt::format("{}: {}", file.string(), size->second)};
+          Found<cv::Size>{{static_cast<int>(width), static_cast<int>(height)}, m.origin};
     }
   }
   if (!into.pose && !into.homography) {

@@ -1,17 +1,19 @@
 #include "tools/calibrate/ocam_results.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include <fmt/format.h>
 
+#include "common/regular_file.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 
 namespace surroundd::calibrate {
 namespace {
+
+constexpr std::size_t kMaxOcamFileBytes = std::size_t{1} << 20;
 
 // The data lines in order; comment lines start with '#'.
 constexpr std::array<std::string_view, 5> kSections{
@@ -61,8 +63,14 @@ OcamNative toOcamNative(const processing::Intrinsics& lens) {
 }
 
 processing::Intrinsics readOcamResults(const std::filesystem::path& file) {
-  std::ifstream stream(file);
-  if (!stream) throw UsageError(fmt::format("{}: cannot open the file", file.string()));
+  // A results file is a few hundred bytes: a FIFO, a device or a file past 1 MiB is refused
+  // (one linked to /dev/zero grew by 400 MB/s, read as one endless line).
+  std::istringstream stream;
+  try {
+    stream.str(readRegularFile(file, kMaxOcamFileBytes));
+  } catch (const FileReadError& error) {
+    throw UsageError(error.what());
+  }
   std::vector<std::pair<int, std::vector<double>>> lines;  // line number, numbers
   int number = 0;
   for (std::string line; std::getline(stream, line) && lines.size() < kSections.size();) {

@@ -12,6 +12,7 @@
 #include "common/ffmpeg_util.hpp"
 #include "render/outputs/video_sink.hpp"
 #include "tests/support/log_capture.hpp"
+#include "tests/support/small_disk.hpp"
 #include "tests/support/stream_receiver.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/support/test_support.hpp"
@@ -358,6 +359,63 @@ TEST(VideoEncoder, CloseIsIdempotentAndEndsWriting) {
   EXPECT_EQ(encoder.path(), dir / "clip.mkv");
 }
 
+// Issue 51: on a full disk the encoder deleted its whole .part file (21 of 229 frames survived the
+// attack). Now the file that holds frames is ended where it stands and keeps its name, playable
+// (MKV, and MP4 in fragments of a second), and the error says so; no file is begun on a disk that
+// is all but full, and one is again once there is room.
+TEST(VideoEncoder, AFullDiskKeepsWhatWasWrittenPlayable) {
+  for (const std::string name : {"full.mp4", "full.mkv"}) {
+    testing::SmallDisk disk(std::uintmax_t{24} << 20);
+    if (!disk.problem().empty()) GTEST_SKIP() << disk.problem();
+    disk.fill(std::uintmax_t{10} << 20);
+    auto settings = settingsFor(disk / name);
+    settings.crf = 0;  // lossless: about a megabyte a second here, and the pictures come back
+    VideoEncoder encoder(settings);
+    std::string error;
+    int sent = 0;
+    for (; sent < 2000 && error.empty(); ++sent) {
+      cv::Mat noise(kSize, CV_8UC3);
+      cv::randu(noise, 0, 256);
+      cv::Mat picture = testPicture(sent);
+      cv::addWeighted(picture, 0.5, noise, 0.5, 0, picture);
+      try {
+        encoder.write(picture, timestampOf(sent));
+      } catch (const EncoderError& e) {
+        error = e.what();
+      }
+    }
+    EXPECT_THAT(error, AllOf(HasSubstr("cannot write to the file: No space left on device"),
+                             HasSubstr((disk / name).string() + "' keeps what was written before"),
+                             HasSubstr("playable")))
+        << name;
+    EXPECT_NO_THROW(encoder.close());  // ended already
+    EXPECT_FALSE(std::filesystem::exists(disk / (name + ".part"))) << name;
+    const auto decoded = testing::decodeAll(disk / name);
+    // At least the first fragment (a second's 30 frames), each at its own time.
+    EXPECT_GE(decoded.images.size(), 30u) << name;
+    EXPECT_LT(decoded.images.size(), static_cast<std::size_t>(sent)) << name;
+    for (std::size_t i = 0; i < decoded.timestamps.size(); ++i) {
+      EXPECT_NEAR(
+          std::chrono::duration<double>(decoded.timestamps[i] - timestampOf(static_cast<int>(i)))
+              .count(),
+          0.0, 1e-3)
+          << name << " frame " << i;
+    }
+
+    // The disk all but full: refused before anything is written; with room again, written.
+    disk.fill(std::uintmax_t{1} << 20);
+    auto next = settings;
+    next.path = disk / ("next-" + name);
+    EXPECT_THAT([&] { VideoEncoder{next}; },
+                ThrowsMessage<EncoderError>(
+                    AllOf(HasSubstr("the disk is full"), HasSubstr("less than the 8 MiB"))));
+    EXPECT_FALSE(std::filesystem::exists(next.path.string() + ".part"));
+    disk.empty();
+    writeVideo(next, 5);
+    EXPECT_EQ(testing::decodeAll(next.path).images.size(), 5u);
+  }
+}
+
 TEST(VideoSink, SegmentsAreWholePlayableFilesAndARestartNumbersOn) {
   const testing::TempDir dir;
   auto settings = settingsFor(dir / "drive.mp4");
@@ -396,10 +454,23 @@ TEST(VideoSink, SegmentsAreWholePlayableFilesAndARestartNumbersOn) {
   // numbering goes on; beside one at the end of the numbers it stops with the file named.
   dir.write("drive-2147483647.mp4", "");
   EXPECT_THAT(write(90, 5), HasSubstr("drive-2147483648.mp4 .."));
-  dir.write("drive-999999999999.mp4", "");
-  EXPECT_THAT([&] { VideoSink(settings, std::chrono::seconds(1)); },
-              ::testing::ThrowsMessage<EncoderError>(
-                  AllOf(HasSubstr("drive-999999999999.mp4"), HasSubstr("move them away"))));
+  // Issue 51: past the largest int64 too, where the next number wrapped to a negative one and a
+  // later run overwrote files: numbers of any length past the end stop it with the file named.
+  for (const std::string past :
+       {"999999999999", "9223372036854775807", "99999999999999999999999"}) {
+    const testing::TempDir other;
+    other.write("drive-" + past + ".mp4", "");
+    VideoEncoderSettings elsewhere = settings;
+    elsewhere.path = other / "drive.mp4";
+    EXPECT_THAT([&] { VideoSink(elsewhere, std::chrono::seconds(1)); },
+                ::testing::ThrowsMessage<EncoderError>(
+                    AllOf(HasSubstr("drive-999999999999.mp4"), HasSubstr("move them away"))))
+        << past;
+  }
+  // A sign is no part of a segment's number.
+  dir.write("drive--5.mp4", "");
+  dir.write("drive-+7000000.mp4", "");
+  EXPECT_THAT(write(95, 5), HasSubstr("drive-2147483649.mp4 .."));
 }
 
 TEST(VideoSink, StreamsMpegTsOverUdpThatAReceiverDecodesToTheSentPictures) {
