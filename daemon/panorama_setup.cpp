@@ -114,7 +114,7 @@ processing::PanoramaLut obtainPanoramaLut(const Config& config, const processing
   const processing::PanoramaSettings settings = panoramaSettings(config);
   const std::string key = processing::panoramaLutKey(rig, settings);
   const processing::PanoramaLutCache cache(lutCacheDir(config));
-  auto lookup = cache.load(key);
+  auto lookup = cache.load(key, settings.geometry.size);
   if (lookup.lut) {
     spdlog::info("panorama LUT {}x{}: loaded {}", settings.geometry.size.width,
                  settings.geometry.size.height, cache.fileFor(key).string());

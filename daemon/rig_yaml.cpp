@@ -273,7 +273,8 @@ std::optional<std::string> firstNonFiniteNumber(const YAML::Node& node, const st
   if (node.IsMap()) {
     for (const auto& entry : node) {
       const std::string key = entry.first.Scalar();
-      if (auto found = firstNonFiniteNumber(entry.second, path.empty() ? key : path + "." + key)) {
+      if (auto found = firstNonFiniteNumber(entry.second,
+                                            path.empty() ? key : fmt::format("{}.{}", path, key))) {
         return found;
       }
     }

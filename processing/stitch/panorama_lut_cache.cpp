@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <zlib.h>
 
+#include "common/camera_limit.hpp"
 #include "common/regular_file.hpp"
 
 namespace surroundd::processing {
@@ -22,6 +23,21 @@ constexpr std::uint32_t kFormatVersion = 1;
 // Above any LUT a panorama the config allows makes (16384 x 8192 pixels of 8-byte taps: 1 GiB,
 // plus the blend taps): a larger file is no LUT of ours.
 constexpr std::size_t kMaxFileBytes = std::size_t{3} << 30;
+
+// The most bytes the LUT of `key` for a panorama of `panorama` pixels can take: the header, the
+// key, the sizes of the panorama and every camera, a tap per pixel, at most two blend taps per
+// pixel (there is one where two cameras meet), a blend row start per row, the checksum.
+std::size_t maxFileBytesFor(const std::string& key, cv::Size panorama) {
+  const auto pixels = static_cast<std::size_t>(std::max(panorama.width, 1)) *
+                      static_cast<std::size_t>(std::max(panorama.height, 1));
+  const std::size_t bytes =
+      sizeof(kMagic) + sizeof(std::uint32_t) + 5 * sizeof(std::uint64_t) + key.size() +
+      (1 + kMaxCameras) * 2 * sizeof(std::int32_t) + pixels * sizeof(LutTap) +
+      2 * pixels * sizeof(BlendTap) +
+      (static_cast<std::size_t>(std::max(panorama.height, 1)) + 1) * sizeof(std::uint32_t) +
+      sizeof(std::uint32_t);
+  return std::min(bytes, kMaxFileBytes);
+}
 
 std::uint32_t crc(const void* data, std::size_t bytes) {
   return static_cast<std::uint32_t>(
@@ -173,23 +189,24 @@ std::filesystem::path PanoramaLutCache::fileFor(const std::string& key) const {
   return folder_ / fmt::format("panorama-{:08x}.lut", crc(key.data(), key.size()));
 }
 
-PanoramaLutCache::Lookup PanoramaLutCache::load(const std::string& key) const {
-  return read(fileFor(key), key);
+PanoramaLutCache::Lookup PanoramaLutCache::load(const std::string& key, cv::Size panorama) const {
+  return read(fileFor(key), key, maxFileBytesFor(key, panorama));
 }
 
 PanoramaLutCache::Lookup PanoramaLutCache::loadFile(const std::filesystem::path& file) {
-  return read(file, std::nullopt);
+  return read(file, std::nullopt, kMaxFileBytes);
 }
 
 PanoramaLutCache::Lookup PanoramaLutCache::read(const std::filesystem::path& path,
-                                                std::optional<std::string_view> key) {
+                                                std::optional<std::string_view> key,
+                                                std::size_t maxBytes) {
   std::error_code ec;
   if (!std::filesystem::exists(std::filesystem::symlink_status(path, ec))) {
     return {std::nullopt, "absent"};
   }
   std::string bytes;
   try {
-    bytes = readRegularFile(path, kMaxFileBytes);
+    bytes = readRegularFile(path, maxBytes);
   } catch (const FileReadError& e) {
     return {std::nullopt, fmt::format("{} is not usable ({})", path.string(), e.what())};
   }

@@ -31,7 +31,10 @@ class PanoramaLutCache {
     std::optional<PanoramaLut> lut;
     std::string problem;  // when there is no LUT: "absent", or why the file was not usable
   };
-  Lookup load(const std::string& key) const;
+  // The LUT stored for `key`, a panorama of `panorama` pixels: a file larger than such a LUT can
+  // be is refused before it is read (a sparse 2.9 GB file was read whole: 3.1 GB resident, the
+  // first picture after 19 s).
+  Lookup load(const std::string& key, cv::Size panorama) const;
   // A LUT file whatever inputs it was built for (its key is not checked; its checksum and
   // contents are): one carried to another machine of the same byte order.
   static Lookup loadFile(const std::filesystem::path& file);
@@ -40,7 +43,8 @@ class PanoramaLutCache {
   void store(const std::string& key, const PanoramaLut& lut) const;
 
  private:
-  static Lookup read(const std::filesystem::path& path, std::optional<std::string_view> key);
+  static Lookup read(const std::filesystem::path& path, std::optional<std::string_view> key,
+                     std::size_t maxBytes);
 
   std::filesystem::path folder_;
 };

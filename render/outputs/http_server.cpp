@@ -183,6 +183,7 @@ void HttpServer::onConnection(void* cls, MHD_Connection* connection, void** /*so
         MHD_get_connection_info(connection, MHD_CONNECTION_INFO_CONNECTION_FD);
     if (info != nullptr) {
       self->connections_[connection] = {info->connect_fd, std::chrono::steady_clock::now()};
+      self->cutOffSlowestHeads();
     }
   } else {
     // Before libmicrohttpd closes the socket, so the reaper never touches a reused descriptor.
@@ -195,6 +196,24 @@ void HttpServer::markHead(MHD_Connection* connection, bool sending) {
   const auto open = connections_.find(connection);
   if (open == connections_.end()) return;
   open->second.headSince = sending ? std::optional(std::chrono::steady_clock::now()) : std::nullopt;
+}
+
+void HttpServer::cutOffSlowestHeads() {
+  std::vector<OpenConnection*> sending;
+  for (auto& [connection, open] : connections_) {
+    if (open.headSince) sending.push_back(&open);
+  }
+  if (sending.size() <= kMaxConnectionsSendingHeads) return;
+  const auto slowestFirst = sending.begin() + (sending.size() - kMaxConnectionsSendingHeads);
+  std::ranges::nth_element(sending, slowestFirst, {},
+                           [](const OpenConnection* open) { return *open->headSince; });
+  for (auto it = sending.begin(); it != slowestFirst; ++it) {
+    // Its connection thread sees the socket fail and closes the connection itself.
+    ::shutdown((*it)->fd, SHUT_RDWR);
+    (*it)->headSince.reset();
+  }
+  spdlog::debug("{}: {} clients still sending their request heads were cut off to make room", name_,
+                slowestFirst - sending.begin());
 }
 
 void HttpServer::cutOffSlowHeaders() {

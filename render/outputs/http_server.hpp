@@ -3,12 +3,14 @@
 // one thread per connection, at most kMaxHttpConnections at a time and
 // kMaxHttpConnectionsPerAddress from one address, idle ones closed after 15 s and ones that have
 // not sent their whole request head within the header timeout (kHeaderTimeout unless told) cut
-// off, so slow-header clients cannot hold every place. It refuses a URL over 4 KiB (414), a body
-// over 1 KiB (413), a Host that is neither an IP address, "localhost" nor one of the allowed host
-// names (421: a web page cannot reach the server through DNS rebinding; no Host at all is an
-// HTTP/1.0 client, not a browser), and a request other than GET or HEAD from another origin
-// (403: no cross-site requests); every answer says "X-Content-Type-Options: nosniff". Every other
-// request, once its body is in (and dropped), goes to the handler on that connection's thread.
+// off, and those still sending their heads hold at most half the places (the slowest cut off
+// first), so slow-header clients, from however many addresses, cannot hold every place. It refuses
+// a URL over 4 KiB (414), a body over 1 KiB (413), a Host that is neither an IP address,
+// "localhost" nor one of the allowed host names (421: a web page cannot reach the server through
+// DNS rebinding; no Host at all is an HTTP/1.0 client, not a browser), and a request other than GET
+// or HEAD from another origin (403: no cross-site requests); every answer says
+// "X-Content-Type-Options: nosniff". Every other request, once its body is in (and dropped), goes
+// to the handler on that connection's thread.
 //
 // Error policy: the constructor throws std::runtime_error naming the address and port ("HTTP
 // stream: cannot listen on 127.0.0.1:8080: Address already in use"). The handler must not throw
@@ -32,6 +34,10 @@ namespace surroundd::render {
 
 inline constexpr unsigned kMaxHttpConnections = 16;
 inline constexpr unsigned kMaxHttpConnectionsPerAddress = 8;
+// Connections still sending their request head hold at most half the places: a new one past that
+// cuts off the one that has been sending its head longest. Slow-header clients from two addresses
+// (8 + 8) otherwise held every place, and the page was refused for as long as they went on.
+inline constexpr unsigned kMaxConnectionsSendingHeads = kMaxHttpConnections / 2;
 inline constexpr std::chrono::milliseconds kHeaderTimeout{10'000};
 
 // Whether a request's Host header names this server: an IPv4 or [IPv6] address, "localhost", or
@@ -82,6 +88,9 @@ class HttpServer {
     std::optional<std::chrono::steady_clock::time_point> headSince;
   };
   void markHead(MHD_Connection* connection, bool sending);
+  // Under headMutex_: past kMaxConnectionsSendingHeads, cuts off the connections that have been
+  // sending their heads longest.
+  void cutOffSlowestHeads();
   std::mutex headMutex_;
   std::condition_variable reaperWake_;
   std::map<MHD_Connection*, OpenConnection> connections_;

@@ -27,7 +27,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     std::memcpy(bytes.data() + body, &crc, sizeof crc);
   }
   surroundd::fuzz::writeFile(cache.fileFor(key), bytes);
-  const auto lookup = cache.load(key);
+  const auto lookup = cache.load(key, {16384, 8192});  // the largest panorama a config may ask for
   if (lookup.lut) {
     // What the stitcher relies on: a tap per pixel, blend rows that cover the blend taps.
     const auto& lut = *lookup.lut;

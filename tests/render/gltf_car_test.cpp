@@ -96,13 +96,15 @@ TEST(GltfCar, FillsTheVehiclesBoxFrontForwardWithItsColoursAndTexture) {
   EXPECT_NEAR(model.vertices[0].colour[1], std::pow(0.05, 1 / 2.2), 1e-5);
 }
 
+// Expects `file` refused with one CarModelError that names it and says `why`.
+void refuses(const std::filesystem::path& file, const std::string& why) {
+  EXPECT_THAT([&] { loadGltfCar(file, {}); },
+              ThrowsMessage<CarModelError>(AllOf(HasSubstr(file.string()), HasSubstr(why))))
+      << why;
+}
+
 TEST(GltfCar, AFileThatIsNoUsableGltfIsOneClearError) {
   const testing::TempDir dir;
-  const auto refuses = [](const std::filesystem::path& file, const std::string& why) {
-    EXPECT_THAT([&] { loadGltfCar(file, {}); },
-                ThrowsMessage<CarModelError>(AllOf(HasSubstr(file.string()), HasSubstr(why))))
-        << why;
-  };
   refuses(dir / "none.glb", "does not exist");
   refuses(dir.write("car.obj", "v 0 0 0\n"), "expected a .glb or .gltf file");
   refuses(dir.write("text.gltf", "a car\n"), "not glTF 2.0 that can be read");
@@ -131,11 +133,6 @@ TEST(GltfCar, AFileThatIsNoUsableGltfIsOneClearError) {
 // (--check-config hung on a FIFO named by a buffer's uri).
 TEST(GltfCar, FilesMadeToExhaustTheLoaderAreRefused) {
   const testing::TempDir dir;
-  const auto refuses = [](const std::filesystem::path& file, const std::string& why) {
-    EXPECT_THAT([&] { loadGltfCar(file, {}); },
-                ThrowsMessage<CarModelError>(AllOf(HasSubstr(file.string()), HasSubstr(why))))
-        << why;
-  };
   std::ifstream in(testCar());
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const auto edited = [&](const std::string& from, const std::string& to) {

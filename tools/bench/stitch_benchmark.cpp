@@ -210,7 +210,7 @@ InputReport measure(const std::filesystem::path& folder, int threads, int repeat
   const std::string key = processing::panoramaLutKey(truth.rig, bowlSettings);
   cache.store(key, lut);
   report.lutBytes = std::filesystem::file_size(cache.fileFor(key));
-  report.lutLoadS = millisecondsOf([&] { (void)cache.load(key); }) / 1000;
+  report.lutLoadS = millisecondsOf([&] { (void)cache.load(key, lut.size); }) / 1000;
   std::filesystem::remove_all(cacheDir);
 
   std::vector<cv::Mat> images;

@@ -68,7 +68,7 @@ bool collectNumbers(const cv::FileNode& node, std::vector<double>& values, int& 
   return true;
 }
 
-cv::Mat matrixOf(std::vector<double> values, int rows) {
+cv::Mat matrixOf(const std::vector<double>& values, int rows) {
   if (rows <= 0 || values.empty() || values.size() % static_cast<std::size_t>(rows) != 0) {
     return {};
   }
@@ -138,14 +138,14 @@ std::optional<cv::Mat> matrixFromNode(const cv::FileNode& node) {
     if (!collectNumbers(node["data"], values, depth)) return std::nullopt;
     const int rows = node["rows"].isInt() ? static_cast<int>(node["rows"])
                                           : (depth > 1 ? static_cast<int>(node["data"].size()) : 1);
-    auto matrix = matrixOf(std::move(values), rows);
+    auto matrix = matrixOf(values, rows);
     return matrix.empty() ? std::nullopt : std::optional(matrix);
   }
   std::vector<double> values;
   int depth = 0;
   if (!collectNumbers(node, values, depth)) return std::nullopt;
   const int rows = depth > 1 ? static_cast<int>(node.size()) : 1;
-  auto matrix = matrixOf(std::move(values), rows);
+  auto matrix = matrixOf(values, rows);
   return matrix.empty() ? std::nullopt : std::optional(matrix);
 }
 

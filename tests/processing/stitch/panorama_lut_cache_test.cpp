@@ -37,9 +37,9 @@ class PanoramaLutCacheTest : public ::testing::Test {
 };
 
 TEST_F(PanoramaLutCacheTest, StoredLutComesBackIdentical) {
-  EXPECT_EQ(cache_.load(key_).problem, "absent");
+  EXPECT_EQ(cache_.load(key_, lut_.size).problem, "absent");
   cache_.store(key_, lut_);
-  const auto lookup = cache_.load(key_);
+  const auto lookup = cache_.load(key_, lut_.size);
   ASSERT_TRUE(lookup.lut.has_value()) << lookup.problem;
   EXPECT_EQ(*lookup.lut, lut_);
   // Written under its final name only: no temporary file left behind.
@@ -55,7 +55,7 @@ TEST_F(PanoramaLutCacheTest, ALutWithoutBlendTapsComesBackIdentical) {
   single.taps = {{0, 0, 0, 0, 0}, {5, 64, 64, 0, 0}};
   single.blendRowBegin = {0, 0};
   cache_.store("single", single);
-  const auto lookup = cache_.load("single");
+  const auto lookup = cache_.load("single", single.size);
   ASSERT_TRUE(lookup.lut.has_value()) << lookup.problem;
   EXPECT_EQ(*lookup.lut, single);
 }
@@ -69,7 +69,7 @@ TEST_F(PanoramaLutCacheTest, BlendRowsOutOfOrderAreCorruptNotReadPastTheEnd) {
   damaged.taps = {{0, 0, 0, 0, 0}, {5, 0, 0, 0, 0}};
   damaged.blendRowBegin = {0, 5, 0};
   cache_.store("damaged", damaged);  // a faulty writer's file: its checksum is right
-  const auto lookup = cache_.load("damaged");
+  const auto lookup = cache_.load("damaged", damaged.size);
   EXPECT_FALSE(lookup.lut.has_value());
   EXPECT_THAT(lookup.problem, HasSubstr("is corrupt (inconsistent contents)"));
 }
@@ -83,7 +83,7 @@ TEST_F(PanoramaLutCacheTest, ASizeWhoseAreaOverflowsIsCorrupt) {
   damaged.taps = {{0, 0, 0, 0, 0}, {5, 0, 0, 0, 0}};
   damaged.blendRowBegin = {0, 0};
   cache_.store("damaged", damaged);
-  const auto lookup = cache_.load("damaged");
+  const auto lookup = cache_.load("damaged", damaged.size);
   EXPECT_FALSE(lookup.lut.has_value());
   EXPECT_THAT(lookup.problem, HasSubstr("is corrupt (inconsistent contents)"));
 }
@@ -114,7 +114,7 @@ TEST_F(PanoramaLutCacheTest, AFileBuiltForOtherInputsIsStale) {
   cache_.store(otherKey, lut_);
   // As if the file had been renamed, or two keys shared a checksum.
   std::filesystem::rename(cache_.fileFor(otherKey), cache_.fileFor(key_));
-  const auto lookup = cache_.load(key_);
+  const auto lookup = cache_.load(key_, lut_.size);
   EXPECT_FALSE(lookup.lut.has_value());
   EXPECT_THAT(lookup.problem, HasSubstr("is stale (built for other inputs)"));
 }
@@ -124,7 +124,7 @@ TEST_F(PanoramaLutCacheTest, AnotherFormatVersionIsStale) {
   std::string bytes = surroundd::testing::fileBytes(cache_.fileFor(key_));
   bytes[8] = 99;  // the version follows the 8-byte magic
   writeBytes(cache_.fileFor(key_), bytes);
-  EXPECT_THAT(cache_.load(key_).problem, HasSubstr("is stale (format 99"));
+  EXPECT_THAT(cache_.load(key_, lut_.size).problem, HasSubstr("is stale (format 99"));
 }
 
 TEST_F(PanoramaLutCacheTest, DamagedOrTruncatedFilesAreCorrupt) {
@@ -137,13 +137,27 @@ TEST_F(PanoramaLutCacheTest, DamagedOrTruncatedFilesAreCorrupt) {
                                    std::pair{good.substr(0, 10), "not a LUT file"},
                                    std::pair{std::string("hello"), "not a LUT file"}}) {
     writeBytes(cache_.fileFor(key_), bytes);
-    const auto lookup = cache_.load(key_);
+    const auto lookup = cache_.load(key_, lut_.size);
     EXPECT_FALSE(lookup.lut.has_value());
     EXPECT_THAT(lookup.problem, HasSubstr(std::string("is corrupt (") + why)) << bytes.size();
   }
   // Rebuilt and stored again, it loads.
   cache_.store(key_, lut_);
-  EXPECT_TRUE(cache_.load(key_).lut.has_value());
+  EXPECT_TRUE(cache_.load(key_, lut_.size).lut.has_value());
+}
+
+// Issue 51: a sparse file of 2.9 GB in the cache's place was read whole (3.1 GB resident, the
+// first picture after 19 s). A file larger than the panorama's LUT can be is refused unread.
+TEST_F(PanoramaLutCacheTest, AFileLargerThanThePanoramasLutCanBeIsRefusedUnread) {
+  const auto path = cache_.fileFor(key_);
+  std::filesystem::create_directories(path.parent_path());
+  std::ofstream(path).close();  // made, then given a hole of 2.9 GB
+  std::filesystem::resize_file(path, std::uintmax_t{2900} << 20);
+  const auto lookup = cache_.load(key_, lut_.size);
+  EXPECT_FALSE(lookup.lut.has_value());
+  EXPECT_THAT(lookup.problem, AllOf(HasSubstr(path.string()), HasSubstr("larger than")));
+  cache_.store(key_, lut_);
+  EXPECT_TRUE(cache_.load(key_, lut_.size).lut.has_value());
 }
 
 // Issue 18: a FIFO in the cache hung start-up in open(), a symlink to /dev/zero was read without
@@ -153,7 +167,7 @@ TEST_F(PanoramaLutCacheTest, AnEntryThatIsNoFileIsRefusedWithoutReadingIt) {
   const auto path = cache_.fileFor(key_);
   std::filesystem::create_directories(path.parent_path());
   const auto expectRefused = [&](std::string_view kind) {
-    const auto lookup = cache_.load(key_);
+    const auto lookup = cache_.load(key_, lut_.size);
     EXPECT_FALSE(lookup.lut.has_value());
     EXPECT_THAT(lookup.problem, AllOf(HasSubstr(path.string()), HasSubstr(kind)));
   };
@@ -161,13 +175,13 @@ TEST_F(PanoramaLutCacheTest, AnEntryThatIsNoFileIsRefusedWithoutReadingIt) {
   expectRefused("a FIFO, not a file");
   ASSERT_EQ(::mkfifo((path.string() + ".part").c_str(), 0600), 0);
   cache_.store(key_, lut_);  // neither the FIFO nor one under the temporary name blocks it
-  EXPECT_TRUE(cache_.load(key_).lut.has_value());
+  EXPECT_TRUE(cache_.load(key_, lut_.size).lut.has_value());
 
   std::filesystem::remove(path);
   std::filesystem::create_symlink("/dev/zero", path);
   expectRefused("a character device, not a file");
   cache_.store(key_, lut_);
-  EXPECT_TRUE(cache_.load(key_).lut.has_value());
+  EXPECT_TRUE(cache_.load(key_, lut_.size).lut.has_value());
 
   std::filesystem::remove(path);
   std::filesystem::create_directory(path);
