@@ -2,17 +2,45 @@
 
 #include <algorithm>
 #include <condition_variable>
+#include <ctime>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <thread>
+
+#include <opencv2/core/utility.hpp>
+#include <pthread.h>
 
 #include "processing/calibration/view_acceptance.hpp"
 
 namespace surroundd::processing {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+// The CPU time a thread has used (its CPU clock, from pthread_getcpuclockid).
+std::chrono::nanoseconds cpuTime(clockid_t clock) {
+  timespec now{};
+  ::clock_gettime(clock, &now);
+  return std::chrono::seconds(now.tv_sec) + std::chrono::nanoseconds(now.tv_nsec);
+}
+
+clockid_t thisThreadsCpuClock() {
+  clockid_t clock = CLOCK_THREAD_CPUTIME_ID;
+  ::pthread_getcpuclockid(::pthread_self(), &clock);
+  return clock;
+}
+
+// OpenCV's own threads off while the pictures are searched (they are searched in parallel
+// already), so that all of a search's work is on its worker's CPU clock; as it was after.
+class OpenCvThreadsOff {
+ public:
+  OpenCvThreadsOff() : threads_(cv::getNumThreads()) { cv::setNumThreads(1); }
+  ~OpenCvThreadsOff() { cv::setNumThreads(threads_); }
+  OpenCvThreadsOff(const OpenCvThreadsOff&) = delete;
+  OpenCvThreadsOff& operator=(const OpenCvThreadsOff&) = delete;
+
+ private:
+  int threads_;
+};
 
 // Everything a worker touches, shared with the caller: an abandoned worker may outlive the call.
 struct SearchState {
@@ -25,9 +53,12 @@ struct SearchState {
   std::condition_variable changed;
   std::vector<PictureSearch> results;
   std::vector<char> finished;
-  std::vector<std::optional<Clock::time_point>> boundStarts;  // per worker slot
-  std::vector<std::size_t> current;                           // per worker slot
-  std::vector<char> abandoned;                                // per worker slot
+  // Per worker slot: its thread's CPU clock, and that clock's reading when its picture's search
+  // began (none between pictures).
+  std::vector<clockid_t> cpuClocks;
+  std::vector<std::optional<std::chrono::nanoseconds>> boundStarts;
+  std::vector<std::size_t> current;  // per worker slot
+  std::vector<char> abandoned;       // per worker slot
   std::vector<std::size_t> finishOrder;
   std::size_t next = 0;
   bool stopping = false;
@@ -36,7 +67,8 @@ struct SearchState {
 PictureSearch searchOne(const cv::Mat& gray, const CalibrationBoard& board) {
   PictureSearch result;
   result.imageSize = gray.size();
-  const auto start = Clock::now();
+  const clockid_t cpu = thisThreadsCpuClock();
+  const auto start = cpuTime(cpu);
   auto found = findBoard(gray, board);
   result.seenGrid = found.seenGrid;
   switch (found.outcome) {
@@ -53,12 +85,13 @@ PictureSearch searchOne(const cv::Mat& gray, const CalibrationBoard& board) {
       result.outcome = PictureSearch::Outcome::kNotFound;
       break;
   }
-  result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  result.seconds = std::chrono::duration<double>(cpuTime(cpu) - start).count();
   return result;
 }
 
 void workerLoop(const std::shared_ptr<SearchState>& state, std::size_t slot) {
   std::unique_lock lock(state->mutex);
+  state->cpuClocks[slot] = thisThreadsCpuClock();
   while (!state->stopping && !state->abandoned[slot] && state->next < state->results.size()) {
     const std::size_t index = state->next++;
     state->current[slot] = index;
@@ -75,7 +108,7 @@ void workerLoop(const std::shared_ptr<SearchState>& state, std::size_t slot) {
       state->changed.notify_all();
       continue;
     }
-    state->boundStarts[slot] = Clock::now();
+    state->boundStarts[slot] = cpuTime(state->cpuClocks[slot]);
     lock.unlock();
     PictureSearch result = searchOne(gray, state->board);
     lock.lock();
@@ -95,6 +128,7 @@ std::vector<PictureSearch> searchPictures(std::size_t count, PictureLoader loade
                                           const CalibrationBoard& board,
                                           const SearchOptions& options,
                                           const SearchProgress& progress) {
+  const OpenCvThreadsOff serialOpenCv;
   auto state = std::make_shared<SearchState>(count, std::move(loader), board);
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const auto workers = static_cast<std::size_t>(
@@ -104,20 +138,25 @@ std::vector<PictureSearch> searchPictures(std::size_t count, PictureLoader loade
     std::lock_guard lock(state->mutex);
     const std::size_t slot = state->current.size();
     state->current.push_back(0);
+    state->cpuClocks.push_back(CLOCK_THREAD_CPUTIME_ID);  // the worker sets its own
     state->boundStarts.emplace_back();
     state->abandoned.push_back(0);
     threads.emplace_back(workerLoop, state, slot);
   };
   for (std::size_t i = 0; i < workers; ++i) startWorker();
 
-  std::size_t reported = 0, largerGrids = 0, found = 0;
+  std::size_t reported = 0;
+  // The pictures in index order up to the first one not done yet: what the early stop looks at,
+  // so that it stops alike whatever order the threads finish in.
+  std::size_t prefix = 0, largerGrids = 0, found = 0;
   std::unique_lock lock(state->mutex);
   while (reported < count) {
     state->changed.wait_for(lock, std::chrono::milliseconds(50));
-    // Pictures past their bound: report them, give up their workers, start new ones.
+    // Pictures past their bound of CPU time: report them, give up their workers, start new ones.
     for (std::size_t slot = 0; slot < state->boundStarts.size(); ++slot) {
       const auto& started = state->boundStarts[slot];
-      if (state->abandoned[slot] || !started || Clock::now() - *started < options.perPicture) {
+      if (state->abandoned[slot] || !started ||
+          cpuTime(state->cpuClocks[slot]) - *started < options.perPicture) {
         continue;
       }
       const std::size_t index = state->current[slot];
@@ -134,11 +173,15 @@ std::vector<PictureSearch> searchPictures(std::size_t count, PictureLoader loade
     while (reported < state->finishOrder.size()) {
       const std::size_t index = state->finishOrder[reported++];
       const PictureSearch result = state->results[index];
-      if (result.outcome == PictureSearch::Outcome::kLargerThanBoard) ++largerGrids;
-      if (result.outcome == PictureSearch::Outcome::kFound) ++found;
       lock.unlock();
       if (progress) progress(index, result, reported);
       lock.lock();
+    }
+    for (; prefix < count && state->finished[prefix]; ++prefix) {
+      const auto outcome = state->results[prefix].outcome;
+      if (outcome == PictureSearch::Outcome::kLargerThanBoard) ++largerGrids;
+      if (outcome == PictureSearch::Outcome::kFound) ++found;
+      if (found == 0 && static_cast<int>(largerGrids) >= options.largerGridsToStop) break;
     }
     if (found == 0 && static_cast<int>(largerGrids) >= options.largerGridsToStop) break;
   }

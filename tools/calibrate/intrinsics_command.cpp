@@ -133,8 +133,9 @@ Detections detectBoards(const std::vector<std::filesystem::path>& files,
       largerGrids.push_back(
           fmt::format("{}x{} in {}", result.seenGrid.width, result.seenGrid.height, name));
     } else if (result.outcome == PictureSearch::Outcome::kTimedOut) {
-      found.notes.push_back(fmt::format("{}: no board found within {:g} s (--detect-timeout-s)",
-                                        name, options.detectTimeoutS));
+      found.notes.push_back(
+          fmt::format("{}: no board found within {:g} s of CPU time (--detect-timeout-s)", name,
+                      options.detectTimeoutS));
     } else if (result.outcome == PictureSearch::Outcome::kFound) {
       if (result.edgeWidthPx > options.limits.maxEdgeWidthPx) {
         found.notes.push_back(

@@ -51,7 +51,8 @@ it already was) are skipped with a note.
                              pictures, and never past where the distortion stops increasing)
   --update-rig FILE          also write the lens into this rig file (see "--update-rig" below)
   --camera NAME              with --update-rig: the camera to update
-  --detect-timeout-s S       give up the board search in one picture after S seconds (default 10)
+  --detect-timeout-s S       give up the board search in one picture after S seconds of its CPU
+                             time (default 10; the machine's load does not change which count)
 limits of the verdict (a solve outside any of them fails):
   --max-rms-px X             RMS over all corners (default 1)
   --max-view-rms-px X        a view above it is left out and named (default 2)
