@@ -251,6 +251,29 @@ TEST(CalibrateCli, IntrinsicsWithAnUnreadableOrOddSizedImage) {
                     "from one camera at one resolution");
 }
 
+// Issue 47: a lens fitted to 640x480 pictures was written over a 1920x1280 camera's without a
+// word. Pictures of another size than the camera's are refused, naming both, before the solve,
+// and the rig is left as it was.
+TEST(CalibrateCli, IntrinsicsForARigCameraOfAnotherSizeAreRefused) {
+  const TempDir dir;
+  auto camera = presetCameras("paper.yaml").front();
+  const auto images = writeImages(dir, "views", boardViews(camera.intrinsics, kBoard, 6, 5));
+  const cv::Size pictures = camera.intrinsics.imageSize;
+  camera.intrinsics.imageSize = pictures * 2;
+  camera.intrinsics.cx = 2 * camera.intrinsics.cx;
+  camera.intrinsics.cy = 2 * camera.intrinsics.cy;
+  const auto rig = writeRig(dir, camera);
+  const std::string before = surroundd::testing::fileBytes(rig);
+  auto arguments = intrinsicsOn(dir, images);
+  arguments.insert(arguments.end(), {"--update-rig", rig.string(), "--camera", camera.name});
+  expectFailure(calibrate(dir, arguments), 2,
+                fmt::format("--update-rig: camera '{}' in {} takes {}x{} pictures, these are {}x{}",
+                            camera.name, rig.string(), 2 * pictures.width, 2 * pictures.height,
+                            pictures.width, pictures.height));
+  EXPECT_EQ(surroundd::testing::fileBytes(rig), before);
+  EXPECT_FALSE(std::filesystem::exists(dir / "lens.yaml"));
+}
+
 // The guide's camera: an unreachable device, a recording that is not there (needs the guide's
 // page: a build without HTTP refuses the guide before it opens a camera).
 TEST(CalibrateCli, GuideCamerasThatCannotBeOpenedAreNamed) {

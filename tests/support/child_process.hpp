@@ -83,8 +83,8 @@ class ChildProcess {
   // `arguments` with the emulator in front where they start a program of this build.
   static std::vector<std::string> launched(std::vector<std::string> arguments) {
     const std::vector<std::string> launcher{SURROUNDD_PROGRAM_LAUNCHER};
-    constexpr std::string_view kBuild = SURROUNDD_BINARY_DIR "/";
-    if (launcher.empty() || arguments.empty() || !arguments.front().starts_with(kBuild)) {
+    const std::string build = std::string(SURROUNDD_BINARY_DIR) + "/";
+    if (launcher.empty() || arguments.empty() || !arguments.front().starts_with(build)) {
       return arguments;
     }
     arguments.insert(arguments.begin(), launcher.begin(), launcher.end());

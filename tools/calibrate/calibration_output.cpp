@@ -12,8 +12,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include "common/regular_file.hpp"
 #include "daemon/rig_yaml.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
+#include "tools/calibrate/rig_text_edit.hpp"
 
 namespace surroundd::calibrate {
 namespace {
@@ -54,6 +56,19 @@ void writeAtomically(const std::filesystem::path& file, const std::string& text,
 
 using Fields = std::function<void(YAML::Emitter&)>;
 
+// A rig file is a few kilobytes; this bounds what a mistaken path could make it read.
+constexpr std::size_t kMaxRigBytes = std::size_t{16} << 20;
+
+// `fields` as one flow map, "{name: value, ...}".
+std::string flowMap(const Fields& fields) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(12);  // far below any calibration's uncertainty, still readable
+  out << YAML::Flow << YAML::BeginMap;
+  fields(out);
+  out << YAML::EndMap;
+  return out.c_str();
+}
+
 // One block `key: {name: value, ...}` of the rig schema, with a comment on top.
 std::string block(std::string_view key, std::string_view comment, const Fields& fields) {
   YAML::Emitter out;
@@ -87,67 +102,6 @@ Fields mountFields(const processing::Pose& pose) {
   };
 }
 
-// The file's leading comment block, verbatim: every line before the first that holds YAML.
-std::string headerOf(const std::string& text) {
-  std::size_t end = 0;
-  while (end < text.size()) {
-    const auto next = text.find('\n', end);
-    const auto line = std::string_view(text).substr(
-        end, next == std::string::npos ? std::string::npos : next - end);
-    const auto first = line.find_first_not_of(" \t\r");
-    if (first != std::string_view::npos && line[first] != '#') break;
-    end = next == std::string::npos ? text.size() : next + 1;
-  }
-  std::string header = text.substr(0, end);
-  if (!header.empty() && header.back() != '\n') header += '\n';
-  return header;
-}
-
-// The rig document again, with `comment` beside `key` of each camera named in `cameras`. Only
-// the paths down to those cameras are walked; every other node is emitted as it was read (its
-// keys, their order and flow or block style).
-std::string emitRig(const YAML::Node& document, std::span<const std::string> cameras,
-                    const std::string& key, const std::string& comment) {
-  const auto edited = [&](const YAML::Node& entry) {
-    return entry.IsMap() && entry["name"] &&
-           std::ranges::find(cameras, entry["name"].Scalar()) != cameras.end();
-  };
-  const auto styled = [](YAML::Emitter& out, const YAML::Node& node) {
-    if (node.Style() == YAML::EmitterStyle::Flow) out << YAML::Flow;
-  };
-  YAML::Emitter out;
-  styled(out, document);
-  out << YAML::BeginMap;
-  for (const auto& top : document) {
-    out << YAML::Key << top.first << YAML::Value;
-    if (top.first.Scalar() != "cameras" || !top.second.IsSequence()) {
-      out << top.second;
-      continue;
-    }
-    styled(out, top.second);
-    out << YAML::BeginSeq;
-    for (const auto& entry : top.second) {
-      if (!edited(entry)) {
-        out << entry;
-        continue;
-      }
-      styled(out, entry);
-      out << YAML::BeginMap;
-      for (const auto& field : entry) {
-        out << YAML::Key << field.first << YAML::Value;
-        if (field.first.Scalar() == key) out << YAML::Comment(comment);
-        out << field.second;
-      }
-      out << YAML::EndMap;
-    }
-    out << YAML::EndSeq;
-  }
-  out << YAML::EndMap;
-  if (!out.good())
-    throw std::runtime_error(fmt::format("cannot emit the rig: {}", out.GetLastError()));
-  return std::string(out.c_str()) + "\n";
-}
-
 bool near(double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(1.0, std::abs(b)); }
 
 // Equal within the digits written (12 significant; a pose also goes through its angles).
@@ -177,40 +131,33 @@ struct RigEdit {
   std::function<void(processing::CameraCalibration&)> change;
 };
 
-// Replaces the `key` block (lens or mount) of each edited camera in a rig file, editing the YAML
-// document itself so that every other key stays, and the file's header comment with it. All the
-// edits go into one file written beside and renamed: the rig takes all of them or none. A result
-// that does not read back to the changed calibrations is refused.
+// Replaces the `key` block (lens or mount) of each edited camera in a rig file, in its text
+// (rig_text_edit.hpp): every other byte stays. All the edits go into one file written beside and
+// renamed: the rig takes all of them or none. A result that does not read back to the changed
+// calibrations is refused.
 void updateRig(const std::filesystem::path& rig, const std::string& key,
                std::span<const RigEdit> edits, std::string_view comment) {
   const auto before = daemon::loadRigFile(rig);  // a rig that does not load is not edited
   auto expected = before;
-  std::vector<std::string> cameras;
-  cameras.reserve(edits.size());
+  std::vector<RigTextEdit> textEdits;
+  textEdits.reserve(edits.size());
   for (const auto& edit : edits) {
     const auto it = std::find_if(expected.begin(), expected.end(),
                                  [&](const auto& c) { return c.calibration.name == edit.camera; });
     if (it == expected.end()) rigCamera(rig, edit.camera);  // throws the message naming them
     edit.change(it->calibration);
-    cameras.push_back(edit.camera);
+    textEdits.push_back({edit.camera, flowMap(edit.fields)});
   }
-
-  std::ifstream in(rig);
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  YAML::Node document = YAML::Load(text);
-  for (auto entry : document["cameras"]) {
-    for (const auto& edit : edits) {
-      if (entry.IsMap() && entry["name"] && entry["name"].Scalar() == edit.camera) {
-        entry[key] = YAML::Load(block(key, "", edit.fields))[key];
-      }
-    }
-  }
-  // One line beside each block: yaml-cpp keeps no comment of the document, so this one is all the
-  // record the rig has of where the values came from. The block is written in block style, so
-  // that its values do not drop to the line below the comment as a flow map's would.
+  // The comment is all the record the rig has of where the values came from: beside each value.
   std::string note(comment);
   std::ranges::replace(note, '\n', ' ');
-  const std::string updated = headerOf(text) + emitRig(document, cameras, key, note);
+  std::string updated;
+  try {
+    updated = editRigText(readRegularFile(rig, kMaxRigBytes), key, textEdits, note);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("--update-rig: {}: {} cannot be edited in place: {}", rig.string(),
+                                 key, e.what()));
+  }
 
   writeAtomically(rig, updated, [&](const std::filesystem::path& written) {
     const auto refuse = [&](const std::string& why) {
@@ -273,6 +220,7 @@ void writeMountBlocks(const std::filesystem::path& file,
 
 void updateRigLens(const std::filesystem::path& rig, const std::string& camera,
                    const processing::Intrinsics& lens, std::string_view comment) {
+  checkRigPictureSize(rig, camera, lens.imageSize);
   const RigEdit edit{camera, lensFields(lens),
                      [&](processing::CameraCalibration& c) { c.intrinsics = lens; }};
   updateRig(rig, "lens", {&edit, 1}, comment);
@@ -306,6 +254,17 @@ processing::CameraCalibration rigCamera(const std::filesystem::path& rig,
   }
   throw UsageError(fmt::format("--camera: the rig '{}' has no camera '{}' (it has {})",
                                rig.string(), camera, names));
+}
+
+void checkRigPictureSize(const std::filesystem::path& rig, const std::string& camera,
+                         cv::Size pictures) {
+  const cv::Size size = rigCamera(rig, camera).intrinsics.imageSize;
+  if (size != pictures) {
+    throw UsageError(fmt::format(
+        "--update-rig: camera '{}' in {} takes {}x{} pictures, these are {}x{}: a lens fitted to "
+        "them does not fit it; calibrate from that camera's own pictures, at its size",
+        camera, rig.string(), size.width, size.height, pictures.width, pictures.height));
+  }
 }
 
 }  // namespace surroundd::calibrate

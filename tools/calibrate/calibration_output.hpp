@@ -30,12 +30,12 @@ void writeMountBlocks(const std::filesystem::path& file,
 // A PNG of `picture` (8-bit, 1 or 3 channels).
 void writePng(const std::filesystem::path& file, const cv::Mat& picture);
 
-// Replaces one camera's lens: or mount: block in a rig file, editing the YAML document: every
-// other key (sources with their sequence_fps, health, other cameras, ...) stays, and so does the
-// file's leading comment block, verbatim; comments inside the document are lost (yaml-cpp keeps
-// none), and `comment` goes on one line beside the new block. The result must read back through
+// Replaces one camera's lens: or mount: value in a rig file, in its text (rig_text_edit.hpp):
+// every other byte stays as it was (comments, order, style, other cameras, keys of the user's
+// own), and `comment` goes on one line beside the new value. The result must read back through
 // daemon::loadRigFile to the new calibration, or nothing is written (std::runtime_error). Throws
-// UsageError when the rig has no camera of that name.
+// UsageError when the rig has no camera of that name, and when a lens's pictures are of another
+// size than the camera's (checkRigPictureSize).
 void updateRigLens(const std::filesystem::path& rig, const std::string& camera,
                    const processing::Intrinsics& lens, std::string_view comment);
 void updateRigMount(const std::filesystem::path& rig, const std::string& camera,
@@ -49,5 +49,10 @@ void updateRigMounts(const std::filesystem::path& rig,
 // The camera of that name in a rig file; UsageError listing the names when there is none.
 processing::CameraCalibration rigCamera(const std::filesystem::path& rig,
                                         const std::string& camera);
+// UsageError naming both sizes when camera `camera` of `rig` takes pictures of another size than
+// `pictures`: a lens fitted to them does not fit it (one of 640x480 was once written over a
+// 1920x1280 camera without a word).
+void checkRigPictureSize(const std::filesystem::path& rig, const std::string& camera,
+                         cv::Size pictures);
 
 }  // namespace surroundd::calibrate

@@ -208,6 +208,9 @@ void runIntrinsics(const IntrinsicsOptions& options, std::ostream& log) {
   if (options.updateRig) rigCamera(*options.updateRig, options.camera);  // before the long part
   const auto files = listImages(options);
   Detections found = detectBoards(files, options, log);
+  if (options.updateRig && found.imageSize.area() > 0) {
+    checkRigPictureSize(*options.updateRig, options.camera, found.imageSize);  // before the solve
+  }
   dropDuplicates(found);
   for (const auto& note : found.notes) log << "  skipped " << note << "\n";
   if (found.views.empty()) {
