@@ -136,7 +136,21 @@ CoverageMap coverageOf(std::span<const BoardView> views, cv::Size imageSize, con
   return map;
 }
 
-FieldOfView fieldOfViewOf(const Intrinsics& lens, const ImageCircle& circle) {
+double widestCornerAngleRad(const Intrinsics& lens, std::span<const BoardView> views) {
+  const CameraModel model(lens);
+  double widest = 0;
+  for (const auto& view : views) {
+    for (const auto& corner : view.corners) {
+      if (const auto ray = model.unproject({corner.x, corner.y})) {
+        widest = std::max(widest, std::acos(std::clamp((*ray)[2] / cv::norm(*ray), -1.0, 1.0)));
+      }
+    }
+  }
+  return widest;
+}
+
+FieldOfView fieldOfViewOf(const Intrinsics& lens, const ImageCircle& circle,
+                          std::optional<double> widestCornerRad) {
   FieldOfView field;
   const auto lit = widestLitFieldAngle(lens, circle.lit);
   double halfRad = lit.rad;
@@ -155,6 +169,17 @@ FieldOfView fieldOfViewOf(const Intrinsics& lens, const ImageCircle& circle) {
         "--field-of-view-deg for the lens's real field",
         2 * halfRad * kToDeg);
     halfRad = std::numbers::pi / 2;
+  }
+  if (const double reach = widestCornerRad.value_or(halfRad) + kFieldPastCornersDeg / kToDeg;
+      widestCornerRad && halfRad > reach) {
+    field.note = fmt::format(
+        "limited to {:.1f} deg: the board's corners reached {:.1f} deg off the axis, and the "
+        "solved distortion is taken {:g} deg past them, not to the {}'s {:.1f}; pictures with the "
+        "board nearer the edge of the picture widen it, --field-of-view-deg sets it",
+        2 * reach * kToDeg, *widestCornerRad * kToDeg, kFieldPastCornersDeg,
+        field.fromImageCircle ? "image circle" : "picture", 2 * halfRad * kToDeg);
+    field.fromImageCircle = false;
+    halfRad = reach;
   }
   field.fullDeg = 2 * halfRad * kToDeg;
   return field;

@@ -3,6 +3,7 @@
 // show: the coverage map (what a guided flow fills in, what a verdict asks enough of), the lens's
 // image circle found from the pictures, and the field of view that follows from it.
 
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -50,10 +51,20 @@ struct FieldOfView {
   std::string note;              // why the value is what it is, when it was limited
 };
 
+// How far past the widest angle the board's corners reached a field is taken: a few degrees of
+// the polynomial's extrapolation, where it stays close to the lens.
+inline constexpr double kFieldPastCornersDeg = 5;
+
+// The widest angle off the optical axis that any of `views`' corners reached through `lens`.
+double widestCornerAngleRad(const Intrinsics& lens, std::span<const BoardView> views);
+
 // The field the calibrated lens covers: to the edge of its image circle where the pictures show
 // it; to the image corners where they are lit, but never past 180 degrees that way (a lens whose
 // circle fills the sensor shows nothing that proves more) nor past where the solved polynomial
-// stops increasing.
-FieldOfView fieldOfViewOf(const Intrinsics& lens, const ImageCircle& circle);
+// stops increasing; and, given the widest angle the corners reached, never more than
+// kFieldPastCornersDeg past it (the polynomial is known only where corners were: extrapolated to
+// 193-200 degrees from corners at 72, it put real rigs' far ground in the wrong place).
+FieldOfView fieldOfViewOf(const Intrinsics& lens, const ImageCircle& circle,
+                          std::optional<double> widestCornerRad = std::nullopt);
 
 }  // namespace surroundd::processing

@@ -142,9 +142,14 @@ TEST(CalibrateCli, IntrinsicsWriteALensBlockTheRigAccepts) {
   EXPECT_EQ(lens.imageSize, truth.imageSize);
   EXPECT_NEAR(lens.fx / truth.fx, 1, 0.005);
   EXPECT_NEAR(lens.fy / truth.fy, 1, 0.005);
-  // As far as the images are lit, through a polynomial fitted out to 80 degrees: a few degrees
-  // short.
-  EXPECT_NEAR(lens.maxFieldAngleRad * 360 / std::numbers::pi, 190, 8);
+  // A few degrees past the widest angle the board's corners reached (issue 47: the polynomial
+  // is known only where corners were): about 68 degrees off the axis in these views, so about 146
+  // of the lens's 190, and the output says why.
+  const double fieldDeg = lens.maxFieldAngleRad * 360 / std::numbers::pi;
+  EXPECT_GT(fieldDeg, 120);
+  EXPECT_LT(fieldDeg, 185);
+  EXPECT_THAT(run.output, HasSubstr(fmt::format("limited to {:.1f} deg: the board's corners reached",
+                                                fieldDeg)));
   EXPECT_FALSE(cv::imread((dir / "residuals.png").string()).empty());
   // --update-rig: the rig's camera has the new lens and keeps its mount, and the rig keeps every
   // other key.

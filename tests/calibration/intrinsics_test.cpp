@@ -116,6 +116,37 @@ TEST(IntrinsicCalibration, APinholeWhoseDistortionTurnsShortOfTheCornersHasTheFi
   EXPECT_EQ(straight.note, "");
 }
 
+// Issue 47: fields of 193-200 degrees were written for lenses whose corners had reached 72
+// degrees off the axis, past real image circles of 150-174. The field now ends a few degrees past
+// the widest corner, and says so.
+TEST(IntrinsicCalibration, TheFieldEndsAFewDegreesPastTheWidestCorner) {
+  const auto lens = presetCameras("fisheye.yaml").front().intrinsics;
+  const processing::ImageCircle wholePicture{cv::Mat(lens.imageSize, CV_8U, cv::Scalar(255)),
+                                             false};
+  const processing::CameraModel model(lens);
+  // A view whose corners reach 60 degrees off the axis at most.
+  const double reachRad = 60 * std::numbers::pi / 180;
+  processing::BoardView view;
+  for (const double angle : {0.0, reachRad / 2, reachRad}) {
+    const auto pixel =
+        model.project({std::sin(angle) * 0.6, std::sin(angle) * 0.8, std::cos(angle)});
+    ASSERT_TRUE(pixel.has_value());
+    view.corners.emplace_back(static_cast<float>(pixel->x), static_cast<float>(pixel->y));
+  }
+  const double widest = processing::widestCornerAngleRad(lens, {&view, 1});
+  EXPECT_NEAR(widest, reachRad, 1e-4);
+  const auto field = processing::fieldOfViewOf(lens, wholePicture, widest);
+  EXPECT_NEAR(field.fullDeg, 2 * (60 + processing::kFieldPastCornersDeg), 0.01);
+  EXPECT_FALSE(field.fromImageCircle);
+  EXPECT_THAT(field.note, ::testing::HasSubstr("limited to 130.0 deg: the board's corners "
+                                               "reached 60.0 deg off the axis"));
+  // Corners at the picture's edge leave the field as the picture has it.
+  const auto whole = processing::fieldOfViewOf(lens, wholePicture);
+  EXPECT_EQ(
+      processing::fieldOfViewOf(lens, wholePicture, whole.fullDeg * std::numbers::pi / 360).fullDeg,
+      whole.fullDeg);
+}
+
 TEST(IntrinsicCalibration, TooFewViewsSaySoAndHowManyAreNeeded) {
   const auto truth = presetCameras("paper.yaml").front().intrinsics;
   const std::vector<processing::BoardView> views(

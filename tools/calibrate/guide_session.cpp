@@ -116,7 +116,7 @@ void GuideSession::solve(std::chrono::nanoseconds streamTime) {
     solve_ = std::move(solved);
     return;
   }
-  solved.field = limitField(solved.result.intrinsics, circle_, settings_.fieldOfViewDeg);
+  solved.field = limitField(solved.result.intrinsics, circle_, boards, settings_.fieldOfViewDeg);
   solved.verdict =
       processing::judgeCalibration(solved.result, coverage_.coveredShare, settings_.limits);
   const auto& lens = solved.result.intrinsics;

@@ -240,7 +240,7 @@ void runIntrinsics(const IntrinsicsOptions& options, std::ostream& log) {
   const auto circle = lensCircle(options.model, found.brightest);
   const auto coverage = processing::coverageOf(used, found.imageSize, circle.lit);
   auto& lens = result.intrinsics;
-  const auto field = limitField(lens, circle, options.fieldOfViewDeg);
+  const auto field = limitField(lens, circle, used, options.fieldOfViewDeg);
   printViewTable(result, options.squareMm, options.limits.maxViewRmsPx, log);
   printLens(result, field, log);
   log << fmt::format("coverage {:.0f} % of the lens's cells", 100 * coverage.coveredShare);

@@ -14,8 +14,14 @@ processing::ImageCircle lensCircle(processing::LensModel model, const cv::Mat& b
 
 processing::FieldOfView limitField(processing::Intrinsics& lens,
                                    const processing::ImageCircle& circle,
+                                   std::span<const processing::BoardView> views,
                                    std::optional<double> givenDeg) {
-  auto field = processing::fieldOfViewOf(lens, circle);
+  // A pinhole lens's field is its picture's (what it writes has none): only a wide lens is
+  // extrapolated far past its corners.
+  const bool wide = lens.model != processing::LensModel::kPinhole;
+  auto field = processing::fieldOfViewOf(
+      lens, circle,
+      wide ? std::optional(processing::widestCornerAngleRad(lens, views)) : std::nullopt);
   if (lens.model == processing::LensModel::kFisheye) {
     if (givenDeg) field = {*givenDeg, false, "given by --field-of-view-deg"};
     lens.maxFieldAngleRad = std::min(lens.maxFieldAngleRad, field.fullDeg * std::numbers::pi / 360);

@@ -3,6 +3,7 @@
 // guide: the image circle from the pictures and the field of view that follows from it.
 
 #include <optional>
+#include <span>
 
 #include <opencv2/core.hpp>
 
@@ -16,11 +17,13 @@ namespace surroundd::calibrate {
 // pixel counts.
 processing::ImageCircle lensCircle(processing::LensModel model, const cv::Mat& brightest);
 
-// The field of view of `lens` (see processing::fieldOfViewOf), or `givenDeg` for a fisheye when
-// the user gave it; a fisheye's maxFieldAngleRad is limited to it (within the polynomial's
-// monotonic range, which the solve left in the field).
+// The field of view of `lens` solved from `views` (see processing::fieldOfViewOf: within the image
+// circle and a few degrees past the widest corner), or `givenDeg` for a fisheye when the user gave
+// it; a fisheye's maxFieldAngleRad is limited to it (within the polynomial's monotonic range,
+// which the solve left in the field).
 processing::FieldOfView limitField(processing::Intrinsics& lens,
                                    const processing::ImageCircle& circle,
+                                   std::span<const processing::BoardView> views,
                                    std::optional<double> givenDeg);
 
 }  // namespace surroundd::calibrate
