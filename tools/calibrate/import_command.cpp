@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <optional>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
@@ -49,9 +51,14 @@ std::vector<NamedCalibration> readInputs(const ImportOptions& options) {
   return cameras;
 }
 
+// A fit to a homography further from it than this gets a warning: hand-clicked points give a
+// pixel or so, a wrong --canvas-scale or canvas many.
+constexpr double kPoorFitPx = 2;
+constexpr double kPoorFitM = 0.05;
+
 processing::Pose poseOf(const std::string& camera, const ForeignCalibration& found,
                         const processing::Intrinsics& lens, const ImportOptions& options,
-                        const SourceFrame& frame) {
+                        const SourceFrame& frame, std::vector<std::string>& notes) {
   if (found.pose) return vehiclePose(frame, camera, found.pose->value);
   if (!found.homography) {
     std::string files;
@@ -81,8 +88,47 @@ processing::Pose poseOf(const std::string& camera, const ForeignCalibration& fou
   const cv::Matx33d k(lens.fx, 0, lens.cx, 0, lens.fy, lens.cy, 0, 0, 1);
   const GroundCanvas canvas{*options.canvasScale, options.canvasOrigin, frame.groundFor(camera),
                             frame.verticalSign()};
-  return vehiclePose(frame, camera,
-                     poseFromGroundHomography(found.homography->value, k, canvas, origin));
+  const GroundPoseFit fit =
+      poseFromGroundHomography(found.homography->value, k, lens.imageSize, canvas, origin);
+  const double groundM = fit.rmsGroundUnits * options.unitM;
+  const bool poor = fit.rmsPx > kPoorFitPx || groundM > kPoorFitM;
+  notes.push_back(fmt::format(
+      "{}camera '{}': pose fitted to the homography ({}) over {} ground points: {:.2f} px, "
+      "{:.1f} cm RMS from it{}",
+      poor ? "warning: " : "", camera, origin, fit.points, fit.rmsPx, 100 * groundM,
+      poor ? "; it is not the ground seen by a camera: check --canvas-scale, --canvas-origin and "
+             "the lens, or the points H was made from"
+           : ""));
+  return vehiclePose(frame, camera, fit.pose);
+}
+
+// A warning where a camera named front, back, left or right is placed or looks another way (an
+// inverted matrix put a camera named 'back' in front of the car, looking forward, silently).
+std::optional<std::string> nameAndPoseDisagree(const processing::CameraCalibration& camera) {
+  struct Side {
+    std::string_view name;
+    double x, y;  // its direction, vehicle frame: x forward, y left
+  };
+  constexpr std::array<Side, 4> kSides{
+      {{"front", 1, 0}, {"back", -1, 0}, {"left", 0, 1}, {"right", 0, -1}}};
+  const auto side = std::ranges::find_if(
+      kSides, [&](const Side& s) { return camera.name.find(s.name) != std::string::npos; });
+  if (side == kSides.end()) return std::nullopt;
+  const cv::Vec3d axis = camera.pose.rotation * cv::Vec3d(0, 0, 1);
+  const cv::Vec2d looks(axis[0], axis[1]), at(camera.pose.position[0], camera.pose.position[1]);
+  // Against the side's direction: looking more than 90 degrees away from it, or placed on the
+  // other side of the vehicle's centre.
+  const cv::Vec2d direction(side->x, side->y);
+  const bool looksAway = cv::norm(looks) > 0.2 && looks.dot(direction) < 0;
+  const bool placedAway = at.dot(direction) < -0.1;
+  if (!looksAway && !placedAway) return std::nullopt;
+  return fmt::format(
+      "warning: camera '{}' is {}{}{}: its name says {}; check the pose's direction "
+      "(--pose-direction) or the camera's name",
+      camera.name, placedAway ? fmt::format("placed at x {:+.2f} y {:+.2f} m", at[0], at[1]) : "",
+      placedAway && looksAway ? " and " : "",
+      looksAway ? fmt::format("looking towards x {:+.2f} y {:+.2f}", looks[0], looks[1]) : "",
+      side->name);
 }
 
 std::string headerComment(const ImportOptions& options,
@@ -125,6 +171,7 @@ ImportedRig importRig(const ImportOptions& options) {
     }
   }
   std::vector<daemon::RigCamera> cameras;
+  std::vector<std::string> notes;
   for (const auto& input : inputs) {
     daemon::RigCamera camera;
     auto& c = camera.calibration;
@@ -154,7 +201,7 @@ ImportedRig importRig(const ImportOptions& options) {
                                    picture->string(), image.cols, image.rows, c.name,
                                    c.intrinsics.imageSize.width, c.intrinsics.imageSize.height));
     }
-    c.pose = poseOf(c.name, input.calibration, c.intrinsics, options, frame);
+    c.pose = poseOf(c.name, input.calibration, c.intrinsics, options, frame, notes);
     cameras.push_back(std::move(camera));
   }
   std::vector<processing::Pose> poses;
@@ -170,11 +217,15 @@ ImportedRig importRig(const ImportOptions& options) {
     return static_cast<int>(it - kRigOrder.begin());
   };
   std::ranges::stable_sort(cameras, {}, rank);
-  return {cameras, headerComment(options, inputs)};
+  for (const auto& camera : cameras) {
+    if (auto warning = nameAndPoseDisagree(camera.calibration)) notes.push_back(*warning);
+  }
+  return {cameras, headerComment(options, inputs), notes};
 }
 
 void runImport(const ImportOptions& options, std::ostream& log) {
-  const auto [cameras, header] = importRig(options);
+  const auto [cameras, header, notes] = importRig(options);
+  for (const auto& note : notes) log << note << "\n";
   if (options.out.has_parent_path()) std::filesystem::create_directories(options.out.parent_path());
   daemon::writeRigFile(options.out, cameras, header);
   for (const auto& camera : cameras) {

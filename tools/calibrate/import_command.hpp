@@ -16,13 +16,17 @@ struct ImportedRig {
   // folder of options.out.
   std::vector<daemon::RigCamera> cameras;
   std::string header;  // the rig file's comment: the inputs, the frame options, the command
+  // What the user should know of how each camera was read: a pose fitted to a homography (with
+  // how far from it), a warning where the fit is poor or a camera's name and pose disagree.
+  std::vector<std::string> notes;
 };
 
 // The rig the options describe. Throws UsageError naming the file and key for missing or
 // malformed input.
 ImportedRig importRig(const ImportOptions& options);
 
-// importRig, then writes options.out (beside and renamed) and prints each camera's mount to `log`.
+// importRig, then writes options.out (beside and renamed) and prints the notes and each camera's
+// mount to `log`.
 void runImport(const ImportOptions& options, std::ostream& log);
 
 }  // namespace surroundd::calibrate
