@@ -22,6 +22,8 @@ constexpr auto kLastPictureLeaves = std::chrono::milliseconds(50);
 // After the end of the stream has gone out, how long the viewers get to leave on their own (they
 // leave when its RTCP BYE arrives) before the server closes their connections.
 constexpr auto kViewersLeave = std::chrono::seconds(2);
+// Threads the server serves its clients on: one each up to this many (see listen()).
+constexpr gint kClientThreads = 8;
 
 // The shared pipeline. Each picture is timed by its own stream time from the pipeline's first
 // (RTP timestamps spaced as the cameras took them), and sent as soon as it comes: the server's
@@ -153,6 +155,10 @@ void RtspStreamSink::Impl::listen() {
   const GObjectPtr<GstRTSPMountPoints> mounts(gst_rtsp_server_get_mount_points(s));
   gst_rtsp_mount_points_add_factory(mounts.get(), ("/" + settings.name).c_str(), factory);
   g_signal_connect(s, "client-connected", G_CALLBACK(onClientConnected), this);
+  // Each client on a thread of its own (up to kClientThreads, then shared): with all of them on
+  // one, a client sending a request line of a megabyte held every other one up while it was read.
+  const GObjectPtr<GstRTSPThreadPool> threads(gst_rtsp_server_get_thread_pool(s));
+  gst_rtsp_thread_pool_set_max_threads(threads.get(), kClientThreads);
 
   GError* error = nullptr;
   listening.reset(gst_rtsp_server_create_source(s, nullptr, &error));
