@@ -6,7 +6,11 @@
 
 #include <chrono>
 #include <csignal>
+#include <filesystem>
 #include <regex>
+#include <set>
+#include <sstream>
+#include <vector>
 
 #include <fmt/format.h>
 #include <gmock/gmock.h>
@@ -16,6 +20,7 @@
 #include "tests/support/child_process.hpp"
 #include "tests/support/notify_socket.hpp"
 #include "tests/support/temp_dir.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -139,6 +144,65 @@ TEST(ServiceUnit, IsHardenedToAnExposureOfAtMost2Point5) {
   ASSERT_TRUE(std::regex_search(output, match, overall)) << output;
   RecordProperty("exposure", match[1].str());
   EXPECT_LE(std::stod(match[1].str()), 2.5);
+}
+
+// The address families a unit allows (its RestrictAddressFamilies= lines).
+std::set<std::string> allowedFamilies(const std::string& unit) {
+  std::set<std::string> families;
+  std::istringstream lines(unit);
+  for (std::string line; std::getline(lines, line);) {
+    if (!line.starts_with("RestrictAddressFamilies=")) continue;
+    std::istringstream words(line.substr(line.find('=') + 1));
+    for (std::string family; words >> family;) families.insert(family);
+  }
+  return families;
+}
+
+// Each socket the code opens (socket(AF_... or PF_...) in `source`, named `file`) whose family the
+// unit does not allow, as "file: AF_X".
+std::vector<std::string> familiesNotAllowed(const std::string& file, const std::string& source,
+                                            const std::set<std::string>& allowed) {
+  std::vector<std::string> missing;
+  const std::regex opened(R"(socket\(\s*(AF|PF)_([A-Z0-9]+))");
+  for (auto it = std::sregex_iterator(source.begin(), source.end(), opened);
+       it != std::sregex_iterator(); ++it) {
+    const std::string family = "AF_" + (*it)[2].str();
+    if (!allowed.contains(family)) missing.push_back(file + ": " + family);
+  }
+  return missing;
+}
+
+// Issue 50: the shipped unit left out AF_CAN, so under the service the CAN socket failed, the
+// signals went stale and reverse gear never brought up the rear view: only under the package,
+// never in the tests. Every socket family the code opens must be one the unit allows, and so must
+// those the libraries open for the features (FFmpeg's and gst-rtsp-server's IPv6, udev's netlink,
+// sd_notify's and the control socket's AF_UNIX).
+TEST(ServiceUnit, AllowsEveryAddressFamilyTheCodeOpens) {
+  const std::filesystem::path source(SURROUNDD_SOURCE_DIR);
+  const auto allowed = allowedFamilies(testing::fileBytes(source / "systemd/surroundd.service"));
+  for (const char* family : {"AF_UNIX", "AF_INET", "AF_INET6", "AF_NETLINK"}) {
+    EXPECT_TRUE(allowed.contains(family)) << family;
+  }
+  std::vector<std::string> missing;
+  int files = 0;
+  for (const char* part : {"common", "capture", "vehicle", "processing", "render", "daemon"}) {
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(source / part)) {
+      if (entry.path().extension() != ".cpp" && entry.path().extension() != ".hpp") continue;
+      ++files;
+      for (auto& m : familiesNotAllowed(entry.path().lexically_relative(source).string(),
+                                        testing::fileBytes(entry.path()), allowed)) {
+        missing.push_back(std::move(m));
+      }
+    }
+  }
+  EXPECT_GT(files, 100);
+  EXPECT_THAT(missing, ::testing::IsEmpty());
+  // The check finds what it must: the CAN bus's socket, against the unit as it shipped.
+  const std::string can = testing::fileBytes(source / "vehicle/socket_can_bus.cpp");
+  EXPECT_THAT(familiesNotAllowed("vehicle/socket_can_bus.cpp", can,
+                                 allowedFamilies("RestrictAddressFamilies=AF_UNIX AF_INET "
+                                                 "AF_INET6 AF_NETLINK\n")),
+              ::testing::ElementsAre("vehicle/socket_can_bus.cpp: AF_CAN"));
 }
 
 }  // namespace
