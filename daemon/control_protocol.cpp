@@ -76,6 +76,16 @@ std::filesystem::path defaultControlSocket() {
 }
 // NOLINTEND(concurrency-mt-unsafe)
 
+std::filesystem::path controlSocketToAsk(const std::filesystem::path& own,
+                                         const std::filesystem::path& service) {
+  std::error_code error;
+  if (own.empty() ||
+      (!std::filesystem::exists(own, error) && std::filesystem::exists(service, error))) {
+    return service;
+  }
+  return own;
+}
+
 ControlReply sendControlRequest(const std::filesystem::path& socket, std::string_view line,
                                 std::chrono::milliseconds timeout) {
   const auto fail = [&](std::string_view what) {

@@ -54,6 +54,11 @@ std::string encodeReply(const ControlReply& reply);
 // RuntimeDirectory=, /run/surroundd), else $XDG_RUNTIME_DIR/surroundd/control.sock; empty if
 // neither is set.
 std::filesystem::path defaultControlSocket();
+// The socket surroundctl asks when none is named: `own` (defaultControlSocket(), the user's own
+// surroundd) where it exists or where there is no `service` socket, else `service` (the
+// service's: a login shell has XDG_RUNTIME_DIR set, and the service's socket was never tried).
+std::filesystem::path controlSocketToAsk(const std::filesystem::path& own,
+                                         const std::filesystem::path& service);
 
 // Sends `line` and reads the reply, waiting at most `timeout` for it.
 ControlReply sendControlRequest(const std::filesystem::path& socket, std::string_view line,

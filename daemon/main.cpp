@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/build_info.hpp"
 #include "daemon/config.hpp"
 #include "daemon/logging.hpp"
 #include "daemon/process_start.hpp"
@@ -27,11 +28,13 @@ using namespace surroundd;
 constexpr std::string_view kUsage =
     R"(usage: surroundd --config FILE [--log-level LEVEL] [--pacing MODE] [--check-config]
 
-  --config FILE       the YAML config (see config/surroundd.reference.yaml)
+  --config FILE       the YAML config (see config/surroundd.reference.yaml); also -c FILE,
+                      --config=FILE (and so for every option with a value)
   --check-config      check the config, say what is wrong (exit 2) or that it is good (exit 0),
                       and open nothing
   --log-level LEVEL   trace, debug, info, warning, error or off; overrides logging.level
   --pacing MODE       realtime or as_fast_as_possible; overrides capture.pacing
+  --version           the version, and the optional parts this build has and has not
   --help              this text
 )";
 
@@ -63,7 +66,7 @@ struct Arguments {
   bool checkOnly = false;
 };
 
-// nullopt after printing what was wrong (or the help text, with `help` set).
+// nullopt after printing what was wrong (or the help or version text, with `help` set).
 std::optional<Arguments> parseArguments(int argc, char** argv, bool& help) {
   Arguments arguments;
   const auto fail = [](std::string_view message) {
@@ -71,18 +74,30 @@ std::optional<Arguments> parseArguments(int argc, char** argv, bool& help) {
     return std::nullopt;
   };
   for (int i = 1; i < argc; ++i) {
-    const std::string_view flag = argv[i];
+    std::string_view flag = argv[i];
     if (flag == "--help" || flag == "-h") {
       help = true;
       fmt::print("{}", kUsage);
+      return std::nullopt;
+    }
+    if (flag == "--version") {
+      help = true;
+      fmt::print("{}", versionText("surroundd"));
       return std::nullopt;
     }
     if (flag == "--check-config") {
       arguments.checkOnly = true;
       continue;
     }
-    if (i + 1 >= argc) return fail(fmt::format("'{}' needs a value", flag));
-    const std::string_view value = argv[++i];
+    // --name=value, as GNU programs take it, and -c for --config.
+    std::optional<std::string_view> attached;
+    if (const auto equals = flag.find('='); flag.starts_with("--") && equals != flag.npos) {
+      attached = flag.substr(equals + 1);
+      flag = flag.substr(0, equals);
+    }
+    if (flag == "-c") flag = "--config";
+    if (!attached && i + 1 >= argc) return fail(fmt::format("'{}' needs a value", flag));
+    const std::string_view value = attached ? *attached : std::string_view(argv[++i]);
     if (flag == "--config") {
       arguments.configFile = value;
     } else if (flag == "--log-level") {

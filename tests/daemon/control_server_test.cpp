@@ -15,6 +15,8 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include "tests/support/temp_dir.hpp"
+
 namespace surroundd::daemon {
 namespace {
 
@@ -256,6 +258,20 @@ TEST_F(ControlServerTest, ASecondServerOnTheSamePathIsRefusedAndAStaleOneReplace
   { const ControlServer replaced(stalePath); }
   EXPECT_FALSE(std::filesystem::exists(stalePath));  // removed with its server
   std::filesystem::remove_all(stalePath.parent_path());
+}
+
+// Issue 50: with XDG_RUNTIME_DIR set (any login shell) surroundctl never tried the service's
+// socket. The user's own surroundd's is asked where it exists, else the service's where that does.
+TEST(ControlClient, AsksTheUsersOwnSurrounddElseTheServices) {
+  const testing::TempDir dir;
+  const auto own = dir / "own.sock";
+  const auto service = dir / "service.sock";
+  EXPECT_EQ(controlSocketToAsk(own, service), own);  // neither: the error names the user's
+  dir.write("service.sock", "");
+  EXPECT_EQ(controlSocketToAsk(own, service), service);
+  EXPECT_EQ(controlSocketToAsk({}, service), service);  // no runtime folder at all
+  dir.write("own.sock", "");
+  EXPECT_EQ(controlSocketToAsk(own, service), own);
 }
 
 TEST(ControlClient, SaysWhichSocketItCouldNotReach) {

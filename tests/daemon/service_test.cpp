@@ -132,6 +132,31 @@ outputs:
       std::filesystem::temp_directory_path() / fmt::format("sd-svc-{}", ::getpid()) / "c.sock";
 };
 
+// Issue 50: no program had --version ("'--version' needs a value"), and -c FILE and
+// --config=FILE were refused. Every program says its version and the optional parts built in.
+TEST_F(ServiceTest, EveryProgramSaysItsVersionAndTheConfigTakesEveryForm) {
+  for (const auto& [program, name] :
+       {std::pair{std::string(SURROUNDD_EXECUTABLE), "surroundd"},
+        std::pair{std::string(SURROUNDCTL_EXECUTABLE), "surroundctl"}}) {
+    testing::ChildProcess version({program, "--version"}, dir_ / "version.txt");
+    EXPECT_EQ(version.wait(), 0) << name;
+    EXPECT_THAT(version.output(), AllOf(HasSubstr(std::string(name) + " 0."),
+                                        HasSubstr("\nbuilt with: "), HasSubstr("\nwithout: ")))
+        << name;
+  }
+  const auto config = writeConfig("  - {type: snapshot, stream: mosaic, path: out/m.png}");
+  for (const std::vector<std::string>& form :
+       {std::vector<std::string>{"-c", config.string()},
+        std::vector<std::string>{"--config=" + config.string()}}) {
+    std::vector<std::string> arguments{SURROUNDD_EXECUTABLE};
+    arguments.insert(arguments.end(), form.begin(), form.end());
+    arguments.emplace_back("--check-config");
+    testing::ChildProcess check(arguments, dir_ / "check.txt");
+    EXPECT_EQ(check.wait(), 0) << check.output();
+    EXPECT_THAT(check.output(), HasSubstr(": good ("));
+  }
+}
+
 TEST_F(ServiceTest, ControlRequestsRoundTripAndSigtermLeavesPlayableFiles) {
   const auto launched = std::chrono::steady_clock::now();
   auto surroundd = start(writeConfig(R"(  - {type: video, stream: surround, path: out/orbit.mp4}

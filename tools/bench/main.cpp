@@ -20,6 +20,7 @@
 
 #include <fmt/format.h>
 
+#include "common/build_info.hpp"
 #include "common/work_pool.hpp"
 #include "tools/bench/colour_benchmark.hpp"
 #include "tools/bench/gpu_kit.hpp"
@@ -163,6 +164,10 @@ int main(int argc, char** argv) {
   using surroundd::render::ViewKind;
   if (argc >= 2 && (std::string_view(argv[1]) == "--help" || std::string_view(argv[1]) == "-h")) {
     fmt::print("{}", kUsage);
+    return 0;
+  }
+  if (argc >= 2 && std::string_view(argv[1]) == "--version") {
+    fmt::print("{}", surroundd::versionText("surround-bench"));
     return 0;
   }
   const std::string_view command = argc >= 2 ? argv[1] : "";

@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "common/build_info.hpp"
+
 namespace surroundd::calibrate {
 namespace {
 
@@ -199,6 +201,7 @@ Command parseArguments(std::span<const std::string_view> arguments) {
   if (subcommand == "--help" || subcommand == "-h" || subcommand == "help") {
     return HelpRequest{usage()};
   }
+  if (subcommand == "--version") return HelpRequest{versionText("surround-calibrate")};
   if (subcommand == "intrinsics") {
     if (asksForHelp(rest))
       return HelpRequest{fmt::format("{}\n{}", kIntrinsicsUsage, kUpdateRigUsage)};

@@ -36,6 +36,7 @@
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
 
+#include "common/build_info.hpp"
 #include "common/masked_psnr.hpp"
 #include "common/pixel_format.hpp"
 #include "common/work_pool.hpp"
@@ -310,6 +311,10 @@ int main(int argc, char** argv) {
     const std::string_view value = i + 1 < argc ? argv[i + 1] : "";
     if (arg == "--help" || arg == "-h") {
       fmt::print("{}", kUsage);
+      return 0;
+    }
+    if (arg == "--version") {
+      fmt::print("{}", surroundd::versionText("surround-gpu-check"));
       return 0;
     }
     if (arg == "--frames") {

@@ -4,12 +4,14 @@
 // Exit codes: 0 done, 1 surroundd answered with an error or could not be reached, 2 bad usage.
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <string_view>
 
 #include <fmt/format.h>
 
+#include "common/build_info.hpp"
 #include "daemon/control_protocol.hpp"
 
 namespace {
@@ -32,7 +34,9 @@ commands:
   reload            read the config file again (a bad one is rejected; the old one keeps running)
 
   --socket PATH     surroundd's control socket (default: $RUNTIME_DIRECTORY/control.sock, else
-                    $XDG_RUNTIME_DIR/surroundd/control.sock, else /run/surroundd/control.sock)
+                    $XDG_RUNTIME_DIR/surroundd/control.sock where it exists, else the service's
+                    /run/surroundd/control.sock)
+  --version         the version, and the optional parts this build has and has not
 )";
 
 // A reload restarts the pipeline; building it can take a few seconds.
@@ -43,11 +47,13 @@ int usage(std::string_view message) {
   return 2;
 }
 
+// The service's own (systemd/surroundd.service: RuntimeDirectory=surroundd).
+constexpr const char* kServiceSocket = "/run/surroundd/control.sock";
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::filesystem::path socket = daemon::defaultControlSocket();
-  if (socket.empty()) socket = "/run/surroundd/control.sock";
+  std::filesystem::path socket;
   int i = 1;
   if (i < argc && std::string_view(argv[i]) == "--socket") {
     if (i + 1 >= argc) return usage("--socket needs a path");
@@ -58,6 +64,12 @@ int main(int argc, char** argv) {
     fmt::print("{}", kUsage);
     return 0;
   }
+  if (i < argc && std::string_view(argv[i]) == "--version") {
+    fmt::print("{}", versionText("surroundctl"));
+    return 0;
+  }
+  if (socket.empty())
+    socket = daemon::controlSocketToAsk(daemon::defaultControlSocket(), kServiceSocket);
   if (i >= argc) return usage("no command");
   const std::string_view command = argv[i];
   std::string request(command);

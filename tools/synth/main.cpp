@@ -8,6 +8,7 @@ extern "C" {
 #include <libavutil/log.h>
 }
 
+#include "common/build_info.hpp"
 #include "tools/synth/calibration_session.hpp"
 #include "tools/synth/mat_scene_writer.hpp"
 #include "tools/synth/recording_writer.hpp"
@@ -18,6 +19,10 @@ int main(int argc, char** argv) {
   const std::vector<std::string_view> arguments(argv + 1, argv + argc);
   if (wantsHelp(arguments)) {
     std::cout << synthUsage();
+    return 0;
+  }
+  if (!arguments.empty() && arguments.front() == "--version") {
+    std::cout << surroundd::versionText("surround-synth");
     return 0;
   }
   av_log_set_level(AV_LOG_ERROR);  // x264's per-stream statistics would bury our one-line summary
