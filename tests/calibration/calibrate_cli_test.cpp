@@ -148,8 +148,8 @@ TEST(CalibrateCli, IntrinsicsWriteALensBlockTheRigAccepts) {
   const double fieldDeg = lens.maxFieldAngleRad * 360 / std::numbers::pi;
   EXPECT_GT(fieldDeg, 120);
   EXPECT_LT(fieldDeg, 185);
-  EXPECT_THAT(run.output, HasSubstr(fmt::format("limited to {:.1f} deg: the board's corners reached",
-                                                fieldDeg)));
+  EXPECT_THAT(run.output, HasSubstr(fmt::format(
+                              "limited to {:.1f} deg: the board's corners reached", fieldDeg)));
   EXPECT_FALSE(cv::imread((dir / "residuals.png").string()).empty());
   // --update-rig: the rig's camera has the new lens and keeps its mount, and the rig keeps every
   // other key.
@@ -313,6 +313,9 @@ TEST(CalibrateCli, GuideInABuildWithoutItsPageSaysHowToBuildIt) {
 
 TEST(CalibrateCli, UsageErrorsNameTheOption) {
   const TempDir dir;
+  const CalibrateRun version = calibrate(dir, {"--version"});  // issue 50
+  EXPECT_EQ(version.status, 0) << version.output;
+  EXPECT_THAT(version.output, AllOf(HasSubstr("surround-calibrate 0."), HasSubstr("built with: ")));
   expectFailure(calibrate(dir, {}), 2,
                 "surround-calibrate: missing the subcommand: intrinsics, guide, extrinsics, import "
                 "or mask (see --help)");
