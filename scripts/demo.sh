@@ -6,8 +6,12 @@ set -eu
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 cmake --preset release
+# With what `cmake --install build/release` installs besides them: the changelog, and the manual
+# pages where help2man made them (cmake/Manuals.cmake), so that installing after the demo works.
+manuals=""
+if command -v help2man >/dev/null 2>&1; then manuals=manuals; fi
 cmake --build --preset release --target surroundd surroundctl surround-synth surround-calibrate \
-  surround-bench
+  surround-bench changelog $manuals
 # recordings/demo is the demo's own: made again (--force) only when the generator or its arguments
 # changed since (a recording of the same key is kept, "up to date").
 build/release/tools/synth/surround-synth --rig config/rigs/paper.yaml --out recordings/demo --force
