@@ -164,7 +164,9 @@ std::string headerComment(const ImportOptions& options,
 ImportedRig importRig(const ImportOptions& options) {
   const SourceFrame frame{options.axes, options.unitM, options.groundZ, options.groundZByCamera};
   const auto inputs = readInputs(options);
-  for (const auto& [camera, z] : options.groundZByCamera) {
+  for (const auto& byCamera : options.groundZByCamera) {
+    // Named, not a structured binding: clang before 16 cannot capture one in a lambda.
+    const std::string& camera = byCamera.first;
     if (std::ranges::none_of(inputs,
                              [&](const auto& in) { return lower(in.sourceName) == camera; })) {
       throw UsageError(fmt::format("--ground-z: there is no camera '{}'", camera));
@@ -205,6 +207,7 @@ ImportedRig importRig(const ImportOptions& options) {
     cameras.push_back(std::move(camera));
   }
   std::vector<processing::Pose> poses;
+  poses.reserve(cameras.size());
   for (const auto& camera : cameras) poses.push_back(camera.calibration.pose);
   const cv::Vec3d shift =
       (options.originCentre ? -boundingBoxCentre(poses) : cv::Vec3d()) + options.offsetM;
