@@ -96,6 +96,9 @@ std::optional<Arguments> parseArguments(int argc, char** argv, bool& help) {
       flag = flag.substr(0, equals);
     }
     if (flag == "-c") flag = "--config";
+    if (attached && (flag == "--check-config" || flag == "--help" || flag == "--version")) {
+      return fail(fmt::format("'{}' takes no value", flag));
+    }
     if (!attached && i + 1 >= argc) return fail(fmt::format("'{}' needs a value", flag));
     const std::string_view value = attached ? *attached : std::string_view(argv[++i]);
     if (flag == "--config") {

@@ -33,6 +33,25 @@ constexpr const char* kMp4FragmentMicroseconds = "1000000";
 // A few seconds of a 1080p stream.
 constexpr std::uintmax_t kMinFreeBytes = std::uintmax_t{8} << 20;
 
+// The video packets a player reads from `file` before it ends or breaks off: 0 when it does not
+// open as a video at all (an MP4 cut before its first fragment's index).
+std::size_t framesIn(const std::filesystem::path& file) {
+  const ffmpeg::ExpectedFailures quiet;  // a file cut short is what is being measured
+  AVFormatContext* raw = nullptr;
+  if (avformat_open_input(&raw, file.c_str(), nullptr, nullptr) < 0) return 0;
+  const ffmpeg::InputFormatPtr input(raw);
+  if (avformat_find_stream_info(input.get(), nullptr) < 0) return 0;
+  const int video = av_find_best_stream(input.get(), AVMEDIA_TYPE_VIDEO, -1, -1, nullptr, 0);
+  if (video < 0) return 0;
+  const ffmpeg::PacketPtr packet(av_packet_alloc());
+  std::size_t frames = 0;
+  while (packet && av_read_frame(input.get(), packet.get()) >= 0) {
+    if (packet->stream_index == video && (packet->flags & AV_PKT_FLAG_CORRUPT) == 0) ++frames;
+    av_packet_unref(packet.get());
+  }
+  return frames;
+}
+
 bool takes(const AVCodec* encoder, AVPixelFormat format) {
   // An encoder that lists none (v4l2m2m) learns its device's formats only when it opens.
   if (encoder->pix_fmts == nullptr) return format == AV_PIX_FMT_YUV420P;
@@ -397,18 +416,25 @@ void VideoEncoder::Impl::drain(bool flushing) {
 
 std::string VideoEncoder::Impl::endFile() {
   format.reset();  // closes the file; what its buffer still held may not reach the disk
+  // What reached the disk, read back: packets the muxer took may still have been in its buffer,
+  // or in an MP4 fragment whose index was never written.
+  const std::size_t kept = packetsWritten == 0 ? 0 : framesIn(partPath);
   std::error_code error;
-  if (packetsWritten == 0) {
+  if (kept == 0) {
     std::filesystem::remove(partPath, error);
-    return "no file made";
+    return framesWritten == 0 ? "no file made"
+                              : fmt::format(
+                                    "none of the {} frames encoded reached the file; no "
+                                    "file kept",
+                                    framesWritten);
   }
   std::filesystem::rename(partPath, settings.path, error);
   if (error) {
-    return fmt::format("'{}' keeps what was written before, under that name ({})",
-                       partPath.string(), error.message());
+    return fmt::format("'{}' keeps the first {} of {} frames encoded, under that name ({})",
+                       partPath.string(), kept, framesWritten, error.message());
   }
-  return fmt::format("'{}' keeps what was written before ({} of {} frames encoded), playable",
-                     settings.path.string(), packetsWritten, framesWritten);
+  return fmt::format("'{}' keeps the first {} of {} frames encoded, playable",
+                     settings.path.string(), kept, framesWritten);
 }
 
 void VideoEncoder::Impl::handOver(const AVPacket& encoded) const {

@@ -102,6 +102,27 @@ TEST(RigTextEdit, AValueInsideAFlowEntryIsReplacedThere) {
   EXPECT_EQ(YAML::Load(edited)["cameras"][2]["lens"]["model"].as<std::string>(), "fisheye");
 }
 
+// From a review: the last camera's block value in a file with no newline at its end; a plain
+// scalar with an apostrophe and a comment inside a flow value.
+TEST(RigTextEdit, TheFilesEndAndApostrophesAreReadAsYamlReadsThem) {
+  const std::string lastBlock = "cameras:\n  - name: back\n    mount:\n      x_m: 1\n      y_m: 2";
+  const std::array<RigTextEdit, 1> edit{{{"back", kMount}}};
+  EXPECT_EQ(editRigText(lastBlock, "mount", edit, ""),
+            "cameras:\n  - name: back\n    mount:\n      " + kMount);
+  const std::string added =
+      editRigText("cameras:\n  - name: back\n    lens: {model: x}", "mount", edit, "");
+  EXPECT_EQ(added, "cameras:\n  - name: back\n    lens: {model: x}\n    mount: " + kMount);
+
+  const std::string quoted =
+      "cameras:\n  - name: front\n    lens: {maker: O'Neil, model: pinhole,  # it's ours\n"
+      "           note: 'a, b'}\n    mount: {x_m: 0}\n";
+  const std::array<RigTextEdit, 1> lens{{{"front", "{model: fisheye}"}}};
+  const std::string relensed = editRigText(quoted, "lens", lens, "");
+  EXPECT_EQ(relensed,
+            "cameras:\n  - name: front\n    lens: {model: fisheye}\n    mount: {x_m: 0}\n");
+  EXPECT_EQ(YAML::Load(relensed)["cameras"][0]["mount"]["x_m"].as<double>(), 0);
+}
+
 TEST(RigTextEdit, WhatCannotBeEditedInPlaceIsNamed) {
   const std::array<RigTextEdit, 1> edit{{{"top", kMount}}};
   EXPECT_THAT([&] { editRigText(std::string(kRig), "mount", edit, ""); },

@@ -12,10 +12,13 @@
 namespace surroundd::calibrate {
 namespace {
 
-// Just past the flow collection ('{' or '[') that starts at `begin`, its quoted strings skipped.
+// Just past the flow collection ('{' or '[') that starts at `begin`. Quoted strings are skipped
+// where a scalar can start (after a bracket, a comma, a colon or a blank: "O'Neil" is plain), and
+// so are comments (a '#' after a blank, to the end of its line).
 std::size_t flowEnd(const std::string& text, std::size_t begin) {
   int depth = 0;
   char quote = 0;
+  char before = ' ';  // the character before the one read, outside quotes
   for (std::size_t i = begin; i < text.size(); ++i) {
     const char c = text[i];
     if (quote != 0) {
@@ -23,14 +26,24 @@ std::size_t flowEnd(const std::string& text, std::size_t begin) {
         ++i;
       } else if (c == quote) {
         quote = 0;
+        before = c;
       }
-    } else if (c == '"' || c == '\'') {
+      continue;
+    }
+    const bool scalarStart = before == '{' || before == '[' || before == ',' || before == ':' ||
+                             before == ' ' || before == '\t' || before == '\n';
+    if ((c == '"' || c == '\'') && scalarStart) {
       quote = c;
+    } else if (c == '#' && (before == ' ' || before == '\t' || before == '\n')) {
+      i = std::min(text.find('\n', i), text.size()) - 1;
+      before = '\n';
+      continue;
     } else if (c == '{' || c == '[') {
       ++depth;
     } else if ((c == '}' || c == ']') && --depth == 0) {
       return i + 1;
     }
+    before = c;
   }
   throw std::invalid_argument("a flow collection that does not end");
 }
@@ -39,7 +52,10 @@ std::size_t flowEnd(const std::string& text, std::size_t begin) {
 // line before `next` that holds more than blanks or a comment (that line's comments are the
 // value's; the lines between belong to what follows).
 std::size_t blockEnd(const std::string& text, std::size_t begin, std::size_t next) {
-  std::size_t end = text.rfind('\n', next > 0 ? next - 1 : 0);
+  // The end of the text ends a line too, when the file has no newline at its end.
+  std::size_t end = next == text.size() && !text.ends_with('\n')
+                        ? text.size()
+                        : text.rfind('\n', next > 0 ? next - 1 : 0);
   if (end == std::string::npos || end < begin) return next;
   while (end > begin) {
     const std::size_t lineStart = text.rfind('\n', end - 1);

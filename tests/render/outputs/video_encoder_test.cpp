@@ -3,6 +3,7 @@
 
 #include "render/outputs/video_encoder.hpp"
 
+#include <regex>
 #include <thread>
 
 #include <gmock/gmock.h>
@@ -384,16 +385,20 @@ TEST(VideoEncoder, AFullDiskKeepsWhatWasWrittenPlayable) {
         error = e.what();
       }
     }
-    EXPECT_THAT(error, AllOf(HasSubstr("cannot write to the file: No space left on device"),
-                             HasSubstr((disk / name).string() + "' keeps what was written before"),
-                             HasSubstr("playable")))
-        << name;
+    std::smatch kept;
+    ASSERT_TRUE(std::regex_search(
+        error, kept,
+        std::regex("cannot write to the file: No space left on device; '(.*)' keeps the first "
+                   "([0-9]+) of ([0-9]+) frames encoded, playable")))
+        << error;
+    EXPECT_EQ(kept[1].str(), (disk / name).string());
     EXPECT_NO_THROW(encoder.close());  // ended already
     EXPECT_FALSE(std::filesystem::exists(disk / (name + ".part"))) << name;
     const auto decoded = testing::decodeAll(disk / name);
-    // At least the first fragment (a second's 30 frames), each at its own time.
+    // At least the first fragment (a second's 30 frames), each at its own time; as many as said.
     EXPECT_GE(decoded.images.size(), 30u) << name;
     EXPECT_LT(decoded.images.size(), static_cast<std::size_t>(sent)) << name;
+    EXPECT_NEAR(static_cast<double>(decoded.images.size()), std::stod(kept[2].str()), 1) << name;
     for (std::size_t i = 0; i < decoded.timestamps.size(); ++i) {
       EXPECT_NEAR(
           std::chrono::duration<double>(decoded.timestamps[i] - timestampOf(static_cast<int>(i)))
@@ -413,6 +418,40 @@ TEST(VideoEncoder, AFullDiskKeepsWhatWasWrittenPlayable) {
     disk.empty();
     writeVideo(next, 5);
     EXPECT_EQ(testing::decodeAll(next.path).images.size(), 5u);
+  }
+}
+
+// From a review: a full disk early in an MP4, at a rate where its first fragments are large. What
+// the error says is kept is what plays: the frames a player reads back, or no file at all where
+// none reached it (an MP4 without its index plays nothing, and is not left under the name).
+TEST(VideoEncoder, AFullDiskEarlyInAnMp4KeepsWhatPlaysAndSaysHowMuch) {
+  testing::SmallDisk disk(std::uintmax_t{24} << 20);
+  if (!disk.problem().empty()) GTEST_SKIP() << disk.problem();
+  disk.fill(std::uintmax_t{9} << 20);
+  auto settings = settingsFor(disk / "early.mp4");
+  settings.size = {640, 480};  // noise, losslessly: about a megabyte a frame
+  settings.crf = 0;
+  VideoEncoder encoder(settings);
+  std::string error;
+  for (int sent = 0; sent < 200 && error.empty(); ++sent) {
+    cv::Mat noise(settings.size, CV_8UC3);
+    cv::randu(noise, 0, 256);
+    try {
+      encoder.write(noise, timestampOf(sent));
+    } catch (const EncoderError& e) {
+      error = e.what();
+    }
+  }
+  EXPECT_FALSE(std::filesystem::exists(disk / "early.mp4.part"));
+  std::smatch kept;
+  if (std::regex_search(error, kept,
+                        std::regex("keeps the first ([0-9]+) of ([0-9]+) frames encoded"))) {
+    EXPECT_NEAR(static_cast<double>(testing::decodeAll(disk / "early.mp4").images.size()),
+                std::stod(kept[1].str()), 1);
+    EXPECT_LT(std::stoi(kept[1].str()), std::stoi(kept[2].str()));
+  } else {
+    EXPECT_THAT(error, HasSubstr("frames encoded reached the file; no file kept"));
+    EXPECT_FALSE(std::filesystem::exists(disk / "early.mp4"));
   }
 }
 
