@@ -5,6 +5,9 @@
 # `asan` preset; what is left out says why below), and the threaded parts (the work pool, capture,
 # the pipeline, its outputs' queues and servers, the control server, the service) built with
 # ThreadSanitizer (the `tsan` preset).
+# --fuzz-seeds: then also builds every libFuzzer target (the `fuzz` preset: clang, ASan + UBSan)
+# and runs each once over its seeds (scripts/fuzz.sh seeds): fuzz targets are built nowhere else,
+# and one had stopped compiling unseen.
 # --minimal: then also builds the `minimal` preset (every optional part left out: X11, DRM, HTTP,
 # RTSP, libcamera) and runs the tests that apply to it and may differ there; those of left-out parts
 # are not run (configure lists them).
@@ -13,11 +16,13 @@ set -eu
 cd "$(dirname "$0")/.."
 sanitizers=no
 minimal=no
+fuzzSeeds=no
 for argument in "$@"; do
   case "$argument" in
     --sanitizers) sanitizers=yes ;;
     --minimal) minimal=yes ;;
-    *) echo "usage: scripts/test.sh [--sanitizers] [--minimal]" >&2; exit 2 ;;
+    --fuzz-seeds) fuzzSeeds=yes ;;
+    *) echo "usage: scripts/test.sh [--sanitizers] [--minimal] [--fuzz-seeds]" >&2; exit 2 ;;
   esac
 done
 
@@ -40,7 +45,11 @@ end() { timings="$timings
 begin "dependencies"
 # With what runs the tests that need a KMS screen, V4L2 cameras or a CAN bus on a virtual
 # machine that has them, and Debian's kernel for it.
-scripts/install-deps.sh --device-vm
+if [ "$fuzzSeeds" = yes ]; then
+  scripts/install-deps.sh --device-vm --fuzz
+else
+  scripts/install-deps.sh --device-vm
+fi
 scripts/device-vm.sh fetch || echo "test: no kernel for the device machine: its tests will say so"
 end "dependencies"
 begin "ci build"
@@ -137,6 +146,12 @@ if [ "$minimal" = yes ]; then
   # processing, rendering, the generator, the calibration library).
   ctest --preset minimal -j2 --label-exclude packaging
   end "minimal suite"
+fi
+
+if [ "$fuzzSeeds" = yes ]; then
+  begin "fuzz build and seeds"
+  scripts/fuzz.sh seeds
+  end "fuzz build and seeds"
 fi
 
 echo "test: phase times:$timings"

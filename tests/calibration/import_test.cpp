@@ -624,6 +624,12 @@ TEST(Import, FilesMadeToBreakTheReadersAreRefusedNamingTheFile) {
                     "%YAML:1.0\nK: [300, 0, 320, 0, 300, 240, 0, 0, 1]\n"
                     "image_size: [1e300, 480]\n"),
           ": image_size: expected an image size of 1 to 65536 pixels a side");
+  // A matrix header that asks OpenCV for 17 GB (found by import_fuzz): read as no matrix.
+  refused(dir.write("header.yml",
+                    "%YAML:1.0\n---\ncamera_matrix: !!opencv-matrix\n   rows: "
+                    "65536\n   cols: 65536\n   dt: d\n   data: [ 1., 2. ]\n"),
+          ": camera_matrix: expected a 3x3 camera matrix or [fx, fy, cx, cy], got something that "
+          "is not a matrix");
   EXPECT_FALSE(std::filesystem::exists(dir / "rig.yaml"));
 }
 

@@ -31,7 +31,7 @@ surroundd::render::HttpStreamSink& sink() {
     settings.allowedHosts = {"surround.local"};
     auto made = std::make_unique<surroundd::render::HttpStreamSink>(settings);
     // A picture, so that /snapshot.jpg and /stream.mjpg answer with one.
-    made->consume(cv::Mat(48, 64, CV_8UC3, cv::Scalar(40, 90, 200)), {});
+    made->consume(cv::Mat(48, 64, CV_8UC3, cv::Scalar(40, 90, 200)), std::chrono::nanoseconds(0));
     return made;
   }();
   return *instance;

@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
     const auto sub = folder / name;
     const PanoramaLutCache cache(sub);
     cache.store("fuzz", *lut);
-    if (!cache.load("fuzz").lut) {
+    if (!cache.load("fuzz", lut->size).lut) {
       std::fprintf(stderr, "lut_seed: the %s LUT does not load back\n", name);
       return 1;
     }

@@ -21,6 +21,7 @@ using Keys = std::initializer_list<const char*>;
 constexpr std::size_t kMaxCalibrationFileBytes = std::size_t{16} << 20;
 constexpr std::size_t kMaxCalibrationDepth = 64;
 constexpr double kMaxImageSide = 65536;
+constexpr int kMaxMatrixSide = 16;  // rows or columns of a matrix in a calibration file
 
 constexpr Keys kCameraMatrixKeys{"camera_matrix", "cameraMatrix", "K", "cam_K", "intrinsic_matrix"};
 constexpr Keys kDistortionKeys{"dist_coeffs", "distCoeffs", "distortion_coefficients",
@@ -122,6 +123,17 @@ cv::Matx33d rotationOf(const cv::Mat& matrix, const std::string& origin) {
 std::optional<cv::Mat> matrixFromNode(const cv::FileNode& node) {
   if (node.isMap()) {
     if (!node["dt"].empty()) {  // opencv-matrix
+      // OpenCV allocates what the header says before it reads the data: a damaged header asked
+      // for 17 GB (found by import_fuzz). A calibration's matrices are a few numbers.
+      const cv::FileNode rows = node["rows"], cols = node["cols"], data = node["data"];
+      const auto side = [](const cv::FileNode& n) {
+        return n.isInt() && static_cast<int>(n) >= 1 && static_cast<int>(n) <= kMaxMatrixSide;
+      };
+      if (!side(rows) || !side(cols) || !data.isSeq() ||
+          data.size() !=
+              static_cast<std::size_t>(static_cast<int>(rows) * static_cast<int>(cols))) {
+        return std::nullopt;
+      }
       cv::Mat matrix;
       try {
         node >> matrix;
