@@ -633,5 +633,25 @@ TEST(Import, FilesMadeToBreakTheReadersAreRefusedNamingTheFile) {
   EXPECT_FALSE(std::filesystem::exists(dir / "rig.yaml"));
 }
 
+// Found by import_fuzz: a pjlab calibration.yaml whose document, or one camera's entry, is no map
+// ended the program with yaml-cpp's own exception; NaN, or an image of 1e300 pixels, went on.
+TEST(Import, APjlabYamlOfTheWrongShapeIsRefusedNamingTheFile) {
+  const TempDir dir;
+  const auto refused = [&](const std::string& text, const std::string& why) {
+    const auto file = dir.write("calibration.yaml", text);
+    EXPECT_THAT(importError({"--pjlab-yaml", file.string(), "--out", (dir / "rig.yaml").string()}),
+                AllOf(HasSubstr(file.string()), HasSubstr(why)))
+        << text;
+  };
+  refused("just a scalar\n", "expected a map of image_size and cameras");
+  refused("[1, 2]\n", "expected a map of image_size and cameras");
+  refused("image_size: [1e300, 100]\ncameras: {front: {}}\n", "image_size: expected 1 to 65536");
+  refused("image_size: [640, 480]\ncameras: {front: 3}\n",
+          "cameras: expected each camera's name, then a map");
+  refused("image_size: [640, 480]\ncameras: {front: {K: [.nan, 1, 2, 3]}}\n",
+          "cameras.front.K: expected 4 finite numbers");
+  EXPECT_FALSE(std::filesystem::exists(dir / "rig.yaml"));
+}
+
 }  // namespace
 }  // namespace surroundd::calibrate

@@ -1,6 +1,7 @@
 #include "tools/calibrate/pjlab_layout.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
@@ -10,6 +11,8 @@
 
 namespace surroundd::calibrate {
 namespace {
+
+constexpr double kMaxImageSide = 65536;
 
 std::vector<double> numbers(const YAML::Node& node, std::size_t count, const std::string& where) {
   std::vector<double> values;
@@ -29,6 +32,10 @@ std::vector<double> numbers(const YAML::Node& node, std::size_t count, const std
   if (values.size() != count) {
     throw UsageError(fmt::format("{}: expected a list of {} numbers{}", where, count,
                                  node ? "" : " (the key is missing)"));
+  }
+  if (!std::ranges::all_of(values, [](double v) { return std::isfinite(v); })) {
+    throw UsageError(
+        fmt::format("{}: expected {} finite numbers (no NaN or infinity)", where, count));
   }
   return values;
 }
@@ -71,7 +78,16 @@ std::vector<NamedCalibration> readPjlabYaml(const std::filesystem::path& file,
   } catch (const daemon::ConfigError& error) {
     throw UsageError(error.messages().front());
   }
+  // Each node's kind is checked before it is indexed: yaml-cpp throws its own error (found by
+  // import_fuzz: a document that is a scalar ended the program).
+  if (!root.IsMap()) {
+    throw UsageError(fmt::format("{}: expected a map of image_size and cameras", file.string()));
+  }
   const auto size = numbers(root["image_size"], 2, file.string() + ": image_size");
+  if (!(size[0] >= 1 && size[0] <= kMaxImageSide && size[1] >= 1 && size[1] <= kMaxImageSide)) {
+    throw UsageError(fmt::format("{}: image_size: expected 1 to {} pixels a side", file.string(),
+                                 kMaxImageSide));
+  }
   if (!root["cameras"].IsMap() || root["cameras"].size() == 0) {
     throw UsageError(
         fmt::format("{}: cameras: expected a map of camera names to K, D and "
@@ -81,7 +97,13 @@ std::vector<NamedCalibration> readPjlabYaml(const std::filesystem::path& file,
   std::vector<NamedCalibration> cameras;
   for (const auto& entry : root["cameras"]) {
     NamedCalibration camera;
-    camera.sourceName = entry.first.as<std::string>();
+    if (!entry.first.IsScalar() || !entry.second.IsMap()) {
+      throw UsageError(
+          fmt::format("{}: cameras: expected each camera's name, then a map of K, D "
+                      "and T_cam_from_G",
+                      file.string()));
+    }
+    camera.sourceName = entry.first.Scalar();
     const auto& node = entry.second;
     const auto where = fmt::format("{}: cameras.{}.", file.string(), camera.sourceName);
     auto& c = camera.calibration;
