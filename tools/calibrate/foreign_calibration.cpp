@@ -137,7 +137,7 @@ std::optional<cv::Mat> matrixFromNode(const cv::FileNode& node) {
       cv::Mat matrix;
       try {
         node >> matrix;
-      } catch (const cv::Exception&) {
+      } catch (const std::exception&) {  // cv::Exception, and what OpenCV lets through
         return std::nullopt;
       }
       if (matrix.empty() || matrix.channels() != 1) return std::nullopt;
@@ -204,6 +204,11 @@ void readOpenCvCalibration(const std::filesystem::path& file, PoseDirection dire
   } catch (const cv::Exception& error) {
     throw UsageError(fmt::format("{}: not an OpenCV FileStorage file (YAML, JSON or XML): {}",
                                  file.string(), error.err));
+  } catch (const std::exception& error) {
+    // OpenCV's parsers also let the standard library's own through (std::length_error from a
+    // damaged YAML file: found by import_fuzz).
+    throw UsageError(fmt::format("{}: not an OpenCV FileStorage file (YAML, JSON or XML): {}",
+                                 file.string(), error.what()));
   }
   if (!storage.isOpened()) {
     throw UsageError(
