@@ -624,15 +624,18 @@ TEST(Import, FilesMadeToBreakTheReadersAreRefusedNamingTheFile) {
                     "%YAML:1.0\nK: [300, 0, 320, 0, 300, 240, 0, 0, 1]\n"
                     "image_size: [1e300, 480]\n"),
           ": image_size: expected an image size of 1 to 65536 pixels a side");
-  // A damaged YAML file on which OpenCV's parser throws std::length_error, not its own exception
-  // (found by import_fuzz; NULs and all).
+  // Damaged files that import_fuzz found: a YAML file on which OpenCV's parser threw
+  // std::length_error, not its own exception, and an XML one on which it crashed (SIGSEGV). Both
+  // hold control characters, which no calibration (text) has: refused before OpenCV reads them.
   constexpr char kDamaged[] =
       "%YAML:1.0\n---\ni\xa6"
       "matrix: !!onecpv-matrix\n  . ]\ndistortion_coefficients: !!opencv-matrix\n   rows: 1\n"
       "   dt: d\n \n   : !!opencv-matrix\n   rows: 1\n   dt: d\n \n   dt: d\n   data: [ 0., "
       "1., 2.h\x02\x00\x00 ]\n";
   refused(dir.write("damaged.yml", std::string_view(kDamaged, sizeof kDamaged - 1)),
-          "not an OpenCV FileStorage file (YAML, JSON or XML)");
+          "holds a control character (byte 2 at offset");
+  refused(dir.write("nul.xml", std::string_view("<?xml version=\0\x01<image{{", 25)),
+          "holds a control character (byte 0 at offset 14): not a text file");
   // A matrix header that asks OpenCV for 17 GB (found by import_fuzz): read as no matrix.
   refused(dir.write("header.yml",
                     "%YAML:1.0\n---\ncamera_matrix: !!opencv-matrix\n   rows: "

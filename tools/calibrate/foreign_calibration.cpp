@@ -1,5 +1,6 @@
 #include "tools/calibrate/foreign_calibration.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <initializer_list>
@@ -178,6 +179,20 @@ void refuseWhatOpenCvCannotReadSafely(const std::filesystem::path& file) {
   if (const std::size_t depth = nestingDepth(text); depth > kMaxCalibrationDepth) {
     throw UsageError(fmt::format("{}: nests {} levels deep; a calibration file needs at most {}",
                                  file.string(), depth, kMaxCalibrationDepth));
+  }
+  // A calibration is text: control characters (a NUL, say) are no part of one, and OpenCV's XML
+  // parser crashed on a file with some (found by import_fuzz).
+  if (const auto control = std::ranges::find_if(
+          text,
+          [](unsigned char c) {
+            return (c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f;
+          });
+      control != text.end()) {
+    throw UsageError(
+        fmt::format("{}: holds a control character (byte {} at offset {}): not a text "
+                    "file",
+                    file.string(), static_cast<int>(static_cast<unsigned char>(*control)),
+                    control - text.begin()));
   }
   if (text.find("!!binary") != std::string::npos || text.find("$base64$") != std::string::npos) {
     throw UsageError(fmt::format(
