@@ -657,7 +657,8 @@ TEST(Import, APjlabYamlOfTheWrongShapeIsRefusedNamingTheFile) {
   };
   refused("just a scalar\n", "expected a map of image_size and cameras");
   refused("[1, 2]\n", "expected a map of image_size and cameras");
-  refused("image_size: [1e300, 100]\ncameras: {front: {}}\n", "image_size: expected 1 to 65536");
+  refused("image_size: [1e300, 100]\ncameras: {front: {}}\n",
+          "image_size: expected an image size of 1 to 65536 pixels a side");
   refused("image_size: [640, 480]\ncameras: {front: 3}\n",
           "cameras: expected each camera's name, then a map");
   refused("image_size: [640, 480]\ncameras: {front: {K: [.nan, 1, 2, 3]}}\n",

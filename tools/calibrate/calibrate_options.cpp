@@ -242,4 +242,13 @@ std::string usage() {
       kImportUsage, kMaskUsage);
 }
 
+cv::Size imageSizeFrom(double width, double height, std::string_view where) {
+  constexpr double kMaxSide = 65536;
+  if (!(width >= 1 && width <= kMaxSide && height >= 1 && height <= kMaxSide)) {
+    throw UsageError(fmt::format("{}: expected an image size of 1 to {} pixels a side, got {} x {}",
+                                 where, kMaxSide, width, height));
+  }
+  return {static_cast<int>(width), static_cast<int>(height)};
+}
+
 }  // namespace surroundd::calibrate

@@ -60,6 +60,10 @@ struct HelpRequest {
 using Command = std::variant<IntrinsicsOptions, GuideOptions, MatGuideOptions, ExtrinsicsOptions,
                              ImportOptions, MaskOptions, HelpRequest>;
 
+// An image size read from a calibration file: each side 1 to 65536 pixels, checked before the
+// cast (1e300 pixels fits no int); UsageError naming `where` otherwise.
+cv::Size imageSizeFrom(double width, double height, std::string_view where);
+
 // `arguments` excludes the program name. Throws UsageError.
 Command parseArguments(std::span<const std::string_view> arguments);
 std::string usage();

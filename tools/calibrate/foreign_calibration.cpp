@@ -21,7 +21,6 @@ using Keys = std::initializer_list<const char*>;
 // docs/robustness.md: an imported calibration file of at most 16 MiB, nested at most 64 levels.
 constexpr std::size_t kMaxCalibrationFileBytes = std::size_t{16} << 20;
 constexpr std::size_t kMaxCalibrationDepth = 64;
-constexpr double kMaxImageSide = 65536;
 constexpr int kMaxMatrixSide = 16;  // rows or columns of a matrix in a calibration file
 
 constexpr Keys kCameraMatrixKeys{"camera_matrix", "cameraMatrix", "K", "cam_K", "intrinsic_matrix"};
@@ -267,17 +266,8 @@ void readOpenCvCalibration(const std::filesystem::path& file, PoseDirection dire
     }
     if (const auto size = findKey(root, {"image_size", "imageSize"}, 2); !into.imageSize && size) {
       const auto m = requireMatrix(file, *size, {2}, "an image size: width and height");
-      const double width = m.value.at<double>(0);
-      const double height = m.value.at<double>(1);
-      // Checked before the cast: a size of 1e300 pixels does not fit an int.
-      if (!(width >= 1 && width <= kMaxImageSide && height >= 1 && height <= kMaxImageSide)) {
-        throw UsageError(
-            fmt::format("{}: expected an image size of 1 to {} pixels a side, got "
-                        "{} x {}",
-                        m.origin, kMaxImageSide, width, height));
-      }
-      into.imageSize =
-          Found<cv::Size>{{static_cast<int>(width), static_cast<int>(height)}, m.origin};
+      into.imageSize = Found<cv::Size>{
+          imageSizeFrom(m.value.at<double>(0), m.value.at<double>(1), m.origin), m.origin};
     }
   }
   if (!into.pose && !into.homography) {

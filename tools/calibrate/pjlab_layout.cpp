@@ -12,8 +12,6 @@
 namespace surroundd::calibrate {
 namespace {
 
-constexpr double kMaxImageSide = 65536;
-
 std::vector<double> numbers(const YAML::Node& node, std::size_t count, const std::string& where) {
   std::vector<double> values;
   try {
@@ -84,10 +82,7 @@ std::vector<NamedCalibration> readPjlabYaml(const std::filesystem::path& file,
     throw UsageError(fmt::format("{}: expected a map of image_size and cameras", file.string()));
   }
   const auto size = numbers(root["image_size"], 2, file.string() + ": image_size");
-  if (!(size[0] >= 1 && size[0] <= kMaxImageSide && size[1] >= 1 && size[1] <= kMaxImageSide)) {
-    throw UsageError(fmt::format("{}: image_size: expected 1 to {} pixels a side", file.string(),
-                                 kMaxImageSide));
-  }
+  const cv::Size imageSize = imageSizeFrom(size[0], size[1], file.string() + ": image_size");
   if (!root["cameras"].IsMap() || root["cameras"].size() == 0) {
     throw UsageError(
         fmt::format("{}: cameras: expected a map of camera names to K, D and "
@@ -112,8 +107,7 @@ std::vector<NamedCalibration> readPjlabYaml(const std::filesystem::path& file,
     c.cameraMatrix = Found<cv::Mat>{cv::Mat(k, true).reshape(1, 1), where + "K"};
     const auto d = numbers(node["D"], 4, where + "D");
     c.distortion = Found<std::vector<double>>{d, where + "D"};
-    c.imageSize = Found<cv::Size>{{static_cast<int>(size[0]), static_cast<int>(size[1])},
-                                  file.string() + ": image_size"};
+    c.imageSize = Found<cv::Size>{imageSize, file.string() + ": image_size"};
     const auto t = numbers(node["T_cam_from_G"], 16, where + "T_cam_from_G");
     const cv::Matx33d rotation(t[0], t[1], t[2], t[4], t[5], t[6], t[8], t[9], t[10]);
     c.pose = Found<CameraFromSource>{cameraFromSource(rotation, {t[3], t[7], t[11]}, direction),
