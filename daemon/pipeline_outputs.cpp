@@ -76,7 +76,7 @@ void PipelineOutputs::deliver(PictureOutput& output, std::chrono::nanoseconds st
     if (drawn) timeSwitch(output, *drawn, now);
     if (output.onTrialSince && now - *output.onTrialSince >= kOutputTrial) {
       output.onTrialSince.reset();
-      spdlog::info("output {} works again", output.sink->describe());
+      spdlog::info("output {} works again", output.openedAs);
     }
   });
 }
@@ -159,8 +159,9 @@ void PipelineOutputs::retry(Clock::time_point now) {
     try {
       open(output);
       output.onTrialSince = now;
+      output.openedAs = output.sink->describe();
       spdlog::info("output {} opened again: it works again once it has taken pictures for {} s",
-                   output.sink->describe(), kOutputTrial.count());
+                   output.openedAs, kOutputTrial.count());
     } catch (const std::exception& e) {
       output.retryDelay = std::min(2 * output.retryDelay, kLastOutputRetry);
       output.nextRetry = now + output.retryDelay;

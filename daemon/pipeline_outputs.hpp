@@ -51,6 +51,9 @@ class PipelineOutputs {
     Clock::time_point nextRetry{};               // when failed: when it is opened again
     std::chrono::seconds retryDelay{0};
     std::optional<Clock::time_point> onTrialSince;  // opened again, not yet working again
+    // What the sink said it was when opened again: once it takes pictures, a queued sink's
+    // describe() belongs to its worker, so the "works again" line names it by this.
+    std::string openedAs;
     std::chrono::nanoseconds pendingTime{0};        // stream time of the view's pending picture
     Clock::time_point pendingOrigin{};              // capture time of the pending picture's set
     cv::Mat latest;                                 // header over the picture last handed over, BGR
