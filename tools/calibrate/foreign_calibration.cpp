@@ -31,6 +31,8 @@ constexpr Keys kTransformKeys{"T", "sensor_calib", "T_cam_from_G", "extrinsic", 
 constexpr Keys kRotationKeys{"R", "rotation", "rotation_matrix", "rvec", "rotation_vector"};
 constexpr Keys kTranslationKeys{"t", "tvec", "translation", "translation_vector", "T"};
 constexpr Keys kHomographyKeys{"H", "homography"};
+// A homography the other way: from the undistorted image to the canvas.
+constexpr Keys kProjectionKeys{"project_matrix"};
 
 // The first of `keys` in `node` or, failing that, in its nested maps (depth first): tools wrap
 // their matrices in maps of their own ("front_camera-intrinsic": {param: {cam_K: ...}}).
@@ -99,13 +101,20 @@ Found<cv::Mat> requireMatrix(const std::filesystem::path& file,
   return {matrix->total() == 9 ? matrix->reshape(1, 3) : *matrix, origin};
 }
 
+// A 3x3 matrix of a file (as requireMatrix shaped it).
+cv::Matx33d matx33(const cv::Mat& matrix) {
+  cv::Matx33d m;
+  for (int i = 0; i < 9; ++i) m.val[i] = matrix.at<double>(i / 3, i % 3);
+  return m;
+}
+
 cv::Matx33d rotationOf(const cv::Mat& matrix, const std::string& origin) {
   cv::Matx33d rotation;
   if (matrix.total() == 3) {
     cv::Rodrigues(matrix.reshape(1, 3), rotation);
     return rotation;
   }
-  for (int i = 0; i < 9; ++i) rotation.val[i] = matrix.at<double>(i / 3, i % 3);
+  rotation = matx33(matrix);
   // Files round their matrices; the nearest rotation keeps the angles honest. Far from one, the
   // key holds something else.
   cv::Mat w, u, vt;
@@ -264,7 +273,8 @@ void readOpenCvCalibration(const std::filesystem::path& file, PoseDirection dire
         break;
       }
     }
-    if (const auto size = findKey(root, {"image_size", "imageSize"}, 2); !into.imageSize && size) {
+    if (const auto size = findKey(root, {"image_size", "imageSize", "resolution"}, 2);
+        !into.imageSize && size) {
       const auto m = requireMatrix(file, *size, {2}, "an image size: width and height");
       into.imageSize = Found<cv::Size>{
           imageSizeFrom(m.value.at<double>(0), m.value.at<double>(1), m.origin), m.origin};
@@ -303,10 +313,33 @@ void readOpenCvCalibration(const std::filesystem::path& file, PoseDirection dire
           rotation.origin + " and " + tKey->second};
     } else if (const auto h = findKey(root, kHomographyKeys)) {
       const auto m = requireMatrix(file, *h, {9}, "a 3x3 homography");
-      cv::Matx33d homography;
-      for (int i = 0; i < 9; ++i) homography.val[i] = m.value.at<double>(i / 3, i % 3);
-      into.homography = Found<cv::Matx33d>{homography, m.origin};
+      into.homography = Found<cv::Matx33d>{matx33(m.value), m.origin};
+    } else if (const auto p = findKey(root, kProjectionKeys)) {
+      const auto m = requireMatrix(file, *p, {9}, "a 3x3 homography");
+      const cv::Matx33d projection = matx33(m.value);
+      if (std::abs(cv::determinant(projection)) < 1e-12 * std::pow(cv::norm(projection), 3)) {
+        throw UsageError(fmt::format("{}: the homography cannot be inverted", m.origin));
+      }
+      into.homography =
+          Found<cv::Matx33d>{projection.inv(), m.origin +
+                                                   " (inverted: it maps the picture to "
+                                                   "the canvas)"};
     }
+  }
+  const auto pair = [&](const char* key, auto& found) {
+    if (found) return;
+    if (const auto k = findKey(root, {key})) {
+      const auto m = requireMatrix(file, *k, {2}, "two numbers, for x and y");
+      found = Found<cv::Vec2d>{{m.value.at<double>(0), m.value.at<double>(1)}, m.origin};
+    }
+  };
+  pair("scale_xy", into.undistortedScale);
+  pair("shift_xy", into.undistortedShift);
+  if (into.undistortedScale &&
+      (into.undistortedScale->value[0] <= 0 || into.undistortedScale->value[1] <= 0)) {
+    throw UsageError(fmt::format("{}: expected two scales above 0, got {}, {}",
+                                 into.undistortedScale->origin, into.undistortedScale->value[0],
+                                 into.undistortedScale->value[1]));
   }
 }
 

@@ -30,7 +30,12 @@ struct ForeignCalibration {
   std::optional<Found<processing::Intrinsics>> lens;  // complete (calib_results.txt)
   std::optional<Found<CameraFromSource>> pose;
   std::optional<Found<cv::Matx33d>> homography;  // ground canvas -> undistorted image
-  std::vector<std::filesystem::path> files;      // what was read, for the rig's header
+  // The undistorted image's camera matrix, where it is not K: K' = K with fx, fy scaled by
+  // `scale_xy` and cx, cy shifted by `shift_xy` (the files of surround-view-system-introduction,
+  // whose bird's-eye tool undistorts through K').
+  std::optional<Found<cv::Vec2d>> undistortedScale;
+  std::optional<Found<cv::Vec2d>> undistortedShift;
+  std::vector<std::filesystem::path> files;  // what was read, for the rig's header
 };
 
 // Adds what an OpenCV FileStorage file (YAML, JSON or XML) holds to `into`, keeping parts already

@@ -7,10 +7,12 @@
 #include <string_view>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "tools/calibrate/calibrate_options.hpp"
 #include "tools/calibrate/camera_pictures.hpp"
+#include "tools/calibrate/canvas_strips.hpp"
 #include "tools/calibrate/foreign_lens.hpp"
 #include "tools/calibrate/ground_homography.hpp"
 #include "tools/calibrate/ocam_results.hpp"
@@ -56,6 +58,36 @@ std::vector<NamedCalibration> readInputs(const ImportOptions& options) {
 constexpr double kPoorFitPx = 2;
 constexpr double kPoorFitM = 0.05;
 
+// The camera matrix of the undistorted picture the homography maps to.
+cv::Matx33d undistortedCamera(const ForeignCalibration& found, const processing::Intrinsics& lens) {
+  const cv::Vec2d scale = found.undistortedScale ? found.undistortedScale->value : cv::Vec2d(1, 1);
+  const cv::Vec2d shift = found.undistortedShift ? found.undistortedShift->value : cv::Vec2d(0, 0);
+  return {lens.fx * scale[0],
+          0,
+          lens.cx + shift[0],
+          0,
+          lens.fy * scale[1],
+          lens.cy + shift[1],
+          0,
+          0,
+          1};
+}
+
+// The homography from the whole canvas to the undistorted picture: with --canvas-strips, through
+// the camera's strip.
+cv::Matx33d canvasToPicture(const std::string& camera, const ForeignCalibration& found,
+                            const ImportOptions& options) {
+  if (!options.canvasStrips) return found.homography->value;
+  const auto side = sideInName(camera);
+  if (!side) {
+    throw UsageError(fmt::format(
+        "--canvas-strips: camera '{}' has no side in its name (front, back, left or right), "
+        "so its strip of the canvas is not known",
+        camera));
+  }
+  return found.homography->value * stripFromCanvas(*side, *options.canvasStrips);
+}
+
 processing::Pose poseOf(const std::string& camera, const ForeignCalibration& found,
                         const processing::Intrinsics& lens, const ImportOptions& options,
                         const SourceFrame& frame, std::vector<std::string>& notes) {
@@ -85,11 +117,11 @@ processing::Pose poseOf(const std::string& camera, const ForeignCalibration& fou
         "(--axes {})",
         origin, options.axesText));
   }
-  const cv::Matx33d k(lens.fx, 0, lens.cx, 0, lens.fy, lens.cy, 0, 0, 1);
   const GroundCanvas canvas{*options.canvasScale, options.canvasOrigin, frame.groundFor(camera),
                             frame.verticalSign()};
   const GroundPoseFit fit =
-      poseFromGroundHomography(found.homography->value, k, lens.imageSize, canvas, origin);
+      poseFromGroundHomography(canvasToPicture(camera, found, options),
+                               undistortedCamera(found, lens), lens.imageSize, canvas, origin);
   const double groundM = fit.rmsGroundUnits * options.unitM;
   const bool poor = fit.rmsPx > kPoorFitPx || groundM > kPoorFitM;
   notes.push_back(fmt::format(
@@ -105,22 +137,14 @@ processing::Pose poseOf(const std::string& camera, const ForeignCalibration& fou
 // A warning where a camera named front, back, left or right is placed or looks another way (an
 // inverted matrix put a camera named 'back' in front of the car, looking forward, silently).
 std::optional<std::string> nameAndPoseDisagree(const processing::CameraCalibration& camera) {
-  struct Side {
-    std::string_view name;
-    double x, y;  // its direction, vehicle frame: x forward, y left
-  };
-  constexpr std::array<Side, 4> kSides{
-      {{"front", 1, 0}, {"back", -1, 0}, {"left", 0, 1}, {"right", 0, -1}}};
-  const auto side = std::ranges::find_if(
-      kSides, [&](const Side& s) { return camera.name.find(s.name) != std::string::npos; });
-  if (side == kSides.end()) return std::nullopt;
+  const auto side = sideInName(camera.name);
+  if (!side) return std::nullopt;
   const cv::Vec3d axis = camera.pose.rotation * cv::Vec3d(0, 0, 1);
   const cv::Vec2d looks(axis[0], axis[1]), at(camera.pose.position[0], camera.pose.position[1]);
   // Against the side's direction: looking more than 90 degrees away from it, or placed on the
   // other side of the vehicle's centre.
-  const cv::Vec2d direction(side->x, side->y);
-  const bool looksAway = cv::norm(looks) > 0.2 && looks.dot(direction) < 0;
-  const bool placedAway = at.dot(direction) < -0.1;
+  const bool looksAway = cv::norm(looks) > 0.2 && looks.dot(side->direction) < 0;
+  const bool placedAway = at.dot(side->direction) < -0.1;
   if (!looksAway && !placedAway) return std::nullopt;
   return fmt::format(
       "warning: camera '{}' is {}{}{}: its name says {}; check the pose's direction "
@@ -129,6 +153,33 @@ std::optional<std::string> nameAndPoseDisagree(const processing::CameraCalibrati
       placedAway && looksAway ? " and " : "",
       looksAway ? fmt::format("looking towards x {:+.2f} y {:+.2f}", looks[0], looks[1]) : "",
       side->name);
+}
+
+// What the camera's calibration was taken from, part by part.
+std::string takenFrom(const std::string& camera, const ForeignCalibration& found,
+                      const ImportOptions& options) {
+  std::vector<std::string> parts;
+  const auto add = [&](std::string_view what, const auto& part) {
+    if (part) parts.push_back(fmt::format("{} from {}", what, part->origin));
+  };
+  add("lens", found.lens);
+  add("camera matrix", found.cameraMatrix);
+  add("distortion", found.distortion);
+  add("lens model", found.modelName);
+  add("image size", found.imageSize);
+  add("pose", found.pose);
+  add("ground homography", found.homography);
+  add("undistorted fx, fy scale", found.undistortedScale);
+  add("undistorted cx, cy shift", found.undistortedShift);
+  if (options.lens)
+    parts.push_back(
+        fmt::format("lens model {} from --lens", processing::lensModelName(*options.lens)));
+  if (options.imageSize) parts.emplace_back("image size from --image-size");
+  if (found.homography && options.canvasStrips) {
+    parts.push_back(fmt::format("its strip of the canvas: the {} one (--canvas-strips)",
+                                sideInName(camera)->name));
+  }
+  return fmt::format("camera '{}': {}", camera, fmt::join(parts, "; "));
 }
 
 std::string headerComment(const ImportOptions& options,
@@ -173,7 +224,7 @@ ImportedRig importRig(const ImportOptions& options) {
     }
   }
   std::vector<daemon::RigCamera> cameras;
-  std::vector<std::string> notes;
+  std::vector<std::string> notes, sources;
   for (const auto& input : inputs) {
     daemon::RigCamera camera;
     auto& c = camera.calibration;
@@ -204,6 +255,7 @@ ImportedRig importRig(const ImportOptions& options) {
                                    c.intrinsics.imageSize.width, c.intrinsics.imageSize.height));
     }
     c.pose = poseOf(c.name, input.calibration, c.intrinsics, options, frame, notes);
+    sources.push_back(takenFrom(c.name, input.calibration, options));
     cameras.push_back(std::move(camera));
   }
   std::vector<processing::Pose> poses;
@@ -223,11 +275,12 @@ ImportedRig importRig(const ImportOptions& options) {
   for (const auto& camera : cameras) {
     if (auto warning = nameAndPoseDisagree(camera.calibration)) notes.push_back(*warning);
   }
-  return {cameras, headerComment(options, inputs), notes};
+  return {cameras, headerComment(options, inputs), notes, sources};
 }
 
 void runImport(const ImportOptions& options, std::ostream& log) {
-  const auto [cameras, header, notes] = importRig(options);
+  const auto [cameras, header, notes, sources] = importRig(options);
+  for (const auto& source : sources) log << source << "\n";
   for (const auto& note : notes) log << note << "\n";
   if (options.out.has_parent_path()) std::filesystem::create_directories(options.out.parent_path());
   daemon::writeRigFile(options.out, cameras, header);

@@ -19,6 +19,8 @@ struct ImportedRig {
   // What the user should know of how each camera was read: a pose fitted to a homography (with
   // how far from it), a warning where the fit is poor or a camera's name and pose disagree.
   std::vector<std::string> notes;
+  // Per camera, in the order read: what each part of its calibration was taken from.
+  std::vector<std::string> sources;
 };
 
 // The rig the options describe. Throws UsageError naming the file and key for missing or

@@ -31,10 +31,13 @@ Input (one kind):
                                lens model: distortion_model camera_model lens_model
                                  (fisheye|equidistant|kannala_brandt, pinhole|plumb_bob|radtan)
                                image size: image_width + image_height, img_dist_w + img_dist_h,
-                                 image_size or imageSize [w, h]
+                                 image_size, imageSize or resolution [w, h]
                                pose, one of: rvec + tvec; R (3x3) + t; a 4x4 (or 3x4) matrix
                                  T sensor_calib T_cam_from_G extrinsic transform; or a ground
-                                 homography H / homography (see --canvas-scale)
+                                 homography: H / homography (canvas to picture, see
+                                 --canvas-scale) or project_matrix (picture to canvas), through
+                                 K, or through K' = K with fx, fy times scale_xy and cx, cy plus
+                                 shift_xy where the file has them
                              Matrices may be opencv-matrix nodes, {rows, cols, data} maps, or
                              plain (nested) lists. The first file that has a key wins.
   --pjlab DIR                the JSON layout of PJLab SensorsCalibration's surround samples:
@@ -68,6 +71,13 @@ The source frame (nothing is guessed; the rig is only right when these are):
                              columns along source x, rows along source y, so the source z axis
                              must be vertical
   --canvas-origin OU,OV      the canvas pixel of the source origin (default 0,0)
+  --canvas-strips WxH        the canvas is W x H pixels and each camera's homography targets a
+                             strip of its own, turned onto the canvas with its top edge outward
+                             on the camera's side (from its name: front at the top as it is,
+                             right turned 90 degrees clockwise, back 180, left 90 counter-
+                             clockwise), as surround-view-system-introduction's files do: e.g.
+                             --lens fisheye --canvas-strips 1200x1600 --canvas-scale 1
+                             --canvas-origin 600,800 --axes right,back,down --unit-m 0.01
 
 Lens:
   --lens MODEL               pinhole, fisheye or ocam; default: the file's model key, else pinhole
@@ -158,7 +168,7 @@ cv::Matx33d parseAxes(std::string_view text) {
   return axes;
 }
 
-cv::Size parseSize(std::string_view text) {
+cv::Size parseSize(std::string_view option, std::string_view text) {
   const auto x = text.find('x');
   int width = 0, height = 0;
   const auto w = text.substr(0, x == std::string_view::npos ? 0 : x);
@@ -169,7 +179,7 @@ cv::Size parseSize(std::string_view text) {
       b.ec != std::errc() || b.ptr != h.data() + h.size() || width < 16 || height < 16 ||
       width > 16384 || height > 16384) {
     throw UsageError(
-        fmt::format("--image-size: expected WxH in pixels (e.g. 1280x720), got '{}'", text));
+        fmt::format("{}: expected WxH in pixels (e.g. 1280x720), got '{}'", option, text));
   }
   return {width, height};
 }
@@ -225,7 +235,7 @@ ImportOptions parseImport(std::span<const std::string_view> arguments) {
        {"--pjlab", [&](auto v) { o.pjlabDir = std::string(v); }},
        {"--pjlab-yaml", [&](auto v) { o.pjlabYaml = std::string(v); }},
        {"--lens", [&](auto v) { o.lens = parseLens(v); }},
-       {"--image-size", [&](auto v) { o.imageSize = parseSize(v); }},
+       {"--image-size", [&](auto v) { o.imageSize = parseSize("--image-size", v); }},
        {"--field-of-view-deg",
         [&](auto v) {
           o.fieldOfViewDeg = parseDouble("--field-of-view-deg", v, 1, 360, "degrees from 1 to 360");
@@ -260,6 +270,7 @@ ImportOptions parseImport(std::span<const std::string_view> arguments) {
           const auto uv = parseNumbers("--canvas-origin", v, 2, "OU,OV in canvas pixels");
           o.canvasOrigin = {uv[0], uv[1]};
         }},
+       {"--canvas-strips", [&](auto v) { o.canvasStrips = parseSize("--canvas-strips", v); }},
        {"--out", [&](auto v) { o.out = std::string(v); }},
        {"--images", [&](auto v) { o.images = std::string(v); }}},
       {{"--origin-centre", [&](auto) { o.originCentre = true; }}});

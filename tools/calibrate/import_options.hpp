@@ -42,6 +42,9 @@ struct ImportOptions {
   // ((u - origin.x) * scale, (v - origin.y) * scale, groundZ).
   std::optional<double> canvasScale;  // source units per canvas pixel
   cv::Point2d canvasOrigin;
+  // A canvas of this size whose cameras each have a strip of their own (canvas_strips.hpp); none:
+  // every homography targets the whole canvas.
+  std::optional<cv::Size> canvasStrips;
   // Output.
   std::filesystem::path out;
   std::optional<std::filesystem::path> images;  // folder of one still picture per camera
