@@ -8,6 +8,7 @@
 #include <mutex>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <libcamera/libcamera.h>
 #include <sys/mman.h>
 
@@ -45,6 +46,30 @@ struct Candidate {
 }  // namespace
 
 bool libcameraAvailable() { return true; }
+
+std::vector<std::string> libcameraCameras() {
+  const auto manager = sharedManager();
+  std::vector<std::string> lines;
+  for (const auto& camera : manager->cameras()) {
+    std::string line = camera->id();
+    if (const auto model = camera->properties().get(libcamera::properties::Model)) {
+      line += fmt::format(" ({})", *model);
+    }
+    const auto configuration = camera->generateConfiguration({libcamera::StreamRole::Viewfinder});
+    if (configuration && !configuration->empty()) {
+      const libcamera::StreamFormats& formats = configuration->at(0).formats();
+      std::vector<std::string> offers;
+      for (const auto& format : formats.pixelformats()) {
+        const auto range = formats.range(format);
+        offers.push_back(fmt::format("{} {} to {}", format.toString(), range.min.toString(),
+                                     range.max.toString()));
+      }
+      line += fmt::format(": {}", fmt::join(offers, "; "));
+    }
+    lines.push_back(std::move(line));
+  }
+  return lines;
+}
 
 struct LibcameraSource::Impl {
   std::string name;

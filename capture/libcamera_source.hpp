@@ -13,6 +13,7 @@
 #include <chrono>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "capture/frame_source.hpp"
 
@@ -29,6 +30,11 @@ struct LibcameraSettings {
 
 // Whether this build has libcamera.
 bool libcameraAvailable();
+
+// The cameras libcamera finds, one line each: "<id> (<model>): <format> <smallest> to <largest>;
+// ..." (a viewfinder stream's formats). Throws CaptureError where the camera manager does not
+// start, or this build has no libcamera.
+std::vector<std::string> libcameraCameras();
 
 class LibcameraSource final : public FrameSource {
  public:

@@ -8,6 +8,10 @@ namespace surroundd::capture {
 
 bool libcameraAvailable() { return false; }
 
+std::vector<std::string> libcameraCameras() {
+  throw CaptureError("this surroundd was built without libcamera");
+}
+
 struct LibcameraSource::Impl {};
 
 LibcameraSource::LibcameraSource(std::string cameraName, LibcameraSettings /*settings*/) {

@@ -37,16 +37,20 @@ inline constexpr std::array<V4l2FormatCode, 5> kV4l2Formats{{
 struct V4l2Offer {
   std::uint32_t fourcc = 0;
   std::vector<cv::Size> sizes;  // discrete sizes
-  bool anySize = false;         // stepwise or continuous ranges
-  cv::Size smallest, largest;   // of a range
+  // Per discrete size, the frame rates it is offered at (frames per second), where the driver
+  // lists them (discrete intervals); empty where it does not.
+  std::vector<std::vector<double>> rates;
+  bool anySize = false;        // stepwise or continuous ranges
+  cv::Size smallest, largest;  // of a range
   bool has(cv::Size size) const;
 };
 
 // The formats and sizes the device offers for buffers of `bufferType` (single- or multi-planar
 // capture).
 std::vector<V4l2Offer> offersOf(V4l2Device& device, std::uint32_t bufferType);
-// "YUYV 640x480, 320x240; MJPG 1280x720", or "nothing".
-std::string describe(const std::vector<V4l2Offer>& offers);
+// "YUYV 640x480, 320x240; MJPG 1280x720", or "nothing"; with `withRates`, each size's frame
+// rates after it: "YUYV 640x480 (30, 15 fps)".
+std::string describe(const std::vector<V4l2Offer>& offers, bool withRates = false);
 std::string fourccText(std::uint32_t code);
 
 }  // namespace surroundd::capture

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "capture/v4l2_formats.hpp"
+#include "capture/v4l2_probe.hpp"
 
 namespace surroundd::capture {
 namespace {
@@ -62,42 +63,16 @@ void V4l2Source::start() {
   if (const int error = device_->open(settings_.device.string()); error != 0) {
     throw CaptureError(fmt::format("{}: cannot open: {}", where(), errorText(error)));
   }
-  v4l2_capability capability{};
-  if (const int error = device_->ioctl(VIDIOC_QUERYCAP, &capability); error != 0) {
-    throw CaptureError(fmt::format("{}: not a V4L2 device ({})", where(), errorText(error)));
-  }
-  const std::uint32_t caps = (capability.capabilities & V4L2_CAP_DEVICE_CAPS) != 0
-                                 ? capability.device_caps
-                                 : capability.capabilities;
-  const bool singlePlanar = (caps & V4L2_CAP_VIDEO_CAPTURE) != 0;
-  const bool multiPlanar = (caps & V4L2_CAP_VIDEO_CAPTURE_MPLANE) != 0;
-  if ((!singlePlanar && !multiPlanar) || (caps & V4L2_CAP_STREAMING) == 0) {
+  const V4l2Probe probe = probeV4l2(*device_, where());
+  if (!probe.capture) {
     throw CaptureError(fmt::format("{} ('{}', driver {}): cannot capture video by streaming",
-                                   where(), reinterpret_cast<const char*>(capability.card),
-                                   reinterpret_cast<const char*>(capability.driver)));
+                                   where(), probe.card, probe.driver));
   }
-  // Most embedded capture drivers (i.MX, Rockchip, TI) speak only the multi-planar API, even for
-  // one-plane formats; a driver that speaks both is used through the single-planar one.
-  multiplanar_ = !singlePlanar;
-  bufferType_ = multiplanar_ ? V4L2_BUF_TYPE_VIDEO_CAPTURE_MPLANE : V4L2_BUF_TYPE_VIDEO_CAPTURE;
-
-  // The first wanted format that the device offers at the wanted size.
-  const std::vector<V4l2Offer> offers = offersOf(*device_, bufferType_);
-  const V4l2FormatCode* chosen = nullptr;
-  for (const auto& candidate : kV4l2Formats) {
-    if (settings_.format != V4l2Format::kAuto && settings_.format != candidate.format) continue;
-    if (candidate.planes > 1 && !multiplanar_) continue;
-    const auto offer = std::ranges::find(offers, candidate.fourcc, &V4l2Offer::fourcc);
-    if (offer != offers.end() && offer->has(settings_.size)) {
-      chosen = &candidate;
-      break;
-    }
-  }
+  multiplanar_ = probe.multiplanar;
+  bufferType_ = probe.bufferType;
+  const V4l2FormatCode* chosen = chooseV4l2Format(probe, settings_);
   const auto cannot = [&] {
-    return CaptureError(fmt::format("{}: does not offer {} {}x{} (it offers{}: {})", where(),
-                                    toString(settings_.format), settings_.size.width,
-                                    settings_.size.height, multiplanar_ ? ", multi-planar" : "",
-                                    describe(offers)));
+    return CaptureError(fmt::format("{}: {}", where(), notOffered(probe, settings_)));
   };
   if (chosen == nullptr) throw cannot();
   setFormat(*chosen, cannot);

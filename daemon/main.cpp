@@ -8,6 +8,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <iostream>
 #include <optional>
 #include <string_view>
 
@@ -16,6 +17,7 @@
 
 #include "common/build_info.hpp"
 #include "daemon/config.hpp"
+#include "daemon/live_cameras.hpp"
 #include "daemon/logging.hpp"
 #include "daemon/process_start.hpp"
 #include "daemon/rig_yaml.hpp"
@@ -27,11 +29,15 @@ using namespace surroundd;
 
 constexpr std::string_view kUsage =
     R"(usage: surroundd --config FILE [--log-level LEVEL] [--pacing MODE] [--check-config]
+       surroundd --list-cameras
 
   --config FILE       the YAML config (see config/surroundd.reference.yaml); also -c FILE,
                       --config=FILE (and so for every option with a value)
-  --check-config      check the config, say what is wrong (exit 2) or that it is good (exit 0),
-                      and open nothing
+  --check-config      check the config and that each V4L2 camera's device is there and offers
+                      the format and size asked (opened only to ask): say what is wrong (exit 2)
+                      or that it is good (exit 0); nothing streams, no output is opened
+  --list-cameras      the V4L2 capture devices (persistent names, formats, sizes and rates) and
+                      libcamera's cameras, for a config's camera sources
   --log-level LEVEL   trace, debug, info, warning, error or off; overrides logging.level
   --pacing MODE       realtime or as_fast_as_possible; overrides capture.pacing
   --version           the version, and the optional parts this build has and has not
@@ -66,6 +72,32 @@ struct Arguments {
   bool checkOnly = false;
 };
 
+// --check-config: the file, then the devices it names. Returns the exit code.
+int checkConfig(const daemon::Config& config, const std::string& file) {
+  for (const auto& warning : config.warnings) {
+    fmt::print(stderr, "surroundd: warning: {}\n", warning);
+  }
+  std::vector<std::string> problems;
+  try {
+    std::vector<std::string> said;
+    problems = daemon::cameraDeviceProblems(daemon::withAutoDevices(config.cameras, said));
+    for (const auto& line : said) fmt::print("surroundd: {}\n", line);
+  } catch (const std::runtime_error& e) {
+    problems.emplace_back(e.what());
+  }
+  for (const auto& problem : problems) fmt::print(stderr, "surroundd: {}\n", problem);
+  if (!problems.empty()) {
+    fmt::print(stderr,
+               "surroundd: {}: the file is good ({} cameras, {} outputs), but its cameras "
+               "cannot be opened here as it asks ({} problem(s)); nothing was started\n",
+               file, config.cameras.size(), config.outputs.size(), problems.size());
+    return 2;
+  }
+  fmt::print("surroundd: {}: good ({} cameras, {} outputs)\n", file, config.cameras.size(),
+             config.outputs.size());
+  return 0;
+}
+
 // nullopt after printing what was wrong (or the help or version text, with `help` set).
 std::optional<Arguments> parseArguments(int argc, char** argv, bool& help) {
   Arguments arguments;
@@ -89,6 +121,11 @@ std::optional<Arguments> parseArguments(int argc, char** argv, bool& help) {
       arguments.checkOnly = true;
       continue;
     }
+    if (flag == "--list-cameras") {
+      help = true;
+      daemon::listCameras(std::cout);
+      return std::nullopt;
+    }
     // --name=value, as GNU programs take it, and -c for --config.
     std::optional<std::string_view> attached;
     if (const auto equals = flag.find('='); flag.starts_with("--") && equals != flag.npos) {
@@ -96,7 +133,8 @@ std::optional<Arguments> parseArguments(int argc, char** argv, bool& help) {
       flag = flag.substr(0, equals);
     }
     if (flag == "-c") flag = "--config";
-    if (attached && (flag == "--check-config" || flag == "--help" || flag == "--version")) {
+    if (attached && (flag == "--check-config" || flag == "--help" || flag == "--version" ||
+                     flag == "--list-cameras")) {
       return fail(fmt::format("'{}' takes no value", flag));
     }
     if (!attached && i + 1 >= argc) return fail(fmt::format("'{}' needs a value", flag));
@@ -139,14 +177,7 @@ int main(int argc, char** argv) {
                e.messages().size());
     return 2;
   }
-  if (arguments->checkOnly) {
-    for (const auto& warning : config.warnings) {
-      fmt::print(stderr, "surroundd: warning: {}\n", warning);
-    }
-    fmt::print("surroundd: {}: good ({} cameras, {} outputs)\n", arguments->configFile,
-               config.cameras.size(), config.outputs.size());
-    return 0;
-  }
+  if (arguments->checkOnly) return checkConfig(config, arguments->configFile);
   if (arguments->pacing) config.capture.pacing = *arguments->pacing;
   daemon::setUpLogging(arguments->logLevel.value_or(config.logLevel));
   for (const auto& warning : config.warnings) spdlog::warn("{}", warning);

@@ -12,6 +12,7 @@
 #include "capture/libcamera_source.hpp"
 #include "capture/preloaded_source.hpp"
 #include "capture/v4l2_source.hpp"
+#include "daemon/live_cameras.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -66,6 +67,9 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
   // After what the threads use: should one camera fail, the others' futures wait for their
   // threads as they go, before the rest of this function's locals.
   std::vector<std::future<Opened>> opening;
+  std::vector<std::string> said;
+  const std::vector<RigCamera> rig = withAutoDevices(config.cameras, said);
+  for (const auto& line : said) spdlog::info("{}", line);
   const auto inTurn = [](auto open) {
     std::promise<Opened> opened;
     try {
@@ -75,7 +79,7 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
     }
     return opened.get_future();
   };
-  for (const auto& camera : config.cameras) {
+  for (const auto& camera : rig) {
     const auto& name = camera.calibration.name;
     if (camera.libcamera) {
       opening.push_back(inTurn([&] {
@@ -113,8 +117,8 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
   // turn; the others' threads are waited for (their futures' destruction) and what they opened
   // is closed.
   std::vector<std::unique_ptr<capture::CameraStream>> cameras;
-  for (std::size_t c = 0; c < config.cameras.size(); ++c) {
-    const auto& camera = config.cameras[c];
+  for (std::size_t c = 0; c < rig.size(); ++c) {
+    const auto& camera = rig[c];
     const auto& name = camera.calibration.name;
     auto [source, origin] = opening[c].get();
     const cv::Size calibrated = camera.calibration.intrinsics.imageSize;

@@ -6,8 +6,8 @@
 # the pipeline, its outputs' queues and servers, the control server, the service) built with
 # ThreadSanitizer (the `tsan` preset).
 # --fuzz-seeds: then also builds every libFuzzer target (the `fuzz` preset: clang, ASan + UBSan)
-# and runs each once over its seeds (scripts/fuzz.sh seeds): fuzz targets are built nowhere else,
-# and one had stopped compiling unseen.
+# and runs each once over its seeds (scripts/fuzz.sh seeds). The suites already build every target
+# with gcc and run its seeds (FuzzSeeds.*), so this checks only the libFuzzer build itself.
 # --minimal: then also builds the `minimal` preset (every optional part left out: X11, DRM, HTTP,
 # RTSP, libcamera) and runs the tests that apply to it and may differ there; those of left-out parts
 # are not run (configure lists them).

@@ -194,6 +194,18 @@ class FakeV4l2Device final : public surroundd::capture::V4l2Device {
         }
         return EINVAL;
       }
+      case VIDIOC_ENUM_FRAMEINTERVALS: {
+        auto* interval = static_cast<v4l2_frmivalenum*>(argument);
+        const bool offered = std::ranges::any_of(state_->modes, [&](const Mode& mode) {
+          return mode.fourcc == interval->pixel_format &&
+                 mode.size == cv::Size(static_cast<int>(interval->width),
+                                       static_cast<int>(interval->height));
+        });
+        if (!offered || interval->index != 0) return EINVAL;
+        interval->type = V4L2_FRMIVAL_TYPE_DISCRETE;
+        interval->discrete = {static_cast<std::uint32_t>(state_->periodUs), 1'000'000};
+        return 0;
+      }
       case VIDIOC_S_FMT:
         return setFormat(*static_cast<v4l2_format*>(argument), type);
       case VIDIOC_G_PARM:

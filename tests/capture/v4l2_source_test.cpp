@@ -4,6 +4,8 @@
 
 #include "capture/v4l2_source.hpp"
 
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <tuple>
 
@@ -11,7 +13,9 @@
 #include <gtest/gtest.h>
 
 #include "capture/camera_stream.hpp"
+#include "capture/v4l2_probe.hpp"
 #include "tests/capture/fake_v4l2_device.hpp"
+#include "tests/support/temp_dir.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace surroundd::capture {
@@ -179,6 +183,47 @@ TEST(V4l2Source, ARequestTheDeviceCannotMeetSaysWhatItOffers) {
   V4l2Settings nv12 = settingsFor();
   nv12.format = V4l2Format::kNv12;
   EXPECT_THROW(sourceOn(state, nv12), CaptureError);
+}
+
+// Issue 50: what --list-cameras and --check-config read of a device, without streaming: its
+// formats, sizes and each size's rates, and the same choice the source makes.
+TEST(V4l2Probe, ReadsFormatsSizesAndRatesAndChoosesAsTheSourceDoes) {
+  const auto state =
+      deviceOffering({{V4L2_PIX_FMT_MJPEG, {1280, 720}}, {V4L2_PIX_FMT_NV12, kSize}});
+  state->periodUs = 40'000;
+  FakeV4l2Device device(state);
+  const V4l2Probe probe = probeV4l2("/dev/video7", "camera 'front': /dev/video7", device);
+  EXPECT_TRUE(probe.capture);
+  EXPECT_EQ(probe.card, "Fake camera");
+  EXPECT_EQ(describe(probe.offers, true), "MJPG 1280x720 (25 fps); NV12 320x240 (25 fps)")
+      << "offers as the fake device lists them";
+  EXPECT_EQ(fourccText(V4L2_PIX_FMT_Y10), "Y10");
+  EXPECT_EQ(fourccText(V4L2_PIX_FMT_Y16_BE), "Y16-BE");
+  EXPECT_EQ(chooseV4l2Format(probe, settingsFor())->format, V4l2Format::kNv12);
+  EXPECT_EQ(chooseV4l2Format(probe, settingsFor({640, 480})), nullptr);
+  EXPECT_THAT(notOffered(probe, settingsFor({640, 480})),
+              HasSubstr("does not offer auto 640x480 (it offers: MJPG 1280x720; "));
+}
+
+TEST(V4l2Probe, NodesComeInNumberOrderWithTheirPersistentNames) {
+  const testing::TempDir dev;
+  for (const char* node : {"video10", "video2", "video0", "videox", "media0"}) {
+    std::ofstream(dev / node) << "";
+  }
+  std::filesystem::create_directories(dev / "v4l/by-path");
+  std::filesystem::create_directories(dev / "v4l/by-id");
+  std::filesystem::create_symlink("../../video2",
+                                  dev / "v4l/by-path/pci-0000:00:14.0-video-index0");
+  std::filesystem::create_symlink("../../video2", dev / "v4l/by-id/usb-Cam-video-index0");
+  const auto nodes = v4l2Nodes(dev.path());
+  ASSERT_EQ(nodes.size(), 3U);
+  EXPECT_EQ(nodes[0].path.filename(), "video0");
+  EXPECT_EQ(nodes[1].path.filename(), "video2");
+  EXPECT_EQ(nodes[2].path.filename(), "video10");
+  ASSERT_EQ(nodes[1].persistentNames.size(), 2U);
+  EXPECT_EQ(nodes[1].persistentNames[0], dev / "v4l/by-path/pci-0000:00:14.0-video-index0");
+  EXPECT_EQ(nodes[1].persistentNames[1], dev / "v4l/by-id/usb-Cam-video-index0");
+  EXPECT_TRUE(nodes[0].persistentNames.empty());
 }
 
 TEST(V4l2Source, ControlsAreSetWithinTheirRangesAndRefusedOtherwise) {

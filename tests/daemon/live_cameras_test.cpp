@@ -6,10 +6,13 @@
 // shows its bars; and the GPU stitch takes their frames lent the drivers' buffers. Skipped, with a
 // message, where the machine has no four vivid devices.
 
+#include "daemon/live_cameras.hpp"
+
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <filesystem>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -100,6 +103,72 @@ class LiveCameras : public ::testing::Test {
   std::vector<std::filesystem::path> devices_;
   const testing::TempDir dir_;
 };
+
+// Issue 50: bring-up. --list-cameras shows each capture device with its formats, sizes and rates;
+// `device: auto` takes the capture devices no camera names, in number order; --check-config asks
+// each device for the camera's format and size and names what it offers when it has not.
+TEST_F(LiveCameras, TheyAreListedTakenByDeviceAutoAndCheckedForTheFormatAndSize) {
+  std::ostringstream listed;
+  listCameras(listed);
+  for (const auto& device : devices_) {
+    EXPECT_THAT(listed.str(), ::testing::HasSubstr(device.string() + ": 'vivid")) << listed.str();
+  }
+  EXPECT_THAT(listed.str(),
+              ::testing::AllOf(::testing::HasSubstr("YUYV"), ::testing::HasSubstr("320x180 ("),
+                               ::testing::HasSubstr(" fps)")))
+      << listed.str();
+
+  OutputConfig video = videoOutputAt(dir_.path() / "unused.mkv");
+  Config config =
+      vividConfig(devices_, dir_, video, {capture::V4l2Format::kYuyv, capture::V4l2Format::kNv12});
+  // The second camera named, the others auto: they take the rest, in number order.
+  auto sorted = devices_;
+  std::ranges::sort(sorted, {}, [](const std::filesystem::path& p) {
+    return std::stoi(p.filename().string().substr(5));
+  });
+  for (std::size_t i = 0; i < 4; ++i) {
+    config.cameras[i].device->device = i == 1 ? sorted[0] : std::filesystem::path("auto");
+  }
+  std::vector<std::string> said;
+  const auto cameras = withAutoDevices(config.cameras, said);
+  ASSERT_EQ(said.size(), 3U);
+  EXPECT_EQ(cameras[0].device->device, sorted[1]);
+  EXPECT_EQ(cameras[1].device->device, sorted[0]);
+  EXPECT_EQ(cameras[2].device->device, sorted[2]);
+  EXPECT_EQ(cameras[3].device->device, sorted[3]);
+  EXPECT_THAT(said[0], ::testing::HasSubstr(
+                           fmt::format("camera 'front': device auto is {}", sorted[1].string())));
+  EXPECT_THAT(cameraDeviceProblems(cameras), ::testing::IsEmpty());
+
+  // A fifth camera finds none left.
+  auto five = config.cameras;
+  five.push_back(five.back());
+  five.back().calibration.name = "fifth";
+  five.back().device->device = "auto";
+  try {
+    withAutoDevices(five, said);
+    ADD_FAILURE() << "a fifth camera was given a device";
+  } catch (const std::runtime_error& error) {
+    EXPECT_THAT(
+        error.what(),
+        ::testing::AllOf(::testing::HasSubstr("camera 'fifth': device auto: no V4L2 capture"),
+                         ::testing::HasSubstr("found 4")));
+  }
+
+  // A size the devices do not offer: each camera named, with what its device offers.
+  auto odd = cameras;
+  for (auto& camera : odd) camera.device->size = {333, 111};
+  const auto problems = cameraDeviceProblems(odd);
+  ASSERT_EQ(problems.size(), 4U);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_THAT(
+        problems[i],
+        ::testing::AllOf(
+            ::testing::HasSubstr(fmt::format("camera '{}': {}", config.cameras[i].calibration.name,
+                                             odd[i].device->device.string())),
+            ::testing::HasSubstr("333x111 (it offers"), ::testing::HasSubstr("320x180")));
+  }
+}
 
 TEST_F(LiveCameras, FourV4l2CamerasThroughTheKernelMakeTheMosaicAndMatchedSets) {
   OutputConfig video = videoOutputAt(dir_.path() / "mosaic.mkv");
@@ -205,6 +274,36 @@ TEST_F(LiveCameras, TheGpuStitchTakesFramesLentTheDriversBuffers) {
     saidWhichWay += static_cast<std::size_t>(ways);
   }
   EXPECT_GE(saidWhichWay, 1U) << fmt::format("{}", fmt::join(lines, "\n"));
+}
+
+// Anywhere: a device that is not there is named with the camera; `device: auto` on a machine with
+// no capture device says so; the list says there is none.
+TEST(CameraDevices, AMissingDeviceIsNamedAndAutoWithNoneThereSaysSo) {
+  const testing::TempDir dev;
+  Config config = fixtureReplay("synth_small", {});
+  for (auto& camera : config.cameras) {
+    camera.source.reset();
+    camera.device = testing::vividSettings(dev.path() / "video9", capture::V4l2Format::kAuto);
+  }
+  const auto problems = cameraDeviceProblems(config.cameras);
+  ASSERT_EQ(problems.size(), config.cameras.size());
+  EXPECT_EQ(problems[0], fmt::format("camera 'front': {}: cannot open: No such file or directory",
+                                     (dev.path() / "video9").string()));
+
+  config.cameras[2].device->device = "auto";
+  std::vector<std::string> said;
+  try {
+    withAutoDevices(config.cameras, said, dev.path());
+    ADD_FAILURE() << "a camera was given a device where there is none";
+  } catch (const std::runtime_error& error) {
+    EXPECT_THAT(error.what(), ::testing::HasSubstr("camera 'back': device auto: no V4L2 capture "
+                                                   "device is left for it (found 0)"));
+  }
+  std::ostringstream listed;
+  listCameras(listed, dev.path());
+  EXPECT_THAT(listed.str(),
+              ::testing::HasSubstr(fmt::format("no V4L2 capture device in {} (0 video nodes)",
+                                               dev.path().string())));
 }
 
 }  // namespace

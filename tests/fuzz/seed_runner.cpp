@@ -1,0 +1,44 @@
+// A fuzz target's main() where there is no libFuzzer (the gcc builds): its function once over
+// each seed file given, or each file in a folder given, as libFuzzer's -runs=0 does. So every
+// target compiles in every test build, and the ci and ASan + UBSan suites run its seeds; the
+// clang `fuzz` preset (scripts/fuzz.sh) is for fuzzing itself.
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <vector>
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
+// Defined by the targets that set up something first.
+extern "C" __attribute__((weak)) int LLVMFuzzerInitialize(int* argc, char*** argv);
+
+int main(int argc, char** argv) {
+  if (LLVMFuzzerInitialize != nullptr) LLVMFuzzerInitialize(&argc, &argv);
+  std::vector<std::filesystem::path> seeds;
+  for (int i = 1; i < argc; ++i) {
+    const std::filesystem::path given(argv[i]);
+    if (!std::filesystem::is_directory(given)) {
+      seeds.push_back(given);
+      continue;
+    }
+    for (const auto& entry : std::filesystem::directory_iterator(given)) {
+      if (entry.is_regular_file()) seeds.push_back(entry.path());
+    }
+  }
+  std::ranges::sort(seeds);
+  for (const auto& seed : seeds) {
+    std::ifstream in(seed, std::ios::binary);
+    if (!in) {
+      std::fprintf(stderr, "%s: cannot read\n", seed.c_str());
+      return 1;
+    }
+    const std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(in), {}};
+    std::fprintf(stderr, "%s (%zu bytes)\n", seed.c_str(), bytes.size());
+    LLVMFuzzerTestOneInput(bytes.data(), bytes.size());
+  }
+  std::printf("%zu seeds, no finding\n", seeds.size());
+  return seeds.empty() ? 1 : 0;
+}
