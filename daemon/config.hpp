@@ -220,7 +220,12 @@ struct OutputConfig {
   std::string pixelFormat = "yuv420p";
   std::string encoder = "auto";  // H.264: auto | libx264 | an FFmpeg encoder's name
   double segmentS = 0.0;  // video: a new file every this many seconds of stream time; 0 = one file
-  std::string url;        // network: udp://HOST:PORT (MPEG-TS)
+  // video: how many of its files (runs, segments) to keep, and how many MB they may hold; 0: all
+  int keepLast = 0;
+  double maxMb = 0;
+  // Set when opened: `path` as configured, where `path` is this run's own <stem>-N<ext>.
+  std::filesystem::path family;
+  std::string url;  // network: udp://HOST:PORT (MPEG-TS)
   // http and rtsp: the server
   std::string listenAddress = "127.0.0.1";  // only this machine, unless configured otherwise
   int listenPort = 8080;

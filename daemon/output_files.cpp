@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "daemon/output_type.hpp"
+#include "render/outputs/numbered_files.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -85,11 +86,19 @@ std::filesystem::path unusedOutputPath(const OutputConfig& output) {
   const auto taken = [&](const std::filesystem::path& p) {
     return holdsData(p) || (use == OutputPathUse::kKept && holdsData(withPart(p)));
   };
-  std::filesystem::path candidate = output.path;
-  for (int n = 1; taken(candidate); ++n) {
-    candidate.replace_filename(
-        fmt::format("{}-{}{}", output.path.stem().string(), n, output.path.extension().string()));
+  // After the highest number holding data, so that numbers go in the order the runs wrote them:
+  // a video's retention removes the lowest, its own path first, which is then not taken again.
+  std::int64_t n = -1;
+  for (const auto& file : render::numberedFiles(output.path)) {
+    if (holdsData(file.path)) n = std::max(n, file.number);
   }
+  if (n < 0 && !taken(output.path)) return output.path;
+  std::filesystem::path candidate;
+  do {
+    candidate = output.path;
+    candidate.replace_filename(
+        fmt::format("{}-{}{}", output.path.stem().string(), ++n, output.path.extension().string()));
+  } while (taken(candidate));
   return candidate;
 }
 

@@ -13,6 +13,7 @@ namespace {
 
 // The config's output, writing where no earlier run's data is lost.
 OutputConfig withUnusedPath(OutputConfig output) {
+  output.family = output.path;
   if (auto path = unusedOutputPath(output); path != output.path) {
     spdlog::info("{} holds what an earlier run wrote: this run writes {}", output.path.string(),
                  path.string());
@@ -29,7 +30,7 @@ PipelineOutputs::PipelineOutputs(double nominalFps, bool latestWins)
 void PipelineOutputs::addPicture(const OutputConfig& config, cv::Size size, const cv::Mat* picture,
                                  std::unique_ptr<render::SurroundView> view) {
   PictureOutput output;
-  output.config = withUnusedPath(config);
+  output.config = config;
   output.size = size;
   output.picture = picture;
   open(output);
@@ -144,13 +145,12 @@ void PipelineOutputs::record(const capture::FrameSet& set) {
 }
 
 void PipelineOutputs::open(PictureOutput& output) {
-  // Where the failed try left data, this one writes the next name.
-  output.config.path = unusedOutputPath(output.config);
-  output.sink = outputTypeOf(output.config)
-                    .openPictureSink(output.config, {.pictureSize = output.size,
-                                                     .nominalFps = nominalFps_,
-                                                     .latestWins = latestWins_,
-                                                     .renderer = renderer_});
+  // Where an earlier run or the failed try left data, this one writes the next name.
+  const OutputConfig run = withUnusedPath(output.config);
+  output.sink = outputTypeOf(run).openPictureSink(run, {.pictureSize = output.size,
+                                                        .nominalFps = nominalFps_,
+                                                        .latestWins = latestWins_,
+                                                        .renderer = renderer_});
 }
 
 void PipelineOutputs::retry(Clock::time_point now) {

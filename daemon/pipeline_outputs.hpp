@@ -43,7 +43,7 @@ class PipelineOutputs {
 
   // An output of pictures: a stream's picture, made by a stage, or a surround view of its own.
   struct PictureOutput {
-    OutputConfig config;  // to open it again after a failure (its path: the one it writes now)
+    OutputConfig config;  // as configured: each opening writes the next unused name of its path
     cv::Size size;
     const cv::Mat* picture = nullptr;            // the stream's picture; null for a surround view
     std::unique_ptr<render::SurroundView> view;  // surround outputs
@@ -54,9 +54,9 @@ class PipelineOutputs {
     // What the sink said it was when opened again: once it takes pictures, a queued sink's
     // describe() belongs to its worker, so the "works again" line names it by this.
     std::string openedAs;
-    std::chrono::nanoseconds pendingTime{0};        // stream time of the view's pending picture
-    Clock::time_point pendingOrigin{};              // capture time of the pending picture's set
-    cv::Mat latest;                                 // header over the picture last handed over, BGR
+    std::chrono::nanoseconds pendingTime{0};  // stream time of the view's pending picture
+    Clock::time_point pendingOrigin{};        // capture time of the pending picture's set
+    cv::Mat latest;                           // header over the picture last handed over, BGR
     // The current switch of view: whether the output shows it settled (or was spared it), and
     // whether it has had any picture since (an output that takes none, a snapshot after its
     // time, does not hold the switch's end back).

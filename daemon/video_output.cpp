@@ -42,9 +42,14 @@ std::unique_ptr<render::FrameSink> openVideo(const OutputConfig& output,
   settings.url = output.url;
   // A viewer of the stream can tell how late it shows each picture.
   settings.stampCaptureTime = !output.url.empty();
-  auto video = std::make_unique<render::VideoSink>(
-      std::move(settings), std::chrono::duration_cast<std::chrono::nanoseconds>(
-                               std::chrono::duration<double>(output.segmentS)));
+  const render::Retention retention{output.family.empty() ? output.path : output.family,
+                                    output.keepLast,
+                                    static_cast<std::uint64_t>(output.maxMb * 1e6)};
+  auto video =
+      std::make_unique<render::VideoSink>(std::move(settings),
+                                          std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                              std::chrono::duration<double>(output.segmentS)),
+                                          retention);
   // Encoding runs beside the next frame set's stitching; live, the newest picture wins.
   return queuedSink(std::move(video), context, kEncoderQueue);
 }
@@ -106,6 +111,11 @@ OutputType videoOutputType() {
       pixelFormatKey(),
       Key::number("segment_s", &OutputConfig::segmentS, {0.0, 86400.0, false, "seconds"},
                   "a new file every this many seconds of stream time"),
+      Key::integer("keep_last", &OutputConfig::keepLast, 0, 1'000'000,
+                   "the newest files of it kept (segments, or this run's and earlier runs'); 0: "
+                   "all"),
+      Key::number("max_mb", &OutputConfig::maxMb, {0.0, 1e9, false, "MB"},
+                  "MB its files may hold together, the oldest removed first; 0: no limit"),
   };
   type.readSettings = checkVideo;
   type.pathUse = [](const OutputConfig& o) {

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "render/outputs/frame_sink.hpp"
+#include "render/outputs/numbered_files.hpp"
 #include "render/outputs/video_encoder.hpp"
 
 namespace surroundd::render {
@@ -18,12 +19,14 @@ namespace surroundd::render {
 // time each ([0, L), [L, 2L), ... from the first frame set), named <stem>-00001<ext>,
 // <stem>-00002<ext>, ... and each finalized when the next begins, so that a crash or power loss
 // costs at most the segment being written. Numbering goes on after the highest segment already in
-// the folder: a restart never overwrites one.
+// the folder: a restart never overwrites one. With a retention, each file opened (a run's, a
+// segment) removes the oldest of its family's beyond it (numbered_files.hpp).
 class VideoSink final : public FrameSink {
  public:
   // Opens the file (the first segment) or the stream; throws EncoderError naming it.
   explicit VideoSink(VideoEncoderSettings settings,
-                     std::chrono::nanoseconds segmentLength = std::chrono::nanoseconds(0));
+                     std::chrono::nanoseconds segmentLength = std::chrono::nanoseconds(0),
+                     Retention retention = {});
   void consume(const cv::Mat& picture, const PictureTime& time) override;
   bool takesI420() const override { return takesI420_; }
   void finish(const cv::Mat& lastFrame, std::chrono::nanoseconds lastTime) override;
@@ -35,6 +38,7 @@ class VideoSink final : public FrameSink {
 
   VideoEncoderSettings settings_;
   std::chrono::nanoseconds segmentLength_;  // 0: one file
+  Retention retention_;
   std::optional<VideoEncoder> encoder_;
   std::optional<std::int64_t> window_;  // which multiple of segmentLength_ is being written
   std::int64_t firstSegment_ = 1;

@@ -1,6 +1,7 @@
 // No run destroys another's data (issue 18): two outputs of one config that would write the same
 // file are refused at load, and a run that finds an earlier run's file, .part or recording
-// writes the next free name instead. The last test runs the pipeline three times on one config.
+// writes the next name instead. Retention (issue 50): a video's keep_last and max_mb remove its
+// oldest files, over restarts and segments alike.
 
 #include "daemon/output_files.hpp"
 
@@ -12,6 +13,7 @@
 
 #include "daemon/pipeline.hpp"
 #include "daemon/rig_yaml.hpp"
+#include "render/outputs/numbered_files.hpp"
 #include "tests/daemon/config_test_support.hpp"
 #include "tests/daemon/replay_config.hpp"
 #include "tests/support/test_support.hpp"
@@ -80,6 +82,9 @@ TEST(OutputFiles, AnEarlierRunsFilesAreKeptAndTheNextFreeNameTaken) {
   // A FIFO is no data (a test stalls a writer with one): it is written into.
   ASSERT_EQ(::mkfifo((dir / "whole-2.mkv.part").c_str(), 0600), 0);
   EXPECT_EQ(unusedOutputPath(video), dir / "whole-2.mkv");
+  // After the highest number, not into a gap a retention left: numbers follow the runs' order.
+  dir.write("whole-7.mkv", "a later run");
+  EXPECT_EQ(unusedOutputPath(video), dir / "whole-8.mkv");
 
   OutputConfig recording;
   recording.kind = OutputKind::kRecording;
@@ -122,6 +127,61 @@ TEST(OutputFiles, RestartsKeepEveryRunsVideo) {
   EXPECT_GT(first.images.size(), 5u);
   EXPECT_EQ(second.images.size(), first.images.size());
   EXPECT_FALSE(std::filesystem::exists(dir / "whole.mkv"));
+}
+
+TEST(OutputFiles, RetentionRemovesTheOldestOfTheFamilyNeverTheOneBeingWritten) {
+  const testing::TempDir dir;
+  for (const char* name : {"drive.mp4", "drive-1.mp4", "drive-2.mp4.part", "drive-10.mp4",
+                           "drive-x.mp4", "drive.mkv", "drives-3.mp4"}) {
+    dir.write(name, std::string(1000, 'x'));
+  }
+  const auto family = render::numberedFiles(dir / "drive.mp4");
+  std::vector<std::string> names;
+  for (const auto& file : family) names.push_back(file.path.filename().string());
+  EXPECT_THAT(names, ::testing::ElementsAre("drive.mp4", "drive-1.mp4", "drive-2.mp4.part",
+                                            "drive-10.mp4"));
+  // Three kept, the one being written (drive-11, not there yet as a finished file) among them.
+  dir.write("drive-11.mp4.part", "being written");
+  const auto removed = render::retainNewest({dir / "drive.mp4", 3, 0}, dir / "drive-11.mp4");
+  EXPECT_EQ(removed.size(), 2U);
+  EXPECT_FALSE(std::filesystem::exists(dir / "drive.mp4"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "drive-1.mp4"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "drive-2.mp4.part"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "drive-11.mp4.part"));
+  // 1500 bytes together: of the two finished 1000-byte files, only the newer stays.
+  EXPECT_EQ(render::retainNewest({dir / "drive.mp4", 0, 1500}, dir / "drive-11.mp4").size(), 1U);
+  EXPECT_TRUE(std::filesystem::exists(dir / "drive-10.mp4"));
+  // Other names are no part of it.
+  for (const char* other : {"drive-x.mp4", "drive.mkv", "drives-3.mp4"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir / other)) << other;
+  }
+}
+
+// Ten runs of a video output with keep_last: 3, and a segmented one with keep_last: 2: what stays
+// is the newest, each whole.
+TEST(OutputFiles, RestartsAndSegmentsStayWithinTheirRetention) {
+  const testing::TempDir dir;
+  OutputConfig runs = videoOutputAt(dir / "whole.mkv");
+  runs.keepLast = 3;
+  OutputConfig segments = videoOutputAt(dir / "seg.mkv");
+  segments.segmentS = 0.25;
+  segments.keepLast = 2;
+  const Config config = fixtureReplay("synth_small", {runs, segments});
+  const std::atomic<bool> stop{false};
+  for (int run = 0; run < 10; ++run) {
+    Pipeline pipeline(config);
+    EXPECT_EQ(pipeline.run(stop).failedOutputs, 0u);
+  }
+  std::vector<std::string> kept;
+  for (const auto& file : render::numberedFiles(dir / "whole.mkv")) {
+    kept.push_back(file.path.filename().string());
+    EXPECT_GT(surroundd::testing::decodeAll(file.path).images.size(), 5u) << file.path;
+  }
+  EXPECT_THAT(kept, ::testing::ElementsAre("whole-7.mkv", "whole-8.mkv", "whole-9.mkv"));
+  const auto segmentFiles = render::numberedFiles(dir / "seg.mkv");
+  ASSERT_EQ(segmentFiles.size(), 2U);
+  EXPECT_GT(segmentFiles[0].number, 10) << "ten runs of several segments each";
+  EXPECT_EQ(segmentFiles[1].number, segmentFiles[0].number + 1);
 }
 
 }  // namespace

@@ -152,6 +152,19 @@ TEST(HttpStreamSink, MakesJpegsOnlyWhileSomeoneLooks) {
   const testing::HttpResponse response = snapshot.get();
   EXPECT_EQ(response.status, 200);
   EXPECT_GE(psnrOf(response.body, testPicture(2)), 30.0);
+
+  // Issue 50: a new stream viewer after a quiet time gets a fresh picture first, not the one
+  // from when the last viewer left.
+  std::this_thread::sleep_for(milliseconds(400));
+  HttpConnection stream(sink.port());
+  stream.send("GET /stream.mjpg HTTP/1.0\r\n\r\n");
+  EXPECT_EQ(stream.readHead().status, 200);
+  ASSERT_TRUE(eventually([&] { return sink.wantsFrame(milliseconds(133)); }));
+  std::this_thread::sleep_for(milliseconds(100));
+  sink.consume(testPicture(3), milliseconds(133));
+  const std::string first = readPart(stream);
+  EXPECT_GE(psnrOf(first, testPicture(3)), 30.0);
+  EXPECT_LT(psnrOf(first, testPicture(2)), 30.0);
 }
 
 TEST(HttpStreamSink, StatusIsWhatThePipelineLastSet) {
