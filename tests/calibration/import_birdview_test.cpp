@@ -118,11 +118,6 @@ std::vector<std::string> birdViewFiles(const TempDir& dir,
   return arguments;
 }
 
-ImportedRig importWith(const std::vector<std::string>& arguments) {
-  const std::vector<std::string_view> views(arguments.begin(), arguments.end());
-  return importRig(parseImport(views));
-}
-
 TEST(ImportBirdView, TheGeneratedFilesLayTheCanvasOutAsThatToolDoes) {
   // A smooth texture, so that warping in one step or two differs only by rounding.
   cv::Mat noise(720, 1280, CV_32FC1), picture;

@@ -142,11 +142,6 @@ std::vector<std::string> homographyFiles(const TempDir& dir,
   return arguments;
 }
 
-ImportedRig importWith(const std::vector<std::string>& arguments) {
-  const std::vector<std::string_view> views(arguments.begin(), arguments.end());
-  return importRig(parseImport(views));
-}
-
 TEST(Import, AGroundHomographyBecomesThePoseFittedOverTheGroundItCovers) {
   const TempDir dir;
   const auto truth = preset("paper.yaml");

@@ -69,9 +69,13 @@ struct ForeignFrame {
 inline const ForeignFrame kTopDown{
     "right,back,down", {0, -1, 0, -1, 0, 0, 0, 0, -1}, 0.1, 50, {0.7, -0.4, 0}};
 
-inline std::vector<daemon::RigCamera> runImport(std::vector<std::string> arguments) {
+inline ImportedRig importWith(const std::vector<std::string>& arguments) {
   const std::vector<std::string_view> views(arguments.begin(), arguments.end());
-  return importRig(parseImport(views)).cameras;
+  return importRig(parseImport(views));
+}
+
+inline std::vector<daemon::RigCamera> runImport(const std::vector<std::string>& arguments) {
+  return importWith(arguments).cameras;
 }
 
 inline std::string fileName(const CameraCalibration& camera) {
