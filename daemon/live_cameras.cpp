@@ -108,6 +108,7 @@ std::vector<RigCamera> withAutoDevices(std::vector<RigCamera> cameras,
     while (next != nodes.end() && named(*next)) ++next;
     if (next == nodes.end()) {
       std::vector<std::string> found;
+      found.reserve(nodes.size());
       for (const auto& node : nodes) found.push_back(node.path.string());
       throw std::runtime_error(fmt::format(
           "camera '{}': device auto: no V4L2 capture device is left for it (found {}{}); name "

@@ -9,7 +9,9 @@ namespace surroundd::render {
 
 VideoSink::VideoSink(VideoEncoderSettings settings, std::chrono::nanoseconds segmentLength,
                      Retention retention)
-    : settings_(std::move(settings)), segmentLength_(segmentLength), retention_(retention) {
+    : settings_(std::move(settings)),
+      segmentLength_(segmentLength),
+      retention_(std::move(retention)) {
   if (segmentLength_.count() > 0) {
     const auto present = numberedFiles(settings_.path);
     firstSegment_ = (present.empty() ? 0 : present.back().number) + 1;

@@ -139,8 +139,8 @@ std::optional<cv::Mat> matrixFromNode(const cv::FileNode& node) {
         return n.isInt() && static_cast<int>(n) >= 1 && static_cast<int>(n) <= kMaxMatrixSide;
       };
       if (!side(rows) || !side(cols) || !data.isSeq() ||
-          data.size() !=
-              static_cast<std::size_t>(static_cast<int>(rows) * static_cast<int>(cols))) {
+          data.size() != static_cast<std::size_t>(static_cast<int>(rows)) *
+                             static_cast<std::size_t>(static_cast<int>(cols))) {
         return std::nullopt;
       }
       cv::Mat matrix;
