@@ -14,6 +14,9 @@ install(FILES config/surroundd.yaml DESTINATION /etc/surroundd)
 install(FILES README.md config/surroundd.reference.yaml config/demo.yaml
         DESTINATION ${CMAKE_INSTALL_DOCDIR})
 install(DIRECTORY config/rigs DESTINATION ${CMAKE_INSTALL_DOCDIR})
+# The guide the README links to (docs/*.md and its pictures), where the README's links find it.
+install(DIRECTORY docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/docs
+        FILES_MATCHING PATTERN "*.md" PATTERN "*.png" PATTERN "man" EXCLUDE)
 install(FILES cmake/debian/copyright DESTINATION ${CMAKE_INSTALL_DOCDIR})
 # A native package's changelog, compressed as Debian policy asks (gzip -9n: reproducible).
 set(changelog ${PROJECT_BINARY_DIR}/changelog.gz)

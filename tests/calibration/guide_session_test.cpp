@@ -3,7 +3,7 @@
 // sequence by the generator and replayed through capture's FileSource into the GuideSession, as
 // the live page does. The session must pass with the focal length within 0.5 % and the principal
 // point within 1 px of the truth, and say what is missing before it is there. The views and
-// stream time it took are recorded (README: "Guided calibration").
+// stream time it took are recorded (docs/calibration.md: "Guided calibration").
 
 #include "tools/calibrate/guide_session.hpp"
 
@@ -93,7 +93,7 @@ void expectPassedNearTruth(const Replay& run, const processing::Intrinsics& trut
   EXPECT_NEAR(lens.cx, truth.cx, 1.0);
   EXPECT_NEAR(lens.cy, truth.cy, 1.0);
   const double streamS = std::chrono::duration<double>(run.streamTime).count();
-  // What the README quotes.
+  // What docs/calibration.md quotes.
   std::cout << fmt::format(
       "{}: passed after {} views, {:.1f} s of stream ({:.1f} s wall here); fx {:+.3f} %, fy "
       "{:+.3f} %, cx {:+.2f} px, cy {:+.2f} px, RMS {:.3f} px (sd fx {:.3f} px, cx {:.3f} px)\n",

@@ -199,7 +199,7 @@ TEST(MatCli, MissingPicturesAndOptionsThatDoNotGoTogether) {
                  "--markers, --points and --residuals do not go with it");
 }
 
-// The README's example is the mat the generator lays around the fisheye preset, and reads back.
+// docs/calibration.md's example is the mat the generator lays around the fisheye preset, and reads back.
 TEST(MatCli, TheExampleMatIsTheGeneratorsForTheFisheyeRig) {
   const auto example = calibrate::loadMatFile(std::string(SURROUNDD_SOURCE_DIR) +
                                               "/config/mats/four-corner-mat.yaml");

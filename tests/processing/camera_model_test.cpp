@@ -169,7 +169,7 @@ TEST(CameraModel, FisheyeUnprojectInvertsProjectPastNinetyDegrees) {
   expectRoundTrip(CameraModel(fisheye()), 95);
 }
 
-// The README's formula, written out as it reads (Z > 0 only).
+// The formula ../shared/data/README.md gives, written out as it reads (Z > 0 only).
 cv::Point2d readmeProjection(const Intrinsics& in, const cv::Vec3d& point) {
   const double x = point[0] / point[2];
   const double y = point[1] / point[2];
