@@ -18,19 +18,31 @@ build/release/tools/synth/surround-synth --rig config/rigs/paper.yaml --out reco
 build/release/daemon/surroundd --config config/demo.yaml "$@" &
 daemon=$!
 # The rear view with its guidelines (issue 21), after the snapshots at 5 s: the car in reverse
-# with the wheel turned a turn left, straight and a turn right, each snapshot once the 0.4 s
-# switch of view is over.
+# with the wheel turned a turn left, straight and a turn right, each snapshot once the pictures
+# show it: six frame sets after the signal (its view rule is applied within one), and no switch of
+# view under way (the daemon's status says "view switch: under way" until the new view has
+# settled), however long a loaded machine takes.
 ctl() { build/release/tools/surroundctl/surroundctl --socket out/demo/control.sock "$@"; }
-sets=0
-while kill -0 "$daemon" 2>/dev/null && [ "$sets" -lt 180 ]; do
-  sleep 0.2
-  sets=$(ctl status 2>/dev/null | sed -n '1s/^\([0-9]*\) frame sets.*/\1/p')
-  sets=${sets:-0}
-done
+setsIn() { echo "$1" | sed -n '1s/^\([0-9]*\) frame sets.*/\1/p'; }
+# Waits until the daemon has made frame set $1 and no switch of view is under way; 1 when the
+# replay ends first.
+waitFor() {
+  while kill -0 "$daemon" 2>/dev/null; do
+    status=$(ctl status 2>/dev/null) || status=""
+    sets=$(setsIn "$status")
+    if [ "${sets:-0}" -ge "$1" ] && ! echo "$status" | grep -q "view switch: under way"; then
+      return 0
+    fi
+    sleep 0.1
+  done
+  return 1
+}
+waitFor 180 || true
 for turn in left:360 straight:0 right:-360; do
   name=${turn%%:*}
-  if ctl signal gear=R "steering_deg=${turn#*:}" >/dev/null 2>&1 && sleep 0.8 &&
-    ctl snapshot "out/demo/rear-$name.png" >/dev/null 2>&1; then :; else
+  sets=$(setsIn "$(ctl status 2>/dev/null)")
+  if ctl signal gear=R "steering_deg=${turn#*:}" >/dev/null 2>&1 &&
+    waitFor $((${sets:-0} + 6)) && ctl snapshot "out/demo/rear-$name.png" >/dev/null 2>&1; then :; else
     echo "demo: no out/demo/rear-$name.png: the replay ended first"
   fi
 done

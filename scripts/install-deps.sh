@@ -1,6 +1,9 @@
 #!/bin/sh
-# Installs the Debian 12 packages surroundd needs to build, test and run. Idempotent: installs only
-# what is missing and says what that is. Runs apt-get as root, or through sudo.
+# Installs the Debian 12 packages surroundd needs to build and run (what scripts/demo.sh needs).
+# Idempotent: installs only what is missing and says what that is. Runs apt-get as root, or
+# through sudo.
+# --tests: also what the test suite needs (GoogleTest, Xvfb, lintian and help2man for the package,
+#   OpenCV's sample pictures, Chromium and Node.js for the browser tests): scripts/test.sh.
 # --fuzz: also clang and its sanitizer runtimes, for scripts/fuzz.sh (libFuzzer).
 # --soak: also gnuplot, for scripts/soak.sh's plot.
 # --cross-arm64: also the aarch64 cross compiler, qemu-user and mmdebstrap, for
@@ -15,25 +18,27 @@ PACKAGES="
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   libsuitesparse-dev libeigen3-dev
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
-  libx11-dev libxext-dev xvfb libdrm-dev libgbm-dev
+  libx11-dev libxext-dev libdrm-dev libgbm-dev
   libturbojpeg0-dev libcamera-dev libsystemd-dev
-  libgtest-dev libgmock-dev opencv-doc help2man lintian python3
-  libmicrohttpd-dev chromium
+  libmicrohttpd-dev python3
   libgstrtspserver-1.0-dev gstreamer1.0-plugins-base gstreamer1.0-plugins-good
 "
+TEST_PACKAGES="libgtest-dev libgmock-dev xvfb opencv-doc help2man lintian chromium"
+tests=no
 
 for argument in "$@"; do
   case "$argument" in
+    --tests) tests=yes; PACKAGES="$PACKAGES $TEST_PACKAGES" ;;
     --fuzz) PACKAGES="$PACKAGES clang libclang-rt-dev" ;;
     --soak) PACKAGES="$PACKAGES gnuplot-nox" ;;
     --cross-arm64) PACKAGES="$PACKAGES crossbuild-essential-arm64 qemu-user-static mmdebstrap" ;;
     --device-vm) PACKAGES="$PACKAGES qemu-system-x86 busybox-static kmod cpio" ;;
-    *) echo "usage: scripts/install-deps.sh [--fuzz] [--soak] [--cross-arm64] [--device-vm]" >&2; exit 2 ;;
+    *) echo "usage: scripts/install-deps.sh [--tests] [--fuzz] [--soak] [--cross-arm64] [--device-vm]" >&2; exit 2 ;;
   esac
 done
 
 # Node.js drives the browser test; Debian's is enough where none is installed.
-if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+if [ "$tests" = yes ] && { ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; }; then
   PACKAGES="$PACKAGES nodejs npm"
 fi
 

@@ -46,9 +46,9 @@ begin "dependencies"
 # With what runs the tests that need a KMS screen, V4L2 cameras or a CAN bus on a virtual
 # machine that has them, and Debian's kernel for it.
 if [ "$fuzzSeeds" = yes ]; then
-  scripts/install-deps.sh --device-vm --fuzz
+  scripts/install-deps.sh --tests --device-vm --fuzz
 else
-  scripts/install-deps.sh --device-vm
+  scripts/install-deps.sh --tests --device-vm
 fi
 scripts/device-vm.sh fetch || echo "test: no kernel for the device machine: its tests will say so"
 end "dependencies"
