@@ -48,6 +48,10 @@ render::EglContext& presentingRenderer(const OutputContext& context, render::Egl
 // `listen: ADDRESS:PORT` of the types that serve (http, rtsp), `defaultPort` when absent; and the
 // rule that two of a type cannot listen on one port (listen_key.cpp).
 ConfigKey<OutputConfig> listenKey(int defaultPort);
+// Who may watch a server's output (render::Credentials, read when the config is).
+ConfigKey<OutputConfig> passwordFileKey();
+// A server listening beyond 127.0.0.0/8 must say who may watch (an error on `listen` otherwise).
+void requireCredentialsBeyondThisMachine(YamlObject& item, const OutputConfig& o);
 std::optional<OutputConflict> sharesPort(const OutputConfig& earlier, const OutputConfig& output);
 
 }  // namespace surroundd::daemon

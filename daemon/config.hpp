@@ -26,6 +26,7 @@
 #include "render/car_model.hpp"
 #include "render/egl_context.hpp"
 #include "render/guidelines.hpp"
+#include "render/outputs/credentials.hpp"
 #include "render/view_camera.hpp"
 #include "vehicle/can_signal_reader.hpp"
 #include "vehicle/vehicle_signals.hpp"
@@ -231,6 +232,7 @@ struct OutputConfig {
   int listenPort = 8080;
   int jpegQuality = 80;
   std::vector<std::string> allowedHosts;  // host names it answers to besides IPs and localhost
+  std::optional<render::Credentials> credentials;  // who may watch; required beyond loopback
   // rtsp: H.264 served at rtsp://<listen>/<rtspName> (listen's default port there: 8554)
   std::string rtspName;  // empty: what it shows (surround, panorama, mosaic)
   // window (X11)

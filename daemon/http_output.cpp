@@ -21,6 +21,7 @@ std::unique_ptr<render::FrameSink> openHttp(const OutputConfig& output,
   settings.port = output.listenPort;
   settings.jpegQuality = output.jpegQuality;
   settings.allowedHosts = output.allowedHosts;
+  settings.credentials = output.credentials;
   if (output.stream == OutputStream::kSurround) {
     for (const auto& [name, kind] : render::kViewNames) settings.views.emplace_back(name);
     settings.initialView = toString(output.view.value_or(ViewKind::kOrbit));
@@ -40,7 +41,9 @@ OutputType httpOutputType() {
       listenKey(8080),
       Key::integer("quality", &OutputConfig::jpegQuality, 1, 100, "JPEG quality"),
       Key::names("allowed_hosts", &OutputConfig::allowedHosts, 0, 32, "host names it answers to"),
+      passwordFileKey(),
   };
+  type.readSettings = requireCredentialsBeyondThisMachine;
   type.conflict = sharesPort;
   type.openPictureSink = openHttp;
   return type;

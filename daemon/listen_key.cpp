@@ -1,11 +1,13 @@
-// The `listen` key of the output types that serve (http, rtsp), and the rule that two of them
-// cannot listen on one port.
+// The `listen` and `password_file` keys of the output types that serve (http, rtsp), the rule that
+// two of them cannot listen on one port, and the one that a server reachable beyond this machine
+// asks who is watching.
 #include <charconv>
 
 #include <arpa/inet.h>
 #include <fmt/format.h>
 
 #include "daemon/built_in_outputs.hpp"
+#include "render/outputs/credentials.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -43,6 +45,35 @@ ConfigKey<OutputConfig> listenKey(int defaultPort) {
       "listen", "the address and port it listens on",
       [defaultPort](YamlObject& item, OutputConfig& o) { readListen(item, o, defaultPort); },
       sameListen, {}, defaultPort == OutputConfig{}.listenPort ? Shown::kDefault : Shown::kExample);
+}
+
+ConfigKey<OutputConfig> passwordFileKey() {
+  return ConfigKey<OutputConfig>::custom(
+      "password_file", "who may watch: a file with USER:PASSWORD on its first line (chmod 600)",
+      [](YamlObject& item, OutputConfig& o) {
+        if (!item.has("password_file")) return;
+        const auto file = item.existingFile("password_file");
+        if (!file) return;
+        try {
+          o.credentials = render::readCredentialsFile(*file);
+        } catch (const std::runtime_error& error) {
+          item.error("password_file", error.what());
+        }
+      },
+      [](const OutputConfig& a, const OutputConfig& b) { return a.credentials == b.credentials; },
+      {}, Shown::kExample);
+}
+
+void requireCredentialsBeyondThisMachine(YamlObject& item, const OutputConfig& o) {
+  // A password_file given but refused has said so already.
+  if (o.credentials || item.has("password_file") || render::isLoopbackAddress(o.listenAddress)) {
+    return;
+  }
+  item.error("listen",
+             fmt::format("listens on {}, beyond this machine, and no password_file says who may "
+                         "watch: anyone on the vehicle's networks would see its cameras; give a "
+                         "password_file (USER:PASSWORD, chmod 600), or listen on 127.0.0.1",
+                         o.listenAddress));
 }
 
 // Two servers cannot listen on one port of one address (0.0.0.0 is every address).

@@ -64,12 +64,14 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
   std::vector<std::pair<std::string, std::uint64_t>> preloadedBytes;  // per camera so far
   // The replayed cameras play on one clock, as cameras triggered together would deliver.
   const auto replayStart = std::make_shared<capture::ReplayStart>();
-  // After what the threads use: should one camera fail, the others' futures wait for their
-  // threads as they go, before the rest of this function's locals.
-  std::vector<std::future<Opened>> opening;
+  // The cameras the threads read, `device: auto` given its device: declared before the futures,
+  // so that it outlives them.
   std::vector<std::string> said;
   const std::vector<RigCamera> rig = withAutoDevices(config.cameras, said);
   for (const auto& line : said) spdlog::info("{}", line);
+  // After what the threads use: should one camera fail, the others' futures wait for their
+  // threads as they go, before the rest of this function's locals.
+  std::vector<std::future<Opened>> opening;
   const auto inTurn = [](auto open) {
     std::promise<Opened> opened;
     try {

@@ -35,6 +35,7 @@ std::string streamName(const OutputConfig& output) {
 // One path segment a player's URL needs no escaping for.
 void checkRtsp(YamlObject& item, OutputConfig& o) {
   checkEncoder(item, o);
+  requireCredentialsBeyondThisMachine(item, o);
   const bool plain = std::all_of(o.rtspName.begin(), o.rtspName.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_' || c == '.';
   });
@@ -51,6 +52,7 @@ std::unique_ptr<render::FrameSink> openRtsp(const OutputConfig& output,
   settings.port = output.listenPort;
   settings.name = streamName(output);
   settings.video = encoderSettings(output, context);
+  settings.credentials = output.credentials;
   auto sink = std::make_unique<render::RtspStreamSink>(std::move(settings));
   spdlog::info("RTSP stream: {}", sink->url());
   return queuedSink(std::move(sink), context, kEncoderQueue);
@@ -70,6 +72,7 @@ OutputType rtspOutputType() {
       crfKey(),
       presetKey(),
       pixelFormatKey(),
+      passwordFileKey(),
   };
   type.readSettings = checkRtsp;
   type.conflict = sharesPort;  // one server per output

@@ -138,10 +138,12 @@ bool isSameOrigin(std::string_view origin, std::string_view host) {
 
 HttpServer::HttpServer(std::string name, const std::string& address, int port,
                        std::vector<std::string> allowedHosts,
-                       std::chrono::milliseconds headerTimeout, Handler handler)
+                       std::chrono::milliseconds headerTimeout,
+                       std::optional<Credentials> credentials, Handler handler)
     : name_(std::move(name)),
       allowedHosts_(std::move(allowedHosts)),
       headerTimeout_(headerTimeout),
+      credentials_(std::move(credentials)),
       handler_(std::move(handler)) {
   const int fd = listenOn(name_, address, port, port_);
   daemon_ = MHD_start_daemon(
@@ -233,6 +235,16 @@ void HttpServer::cutOffSlowHeaders() {
   }
 }
 
+bool HttpServer::authorized(MHD_Connection* connection) const {
+  char* password = nullptr;
+  char* user = MHD_basic_auth_get_username_password(connection, &password);
+  const bool match =
+      user != nullptr && password != nullptr && credentialsMatch(*credentials_, user, password);
+  MHD_free(user);
+  MHD_free(password);
+  return match;
+}
+
 MHD_Result HttpServer::onRequest(void* cls, MHD_Connection* connection, const char* url,
                                  const char* method, const char* /*version*/,
                                  const char* /*uploadData*/, size_t* uploadDataSize,
@@ -262,6 +274,10 @@ MHD_Result HttpServer::onRequest(void* cls, MHD_Connection* connection, const ch
         (host == nullptr || !isSameOrigin(origin, host))) {
       state->answered = true;
       return reply(connection, MHD_HTTP_FORBIDDEN, "cross-origin request refused\n");
+    }
+    if (self->credentials_ && !self->authorized(connection)) {
+      state->answered = true;
+      return askForCredentials(connection);
     }
     std::uint64_t declared = 0;
     const char* length =
@@ -324,6 +340,18 @@ MHD_Result replyNotAllowed(MHD_Connection* connection, const char* allowed) {
       MHD_create_response_from_buffer(0, const_cast<char*>(""), MHD_RESPMEM_PERSISTENT);
   if (response != nullptr) MHD_add_response_header(response, MHD_HTTP_HEADER_ALLOW, allowed);
   return queue(connection, MHD_HTTP_METHOD_NOT_ALLOWED, response, "text/plain; charset=utf-8");
+}
+
+MHD_Result askForCredentials(MHD_Connection* connection) {
+  constexpr std::string_view kText = "this server asks for a user name and password\n";
+  MHD_Response* response = MHD_create_response_from_buffer(
+      kText.size(), const_cast<char*>(kText.data()), MHD_RESPMEM_PERSISTENT);
+  if (response == nullptr) return MHD_NO;
+  MHD_add_response_header(response, MHD_HTTP_HEADER_CONTENT_TYPE, "text/plain; charset=utf-8");
+  MHD_add_response_header(response, "X-Content-Type-Options", "nosniff");
+  const MHD_Result result = MHD_queue_basic_auth_fail_response(connection, "surroundd", response);
+  MHD_destroy_response(response);
+  return result;
 }
 
 }  // namespace surroundd::render

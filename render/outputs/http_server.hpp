@@ -8,7 +8,8 @@
 // a URL over 4 KiB (414), a body over 1 KiB (413), a Host that is neither an IP address,
 // "localhost" nor one of the allowed host names (421: a web page cannot reach the server through
 // DNS rebinding; no Host at all is an HTTP/1.0 client, not a browser), and a request other than GET
-// or HEAD from another origin (403: no cross-site requests); every answer says
+// or HEAD from another origin (403: no cross-site requests), and, where it has credentials, a
+// request without their user and password (401, HTTP basic authentication); every answer says
 // "X-Content-Type-Options: nosniff". Every other request, once its body is in (and dropped), goes
 // to the handler on that connection's thread.
 //
@@ -29,6 +30,8 @@
 #include <vector>
 
 #include <microhttpd.h>
+
+#include "render/outputs/credentials.hpp"
 
 namespace surroundd::render {
 
@@ -55,7 +58,7 @@ class HttpServer {
   // `name` starts messages ("HTTP stream"); `port` 0 picks a free one (see port()).
   HttpServer(std::string name, const std::string& address, int port,
              std::vector<std::string> allowedHosts, std::chrono::milliseconds headerTimeout,
-             Handler handler);
+             std::optional<Credentials> credentials, Handler handler);
   ~HttpServer();  // stop()
   HttpServer(const HttpServer&) = delete;
   HttpServer& operator=(const HttpServer&) = delete;
@@ -73,10 +76,12 @@ class HttpServer {
   static void onConnection(void* cls, MHD_Connection* connection, void** socketContext,
                            MHD_ConnectionNotificationCode code);
   void cutOffSlowHeaders();
+  bool authorized(MHD_Connection* connection) const;  // the request carries credentials_
 
   std::string name_;
   std::vector<std::string> allowedHosts_;
   std::chrono::milliseconds headerTimeout_;
+  std::optional<Credentials> credentials_;
   Handler handler_;
   int port_ = 0;
 
@@ -109,5 +114,7 @@ MHD_Result reply(MHD_Connection* connection, unsigned status, std::string_view t
                  const char* contentType = "text/plain; charset=utf-8");
 // 405 with an Allow header.
 MHD_Result replyNotAllowed(MHD_Connection* connection, const char* allowed);
+// 401 asking for HTTP basic authentication (realm "surroundd").
+MHD_Result askForCredentials(MHD_Connection* connection);
 
 }  // namespace surroundd::render

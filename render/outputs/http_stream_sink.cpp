@@ -109,7 +109,7 @@ struct HttpStreamSink::Impl {
         encoder(settings.jpegQuality),
         activeView(settings.initialView),
         server("HTTP stream", settings.address, settings.port, settings.allowedHosts,
-               settings.headerTimeout,
+               settings.headerTimeout, settings.credentials,
                [this](MHD_Connection* connection, std::string_view path, std::string_view method) {
                  return route(connection, path, method);
                }) {}

@@ -43,6 +43,8 @@ struct HttpStreamSettings {
   std::string initialView;  // the view shown first, marked on the page; empty or one of `views`
   // Host names (besides IP addresses and localhost) the server answers to; see HttpServer.
   std::vector<std::string> allowedHosts;
+  // Who may watch (HTTP basic authentication); none: anyone who reaches the address.
+  std::optional<Credentials> credentials;
   std::chrono::milliseconds headerTimeout = kHeaderTimeout;  // for a whole request head
   // Another program's page on the same stream (surround-calibrate guide): the HTML served at "/"
   // (static, self-contained; empty: livePage()) and the path of setStatus()'s JSON.

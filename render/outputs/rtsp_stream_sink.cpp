@@ -152,6 +152,22 @@ void RtspStreamSink::Impl::listen() {
   gst_rtsp_media_factory_set_launch(factory, kLaunch);
   gst_rtsp_media_factory_set_shared(factory, TRUE);
   g_signal_connect(factory, "media-configure", G_CALLBACK(onMediaConfigure), this);
+  if (settings.credentials) {
+    // gst-rtsp-server's basic authentication: a client that does not send the user and password
+    // gets 401 and sees nothing of the stream; the user's token gives it the factory's role.
+    const GObjectPtr<GstRTSPAuth> auth(gst_rtsp_auth_new());
+    gchar* basic = gst_rtsp_auth_make_basic(settings.credentials->user.c_str(),
+                                            settings.credentials->password.c_str());
+    GstRTSPToken* token =
+        gst_rtsp_token_new(GST_RTSP_TOKEN_MEDIA_FACTORY_ROLE, G_TYPE_STRING, "viewer", nullptr);
+    gst_rtsp_auth_add_basic(auth.get(), basic, token);
+    g_free(basic);
+    gst_rtsp_token_unref(token);
+    gst_rtsp_media_factory_add_role(factory, "viewer", GST_RTSP_PERM_MEDIA_FACTORY_ACCESS,
+                                    G_TYPE_BOOLEAN, TRUE, GST_RTSP_PERM_MEDIA_FACTORY_CONSTRUCT,
+                                    G_TYPE_BOOLEAN, TRUE, nullptr);
+    gst_rtsp_server_set_auth(s, auth.get());
+  }
   const GObjectPtr<GstRTSPMountPoints> mounts(gst_rtsp_server_get_mount_points(s));
   gst_rtsp_mount_points_add_factory(mounts.get(), ("/" + settings.name).c_str(), factory);
   g_signal_connect(s, "client-connected", G_CALLBACK(onClientConnected), this);

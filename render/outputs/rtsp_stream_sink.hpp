@@ -17,8 +17,10 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
+#include "render/outputs/credentials.hpp"
 #include "render/outputs/frame_sink.hpp"
 #include "render/outputs/video_encoder.hpp"
 
@@ -30,6 +32,8 @@ struct RtspStreamSettings {
   std::string name = "surround";    // the path: rtsp://ADDRESS:PORT/<name>
   // The pictures' size and rate, encoder, crf, preset, pixel format (path and url unused).
   VideoEncoderSettings video;
+  // Who may watch (RTSP basic authentication); none: anyone who reaches the address.
+  std::optional<Credentials> credentials;
 };
 
 class RtspStreamSink final : public FrameSink {

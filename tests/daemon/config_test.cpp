@@ -171,21 +171,45 @@ TEST_F(ConfigTest, SegmentedVideoNetworkStreamAndTheControlSocket) {
                  "  - {type: network, url: \"udp://127.0.0.1:5600\", encoder: mjpeg}",
                  {"outputs[1].encoder: 'mjpeg' does not encode H.264"});
   EXPECT_EQ(config.control.socket, dir_ / "run/control.sock");
+  // Beyond this machine only with a password file (issue 50), read as the config is.
+  dir_.write("viewers.pw", "driver:correct horse battery\n");
+  std::filesystem::permissions(dir_ / "viewers.pw", std::filesystem::perms::owner_read |
+                                                        std::filesystem::perms::owner_write);
   const Config pages = loadConfig(
       configWith("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
-                 "  - {type: http, stream: surround, listen: \"0.0.0.0:9000\", quality: 60}\n"
+                 "  - {type: http, stream: surround, listen: \"0.0.0.0:9000\", quality: 60,\n"
+                 "     password_file: viewers.pw}\n"
                  "  - {type: window, display: \":3\", title: rig}\n"
                  "  - {type: http, stream: mosaic}\n"
                  "  - {type: display, stream: surround, device: /dev/dri/card1, "
                  "connector: HDMI-A-1}\n"
                  "  - {type: rtsp, stream: surround}\n"
                  "  - {type: rtsp, stream: mosaic, listen: \"0.0.0.0:9554\", name: cameras, "
-                 "crf: 30}"));
+                 "crf: 30, password_file: viewers.pw}"));
   ASSERT_EQ(pages.outputs.size(), 7u);
   EXPECT_EQ(pages.outputs[1].kind, OutputKind::kHttp);
   EXPECT_EQ(pages.outputs[1].listenAddress, "0.0.0.0");
   EXPECT_EQ(pages.outputs[1].listenPort, 9000);
   EXPECT_EQ(pages.outputs[1].jpegQuality, 60);
+  ASSERT_TRUE(pages.outputs[1].credentials.has_value());
+  EXPECT_EQ(pages.outputs[1].credentials->user, "driver");
+  EXPECT_EQ(pages.outputs[1].credentials->password, "correct horse battery");
+  EXPECT_EQ(pages.outputs[6].credentials, pages.outputs[1].credentials);
+  EXPECT_FALSE(pages.outputs[3].credentials.has_value());  // 127.0.0.1: none asked
+  expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "  - {type: http, listen: \"0.0.0.0:9000\"}",
+                 {"outputs[1].listen: listens on 0.0.0.0, beyond this machine, and no "
+                  "password_file says who may watch"});
+  expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "  - {type: rtsp, listen: \"192.168.1.5:8554\"}",
+                 {"outputs[1].listen: listens on 192.168.1.5, beyond this machine"});
+  std::filesystem::permissions(dir_ / "viewers.pw", std::filesystem::perms::group_read,
+                               std::filesystem::perm_options::add);
+  expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                 "  - {type: http, listen: \"0.0.0.0:9000\", password_file: viewers.pw}",
+                 {"outputs[1].password_file: ",
+                  "viewers.pw: others than its owner may read or "
+                  "change it (mode 640): chmod 600 it"});
   EXPECT_EQ(pages.outputs[2].kind, OutputKind::kWindow);
   EXPECT_EQ(pages.outputs[2].display, ":3");
   EXPECT_EQ(pages.outputs[2].title, "rig");

@@ -51,9 +51,12 @@ TEST_F(ConfigTest, AVideoInsideARecordingAndTwoHttpOutputsOnOnePortAreRefused) {
   expectOneError("{type: snapshot, path: out/mosaic.png, at_s: 0.5}",
                  "{type: recording, path: out}",
                  {"outputs[1].path: '", "out/mosaic.mp4' is inside the recording folder '"});
+  dir_.write("viewers.pw", "driver:correct horse battery\n");
+  std::filesystem::permissions(dir_ / "viewers.pw", std::filesystem::perms::owner_read |
+                                                        std::filesystem::perms::owner_write);
   expectOneError("{type: snapshot, path: out/mosaic.png, at_s: 0.5}",
                  "{type: http, listen: \"127.0.0.1:8081\"}\n"
-                 "  - {type: http, listen: \"0.0.0.0:8081\"}",
+                 "  - {type: http, listen: \"0.0.0.0:8081\", password_file: viewers.pw}",
                  {"outputs[2].listen: outputs[1] listens on port 8081 already"});
   const std::string socket(120, 's');
   std::string text(kGoodConfig);

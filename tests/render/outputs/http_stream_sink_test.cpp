@@ -167,6 +167,35 @@ TEST(HttpStreamSink, MakesJpegsOnlyWhileSomeoneLooks) {
   EXPECT_LT(psnrOf(first, testPicture(2)), 30.0);
 }
 
+// Issue 50: with credentials, every request without their user and password is answered 401
+// asking for them (HTTP basic authentication), the stream and the page alike.
+TEST(HttpStreamSink, WithCredentialsOnlyTheirUserAndPasswordSeeAnything) {
+  HttpStreamSettings settings = testSettings();
+  settings.credentials = Credentials{"driver", "correct horse battery"};
+  HttpStreamSink sink(settings);
+  sink.consume(testPicture(1), nanoseconds(0));
+  const auto ask = [&](std::string_view target, std::string_view authorization) {
+    std::string request = fmt::format("GET {} HTTP/1.0\r\nHost: 127.0.0.1\r\n", target);
+    if (!authorization.empty())
+      request += fmt::format("Authorization: Basic {}\r\n", authorization);
+    return testing::httpExchange(sink.port(), request + "\r\n");
+  };
+  // base64 of "driver:correct horse battery" and of "driver:wrong horse battery".
+  constexpr std::string_view kRight = "ZHJpdmVyOmNvcnJlY3QgaG9yc2UgYmF0dGVyeQ==";
+  constexpr std::string_view kWrong = "ZHJpdmVyOndyb25nIGhvcnNlIGJhdHRlcnk=";
+  for (const char* target : {"/", "/snapshot.jpg", "/status.json", "/stream.mjpg"}) {
+    const auto refused = ask(target, "");
+    EXPECT_EQ(refused.status, 401) << target;
+    EXPECT_THAT(refused.headers, HasSubstr("WWW-Authenticate: Basic realm=\"surroundd\""))
+        << target;
+    EXPECT_EQ(ask(target, kWrong).status, 401) << target;
+  }
+  const auto snapshot = ask("/snapshot.jpg", kRight);
+  EXPECT_EQ(snapshot.status, 200);
+  EXPECT_GE(psnrOf(snapshot.body, testPicture(1)), 30.0);
+  EXPECT_EQ(ask("/", kRight).status, 200);
+}
+
 TEST(HttpStreamSink, StatusIsWhatThePipelineLastSet) {
   HttpStreamSink sink(testSettings());
   EXPECT_EQ(httpRequest(sink.port(), "GET", "/status.json").body, "{}");

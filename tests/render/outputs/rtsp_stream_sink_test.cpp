@@ -189,11 +189,10 @@ int connectLoopback(int port) {
 
 // The status line of the server's answer to an OPTIONS request, or what went wrong, within
 // `limit`.
-std::string optionsAnswer(int port, milliseconds limit) {
+// The status line of the server's answer to `request`.
+std::string answerTo(int port, const std::string& request, milliseconds limit) {
   const int fd = connectLoopback(port);
   if (fd < 0) return "cannot connect";
-  const std::string request =
-      fmt::format("OPTIONS rtsp://127.0.0.1:{}/surround RTSP/1.0\r\nCSeq: 1\r\n\r\n", port);
   [[maybe_unused]] const auto sent = ::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
   std::string answer;
   const auto deadline = std::chrono::steady_clock::now() + limit;
@@ -215,6 +214,42 @@ std::string optionsAnswer(int port, milliseconds limit) {
   }
   ::close(fd);
   return answer.substr(0, answer.find("\r\n"));
+}
+
+std::string optionsAnswer(int port, milliseconds limit) {
+  return answerTo(
+      port, fmt::format("OPTIONS rtsp://127.0.0.1:{}/surround RTSP/1.0\r\nCSeq: 1\r\n\r\n", port),
+      limit);
+}
+
+// Issue 50: with credentials, a player without their user and password is refused (401) and one
+// with them is described the stream.
+TEST(RtspStreamSink, WithCredentialsOnlyTheirUserAndPasswordAreServed) {
+  RtspStreamSettings settings = settingsOnAnyPort();
+  settings.credentials = Credentials{"driver", "correct horse battery"};
+  RtspStreamSink sink(settings);
+  const auto describe = [&](std::string_view authorization) {
+    std::string request = fmt::format(
+        "DESCRIBE rtsp://127.0.0.1:{}/surround RTSP/1.0\r\nCSeq: 2\r\nAccept: "
+        "application/sdp\r\n",
+        sink.port());
+    if (!authorization.empty())
+      request += fmt::format("Authorization: Basic {}\r\n", authorization);
+    return answerTo(sink.port(), request + "\r\n", milliseconds(5000));
+  };
+  EXPECT_THAT(describe(""), HasSubstr("401"));
+  // base64 of "driver:wrong horse battery" and of "driver:correct horse battery".
+  EXPECT_THAT(describe("ZHJpdmVyOndyb25nIGhvcnNlIGJhdHRlcnk="), HasSubstr("401"));
+  // The stream is made once asked for: pictures come meanwhile, as an output queue hands them.
+  std::atomic<bool> described{false};
+  std::jthread pictures([&](const std::stop_token& stop) {
+    feed(sink, 0, [&](int) { return stop.stop_requested() || described.load(); });
+  });
+  EXPECT_THAT(describe("ZHJpdmVyOmNvcnJlY3QgaG9yc2UgYmF0dGVyeQ=="), HasSubstr("200 OK"));
+  described = true;
+  pictures.request_stop();
+  pictures.join();
+  sink.finish({}, {});
 }
 
 // Issue 51: one connection sending a 1 MB request line stopped gst-rtsp-server's thread for
