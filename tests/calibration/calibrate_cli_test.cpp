@@ -311,6 +311,35 @@ TEST(CalibrateCli, GuideInABuildWithoutItsPageSaysHowToBuildIt) {
   EXPECT_THAT(run.output, Not(HasSubstr("failed")));
 }
 
+// Issue 50: a guide's page served beyond this machine asks who may see it, as the daemon's do.
+TEST(CalibrateCli, AGuidePageBeyondThisMachineNeedsAPasswordFile) {
+  if (!SURROUNDD_GUIDE_BUILT) GTEST_SKIP() << "this build has no guide (SURROUNDD_WITH_HTTP off)";
+  const TempDir dir;
+  const std::vector<std::string> guide{"guide",
+                                       "--board",
+                                       "9x6",
+                                       "--model",
+                                       "fisheye",
+                                       "--out",
+                                       (dir / "lens.yaml").string(),
+                                       "--file",
+                                       (dir / "session_%04d.png").string(),
+                                       "--listen",
+                                       "0.0.0.0:0"};
+  expectFailure(calibrate(dir, guide), 2,
+                "surround-calibrate guide: --listen: 0.0.0.0 is beyond this machine: give "
+                "--password-file FILE");
+  const auto file = dir.write("viewers.pw", "driver:correct horse battery\n");
+  std::filesystem::permissions(file, std::filesystem::perms::owner_read |
+                                         std::filesystem::perms::owner_write |
+                                         std::filesystem::perms::group_read);
+  auto withFile = guide;
+  withFile.insert(withFile.end(), {"--password-file", file.string()});
+  expectFailure(calibrate(dir, withFile), 2,
+                "surround-calibrate guide: --password-file: " + file.string() +
+                    ": others than its owner may read or change it (mode 640): chmod 600 it");
+}
+
 TEST(CalibrateCli, UsageErrorsNameTheOption) {
   const TempDir dir;
   const CalibrateRun version = calibrate(dir, {"--version"});  // issue 50

@@ -18,6 +18,7 @@
 
 #include "processing/calibration/mat_calibration.hpp"
 #include "processing/camera_model.hpp"
+#include "render/outputs/credentials.hpp"
 #include "tools/calibrate/guide_options.hpp"
 #include "tools/calibrate/import_options.hpp"
 #include "tools/calibrate/intrinsics_options.hpp"
@@ -80,10 +81,14 @@ IntrinsicsOptions parseLensOptions(std::span<const std::string_view> arguments, 
 // The mat calibration's limits (--min-corners, --max-rms-px, --max-shift-m, --max-turn-deg,
 // --max-seam-cm) and --inlier-px, of extrinsics --mat and guide --mat.
 Handlers matLimitHandlers(processing::MatLimits& limits, double& inlierPx);
-// A guide's camera request and page: --size WxH (sets `sizeGiven`), --fps, --listen ADDR:PORT; of
-// guide and guide --mat. Defined in guide_options.cpp.
+// A guide's camera request and page: --size WxH (sets `sizeGiven`), --fps, --listen ADDR:PORT,
+// --password-file FILE; of guide and guide --mat. Defined in guide_options.cpp.
 Handlers cameraAndPageHandlers(cv::Size& size, bool& sizeGiven, double& fps, std::string& address,
-                               int& port);
+                               int& port, std::optional<std::filesystem::path>& passwordFile);
+// Who may see a guide's page: the --password-file's user and password; none on 127.x.x.x without
+// one; UsageError for a page beyond this machine without one, or a file that cannot be used.
+std::optional<render::Credentials> pageCredentials(
+    const std::string& address, const std::optional<std::filesystem::path>& passwordFile);
 // A number in [min, max]; UsageError naming the option and `expected` otherwise.
 double parseDouble(std::string_view option, std::string_view text, double min, double max,
                    std::string_view expected);

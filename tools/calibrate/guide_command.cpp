@@ -69,7 +69,8 @@ void runGuide(const GuideOptions& options, std::ostream& log) {
   GuideSession session(settings);
   GuideRunState run;
 
-  const auto served = serveGuidePage(options.address, options.port, guidePage());
+  const auto served =
+      serveGuidePage(options.address, options.port, options.credentials, guidePage());
   render::HttpStreamSink& page = *served;
   page.setStatus(guideStateJson(session, run));
   log << fmt::format("guide page: http://{}:{}/ (reading {}; Ctrl-C stops)\n", options.address,

@@ -38,11 +38,13 @@ std::unique_ptr<capture::FrameSource> openGuideCamera(const std::string& name,
   }
 }
 
-std::unique_ptr<render::HttpStreamSink> serveGuidePage(const std::string& address, int port,
-                                                       std::string_view page) {
+std::unique_ptr<render::HttpStreamSink> serveGuidePage(
+    const std::string& address, int port, const std::optional<render::Credentials>& credentials,
+    std::string_view page) {
   render::HttpStreamSettings http;
   http.address = address;
   http.port = port;
+  http.credentials = credentials;
   http.page = page;
   http.statusPath = "/state.json";
   try {

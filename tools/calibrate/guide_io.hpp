@@ -33,8 +33,9 @@ std::unique_ptr<capture::FrameSource> openGuideCamera(const std::string& name,
 
 // Serves `page` at "/" with the picture stream and GET /state.json (setStatus()). Throws
 // UsageError for a bad --listen, std::runtime_error when it cannot listen.
-std::unique_ptr<render::HttpStreamSink> serveGuidePage(const std::string& address, int port,
-                                                       std::string_view page);
+std::unique_ptr<render::HttpStreamSink> serveGuidePage(
+    const std::string& address, int port, const std::optional<render::Credentials>& credentials,
+    std::string_view page);
 
 // SIGINT and SIGTERM (Ctrl-C, systemctl stop) end a guide: from this call on they set the flag
 // that stopRequested() reads.

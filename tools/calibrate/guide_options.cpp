@@ -32,6 +32,9 @@ status is 0 when the lens passed and was written, 1 otherwise.
   --loop                     with --file: start again at the end
   --listen ADDR:PORT         where to serve the page (default 127.0.0.1:8080; port 0: any free
                              one; the address is printed)
+  --password-file FILE       who may see the page: USER:PASSWORD on the file's first line (chmod
+                             600), asked by HTTP basic authentication; required when --listen is
+                             not 127.x.x.x
   --board, --charuco, --dictionary, --marker-ratio, --model, --out, --square, --field-of-view-deg,
   --update-rig, --camera and the limits (--max-rms-px, --max-view-rms-px, --max-edge-width-px,
   --min-coverage, --min-views): as for surround-calibrate intrinsics
@@ -69,7 +72,7 @@ void parseListen(std::string_view text, std::string& address, int& port) {
 }  // namespace
 
 Handlers cameraAndPageHandlers(cv::Size& size, bool& sizeGiven, double& fps, std::string& address,
-                               int& port) {
+                               int& port, std::optional<std::filesystem::path>& passwordFile) {
   return {{"--size",
            [&](auto v) {
              size = parseFrameSize(v);
@@ -79,13 +82,33 @@ Handlers cameraAndPageHandlers(cv::Size& size, bool& sizeGiven, double& fps, std
            [&](auto v) {
              fps = parseDouble("--fps", v, 0.1, 1000, "frames per second from 0.1 to 1000");
            }},
-          {"--listen", [&](auto v) { parseListen(v, address, port); }}};
+          {"--listen", [&](auto v) { parseListen(v, address, port); }},
+          {"--password-file", [&](auto v) { passwordFile = std::string(v); }}};
+}
+
+std::optional<render::Credentials> pageCredentials(
+    const std::string& address, const std::optional<std::filesystem::path>& passwordFile) {
+  if (passwordFile) {
+    try {
+      return render::readCredentialsFile(*passwordFile);
+    } catch (const std::runtime_error& error) {
+      throw UsageError(fmt::format("--password-file: {}", error.what()));
+    }
+  }
+  if (!render::isLoopbackAddress(address)) {
+    throw UsageError(fmt::format(
+        "--listen: {} is beyond this machine: give --password-file FILE (USER:PASSWORD, chmod "
+        "600) so that only those who have it see the cameras, or listen on 127.0.0.1",
+        address));
+  }
+  return std::nullopt;
 }
 
 GuideOptions parseGuide(std::span<const std::string_view> arguments) {
   GuideOptions o;
   bool size = false;
-  Handlers valued = cameraAndPageHandlers(o.size, size, o.fps, o.address, o.port);
+  std::optional<std::filesystem::path> passwordFile;
+  Handlers valued = cameraAndPageHandlers(o.size, size, o.fps, o.address, o.port, passwordFile);
   valued.merge(Handlers{{"--device", [&](auto v) { o.device = std::string(v); }},
                         {"--file", [&](auto v) { o.file = std::string(v); }}});
   o.lens = parseLensOptions(arguments, std::move(valued),
@@ -95,6 +118,7 @@ GuideOptions parseGuide(std::span<const std::string_view> arguments) {
   }
   if (o.device && o.loop) throw UsageError("--loop: only a --file loops");
   if (o.file && size) throw UsageError("--size: only a --device takes it (a file has its size)");
+  o.credentials = pageCredentials(o.address, passwordFile);
   return o;
 }
 

@@ -11,6 +11,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "render/outputs/credentials.hpp"
 #include "tools/calibrate/intrinsics_options.hpp"
 
 namespace surroundd::calibrate {
@@ -23,8 +24,9 @@ struct GuideOptions {
   cv::Size size{1280, 720};  // --device: the size to ask for
   double fps = 30;           // --device: the rate to ask for; --file: a picture sequence's rate
   bool loop = false;         // --file: start again at its end
-  std::string address = "127.0.0.1";  // IPv4 to listen on
-  int port = 8080;                    // 0: any free port (printed)
+  std::string address = "127.0.0.1";               // IPv4 to listen on
+  int port = 8080;                                 // 0: any free port (printed)
+  std::optional<render::Credentials> credentials;  // --password-file: who may see the page
 };
 
 extern const std::string_view kGuideUsage;

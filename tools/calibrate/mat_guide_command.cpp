@@ -129,7 +129,8 @@ void runMatGuide(const MatGuideOptions& options, std::ostream& log) {
   MatGuideSession session(std::move(settings));
   MatGuideRunState run;
 
-  const auto served = serveGuidePage(options.address, options.port, matGuidePage());
+  const auto served =
+      serveGuidePage(options.address, options.port, options.credentials, matGuidePage());
   render::HttpStreamSink& page = *served;
   page.setStatus(matGuideStateJson(session, run));
   log << fmt::format("guide page: http://{}:{}/ (reading {} cameras; Ctrl-C stops)\n",

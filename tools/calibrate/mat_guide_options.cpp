@@ -36,6 +36,9 @@ exit status is 0 when the mounts passed and were written, 1 otherwise.
   --out FILE                 also write the mount: blocks to FILE (as extrinsics --out)
   --listen ADDR:PORT         where to serve the page (default 127.0.0.1:8080; port 0: any free
                              one; the address is printed)
+  --password-file FILE       who may see the page: USER:PASSWORD on the file's first line (chmod
+                             600), asked by HTTP basic authentication; required when --listen is
+                             not 127.x.x.x
   --inlier-px, --min-corners, --max-rms-px, --max-shift-m, --max-turn-deg, --max-seam-cm: as for
                              surround-calibrate extrinsics --mat (the seam limit, default 3 cm,
                              is the threshold the page states)
@@ -48,7 +51,8 @@ MatGuideOptions parseMatGuide(std::span<const std::string_view> arguments) {
   MatGuideOptions o;
   bool size = false;
   Handlers valued = matLimitHandlers(o.limits, o.inlierPx);
-  valued.merge(cameraAndPageHandlers(o.size, size, o.fps, o.address, o.port));
+  std::optional<std::filesystem::path> passwordFile;
+  valued.merge(cameraAndPageHandlers(o.size, size, o.fps, o.address, o.port, passwordFile));
   valued.merge(
       Handlers{{"--mat", [&](auto v) { o.mat = std::string(v); }},
                {"--rig", [&](auto v) { o.rig = std::string(v); }},
@@ -74,6 +78,7 @@ MatGuideOptions parseMatGuide(std::span<const std::string_view> arguments) {
         "live)");
   }
   if (size && o.devices.empty()) throw UsageError("--size: only a --device takes it");
+  o.credentials = pageCredentials(o.address, passwordFile);
   return o;
 }
 

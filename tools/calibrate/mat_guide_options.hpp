@@ -14,6 +14,7 @@
 #include <opencv2/core.hpp>
 
 #include "processing/calibration/mat_calibration.hpp"
+#include "render/outputs/credentials.hpp"
 
 namespace surroundd::calibrate {
 
@@ -28,6 +29,7 @@ struct MatGuideOptions {
   double fps = 30;                           // devices: the rate to ask for
   std::string address = "127.0.0.1";
   int port = 8080;
+  std::optional<render::Credentials> credentials;  // --password-file: who may see the page
   processing::MatLimits limits;
   double inlierPx = 3.0;
 };
