@@ -10,7 +10,30 @@ include(${CMAKE_CURRENT_LIST_DIR}/Manuals.cmake)
 install(TARGETS surroundd surroundctl surround-synth surround-calibrate surround-bench
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(FILES systemd/surroundd.service DESTINATION lib/systemd/system)
-install(FILES config/surroundd.yaml DESTINATION /etc/surroundd)
+# The installed config shows the live view on a page on this machine; a build without HTTP has
+# no page, so its config writes the top view as a picture in the state folder instead (the
+# installed config must pass --check-config in every build: tests/packaging/install_test.sh).
+if(SURROUNDD_WITH_HTTP)
+  set(installed_config config/surroundd.yaml)
+else()
+  set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS
+               ${PROJECT_SOURCE_DIR}/config/surroundd.yaml)
+  file(READ ${PROJECT_SOURCE_DIR}/config/surroundd.yaml text)
+  set(page "  # The live view and its page (health, frame rate, view buttons), on this machine only; a listen
+  # address beyond it serves every network the vehicle computer is on.
+  - {type: http, stream: surround, listen: 127.0.0.1:8080}")
+  string(FIND "${text}" "${page}" at)
+  if(at EQUAL -1)
+    message(FATAL_ERROR "config/surroundd.yaml: its http output is not as cmake/Packaging.cmake "
+                        "replaces it in a build without HTTP: change both")
+  endif()
+  string(REPLACE "${page}" "  # This build has no HTTP page: the top view, 5 s after the start.
+  - {type: snapshot, stream: surround, view: top, path: /var/lib/surroundd/top.png, at_s: 5}"
+         text "${text}")
+  set(installed_config ${PROJECT_BINARY_DIR}/surroundd.yaml)
+  file(WRITE ${installed_config} "${text}")
+endif()
+install(FILES ${installed_config} DESTINATION /etc/surroundd)
 install(FILES README.md config/surroundd.reference.yaml config/demo.yaml
         DESTINATION ${CMAKE_INSTALL_DOCDIR})
 install(DIRECTORY config/rigs DESTINATION ${CMAKE_INSTALL_DOCDIR})
