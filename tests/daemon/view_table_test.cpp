@@ -83,9 +83,12 @@ TEST(ViewTableTest, AViewSwitchedToIsDrawnWhileItsTableIsMadeBesideTheSets) {
   }
   ASSERT_TRUE(observer.gathered) << "the top view was still drawn by OpenGL after " << kMostSets
                                  << " sets";
-  // The orbit's sets, and at least the switch's own set, drawn by the renderer: a table made
-  // before the switch's set went on would have left that set's picture to the gather.
-  EXPECT_GE(observer.readBacks(), kSwitchAt + 1);
+  // The orbit's sets drawn by the renderer. The switch's own set is drawn too unless the table's
+  // thread finished it before that set's picture was taken, which a slow pipeline thread (ASan,
+  // a loaded machine) lets happen: it then goes out gathered, which is no fault (one CI run in
+  // four under ASan counted 10 read-backs, not 11). That no set is left without its picture is
+  // the check below.
+  EXPECT_GE(observer.readBacks(), kSwitchAt);
   EXPECT_THAT(log, Contains(HasSubstr("the top view 320x180 is gathered from the camera frames "
                                       "through its own look-up table (made in")));
   // Every set's picture went out, those drawn while the table was made included.
