@@ -52,7 +52,7 @@ std::vector<double> ratesOf(V4l2Device& device, std::uint32_t fourcc,
 
 }  // namespace
 
-std::vector<V4l2Offer> offersOf(V4l2Device& device, std::uint32_t bufferType) {
+std::vector<V4l2Offer> offersOf(V4l2Device& device, std::uint32_t bufferType, FrameRates rates) {
   std::vector<V4l2Offer> offers;
   for (std::uint32_t i = 0;; ++i) {
     v4l2_fmtdesc description{};
@@ -69,7 +69,9 @@ std::vector<V4l2Offer> offersOf(V4l2Device& device, std::uint32_t bufferType) {
       if (size.type == V4L2_FRMSIZE_TYPE_DISCRETE) {
         offer.sizes.emplace_back(static_cast<int>(size.discrete.width),
                                  static_cast<int>(size.discrete.height));
-        offer.rates.push_back(ratesOf(device, offer.fourcc, size.discrete));
+        if (rates == FrameRates::kListed) {
+          offer.rates.push_back(ratesOf(device, offer.fourcc, size.discrete));
+        }
       } else {
         offer.anySize = true;
         offer.smallest = {static_cast<int>(size.stepwise.min_width),
@@ -84,7 +86,7 @@ std::vector<V4l2Offer> offersOf(V4l2Device& device, std::uint32_t bufferType) {
   return offers;
 }
 
-std::string describe(const std::vector<V4l2Offer>& offers, bool withRates) {
+std::string describe(const std::vector<V4l2Offer>& offers, FrameRates rates) {
   std::string text;
   for (const auto& offer : offers) {
     text += fmt::format("{}{}", text.empty() ? "" : "; ", fourccText(offer.fourcc));
@@ -95,7 +97,7 @@ std::string describe(const std::vector<V4l2Offer>& offers, bool withRates) {
     for (std::size_t k = 0; k < offer.sizes.size(); ++k) {
       text +=
           fmt::format("{}{}x{}", k == 0 ? " " : ", ", offer.sizes[k].width, offer.sizes[k].height);
-      if (withRates && k < offer.rates.size() && !offer.rates[k].empty()) {
+      if (rates == FrameRates::kListed && k < offer.rates.size() && !offer.rates[k].empty()) {
         text += fmt::format(" ({:g} fps)", fmt::join(offer.rates[k], ", "));
       }
     }

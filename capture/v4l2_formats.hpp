@@ -37,20 +37,26 @@ inline constexpr std::array<V4l2FormatCode, 5> kV4l2Formats{{
 struct V4l2Offer {
   std::uint32_t fourcc = 0;
   std::vector<cv::Size> sizes;  // discrete sizes
-  // Per discrete size, the frame rates it is offered at (frames per second), where the driver
-  // lists them (discrete intervals); empty where it does not.
+  // Per discrete size, the frame rates it is offered at (frames per second), where they were
+  // asked for (FrameRates::kListed) and the driver lists them (discrete intervals).
   std::vector<std::vector<double>> rates;
   bool anySize = false;        // stepwise or continuous ranges
   cv::Size smallest, largest;  // of a range
   bool has(cv::Size size) const;
 };
 
+// Whether the frame rates of each size are asked for and told: only a listing wants them, and a
+// driver like vivid answers thousands of VIDIOC_ENUM_FRAMEINTERVALS for them, which a camera's
+// every (re)opening would pay.
+enum class FrameRates { kLeftOut, kListed };
+
 // The formats and sizes the device offers for buffers of `bufferType` (single- or multi-planar
-// capture).
-std::vector<V4l2Offer> offersOf(V4l2Device& device, std::uint32_t bufferType);
-// "YUYV 640x480, 320x240; MJPG 1280x720", or "nothing"; with `withRates`, each size's frame
-// rates after it: "YUYV 640x480 (30, 15 fps)".
-std::string describe(const std::vector<V4l2Offer>& offers, bool withRates = false);
+// capture), with each size's rates where `rates` says.
+std::vector<V4l2Offer> offersOf(V4l2Device& device, std::uint32_t bufferType,
+                                FrameRates rates = FrameRates::kLeftOut);
+// "YUYV 640x480, 320x240; MJPG 1280x720", or "nothing"; with the rates listed, each size's after
+// it: "YUYV 640x480 (30, 15 fps)".
+std::string describe(const std::vector<V4l2Offer>& offers, FrameRates rates = FrameRates::kLeftOut);
 std::string fourccText(std::uint32_t code);
 
 }  // namespace surroundd::capture

@@ -26,7 +26,7 @@ int videoNumber(const std::filesystem::path& node) {
 
 }  // namespace
 
-V4l2Probe probeV4l2(V4l2Device& opened, const std::string& where) {
+V4l2Probe probeV4l2(V4l2Device& opened, const std::string& where, FrameRates rates) {
   v4l2_capability capability{};
   if (const int error = opened.ioctl(VIDIOC_QUERYCAP, &capability); error != 0) {
     throw CaptureError(
@@ -48,18 +48,18 @@ V4l2Probe probeV4l2(V4l2Device& opened, const std::string& where) {
   probe.multiplanar = !singlePlanar;
   probe.bufferType =
       probe.multiplanar ? V4L2_BUF_TYPE_VIDEO_CAPTURE_MPLANE : V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  probe.offers = offersOf(opened, probe.bufferType);
+  probe.offers = offersOf(opened, probe.bufferType, rates);
   return probe;
 }
 
-V4l2Probe probeV4l2(const std::filesystem::path& node, const std::string& where,
-                    V4l2Device& device) {
+V4l2Probe probeV4l2(const std::filesystem::path& node, const std::string& where, V4l2Device& device,
+                    FrameRates rates) {
   if (const int error = device.open(node.string()); error != 0) {
     throw CaptureError(
         fmt::format("{}: cannot open: {}", where, std::generic_category().message(error)));
   }
   try {
-    auto probe = probeV4l2(device, where);
+    auto probe = probeV4l2(device, where, rates);
     device.close();
     return probe;
   } catch (...) {

@@ -23,13 +23,15 @@ struct V4l2Probe {
   std::vector<V4l2Offer> offers;  // of bufferType; empty when not a capture node
 };
 
-// Asks an opened device. Throws CaptureError "<where>: not a V4L2 device (...)".
-V4l2Probe probeV4l2(V4l2Device& opened, const std::string& where);
+// Asks an opened device (each size's frame rates only where `rates` says). Throws CaptureError
+// "<where>: not a V4L2 device (...)".
+V4l2Probe probeV4l2(V4l2Device& opened, const std::string& where,
+                    FrameRates rates = FrameRates::kLeftOut);
 
 // Opens the node, asks it and closes it. Throws CaptureError "<where>: cannot open: ..." or as
 // above.
-V4l2Probe probeV4l2(const std::filesystem::path& node, const std::string& where,
-                    V4l2Device& device);
+V4l2Probe probeV4l2(const std::filesystem::path& node, const std::string& where, V4l2Device& device,
+                    FrameRates rates = FrameRates::kLeftOut);
 
 // The format V4l2Source takes for these settings: the first of kV4l2Formats that the settings
 // allow and the device offers at their size; null when none.

@@ -48,7 +48,8 @@ void listCameras(std::ostream& out, const std::filesystem::path& dev) {
     const auto device = capture::makeKernelV4l2Device();
     capture::V4l2Probe probe;
     try {
-      probe = capture::probeV4l2(node.path, node.path.string(), *device);
+      probe =
+          capture::probeV4l2(node.path, node.path.string(), *device, capture::FrameRates::kListed);
     } catch (const capture::CaptureError& error) {
       out << error.what() << "\n";
       continue;
@@ -64,7 +65,7 @@ void listCameras(std::ostream& out, const std::filesystem::path& dev) {
       if (std::ranges::any_of(capture::kV4l2Formats, [&](const capture::V4l2FormatCode& code) {
             return code.fourcc == offer.fourcc;
           })) {
-        out << "  " << capture::describe({offer}, true) << "\n";
+        out << "  " << capture::describe({offer}, capture::FrameRates::kListed) << "\n";
       } else {
         others.push_back(capture::fourccText(offer.fourcc));
       }

@@ -192,11 +192,19 @@ TEST(V4l2Probe, ReadsFormatsSizesAndRatesAndChoosesAsTheSourceDoes) {
       deviceOffering({{V4L2_PIX_FMT_MJPEG, {1280, 720}}, {V4L2_PIX_FMT_NV12, kSize}});
   state->periodUs = 40'000;
   FakeV4l2Device device(state);
-  const V4l2Probe probe = probeV4l2("/dev/video7", "camera 'front': /dev/video7", device);
+  const V4l2Probe probe =
+      probeV4l2("/dev/video7", "camera 'front': /dev/video7", device, FrameRates::kListed);
   EXPECT_TRUE(probe.capture);
   EXPECT_EQ(probe.card, "Fake camera");
-  EXPECT_EQ(describe(probe.offers, true), "MJPG 1280x720 (25 fps); NV12 320x240 (25 fps)")
+  EXPECT_EQ(describe(probe.offers, FrameRates::kListed),
+            "MJPG 1280x720 (25 fps); NV12 320x240 (25 fps)")
       << "offers as the fake device lists them";
+  // What a source's opening asks: the formats and sizes, no rates.
+  FakeV4l2Device again(state);
+  const V4l2Probe opening = probeV4l2("/dev/video7", "camera 'front': /dev/video7", again);
+  ASSERT_EQ(opening.offers.size(), 2U);
+  EXPECT_TRUE(opening.offers[0].rates.empty());
+  EXPECT_EQ(describe(opening.offers), "MJPG 1280x720; NV12 320x240");
   EXPECT_EQ(fourccText(V4L2_PIX_FMT_Y10), "Y10");
   EXPECT_EQ(fourccText(V4L2_PIX_FMT_Y16_BE), "Y16-BE");
   EXPECT_EQ(chooseV4l2Format(probe, settingsFor())->format, V4l2Format::kNv12);
