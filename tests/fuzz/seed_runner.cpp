@@ -7,9 +7,13 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
+#include <string>
 #include <vector>
+
+#include "common/regular_file.hpp"
+
+// Seeds are small; one past this is not one (libFuzzer's own default -max_len is 4 KiB).
+constexpr std::size_t kMaxSeedBytes = std::size_t{64} << 20;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
 // Defined by the targets that set up something first.
@@ -30,14 +34,15 @@ int main(int argc, char** argv) {
   }
   std::ranges::sort(seeds);
   for (const auto& seed : seeds) {
-    std::ifstream in(seed, std::ios::binary);
-    if (!in) {
-      std::fprintf(stderr, "%s: cannot read\n", seed.c_str());
+    std::string bytes;
+    try {
+      bytes = surroundd::readRegularFile(seed, kMaxSeedBytes);
+    } catch (const surroundd::FileReadError& error) {
+      std::fprintf(stderr, "%s\n", error.what());
       return 1;
     }
-    const std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(in), {}};
     std::fprintf(stderr, "%s (%zu bytes)\n", seed.c_str(), bytes.size());
-    LLVMFuzzerTestOneInput(bytes.data(), bytes.size());
+    LLVMFuzzerTestOneInput(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
   }
   std::printf("%zu seeds, no finding\n", seeds.size());
   return seeds.empty() ? 1 : 0;
