@@ -11,7 +11,7 @@ cmake --preset release
 manuals=""
 if command -v help2man >/dev/null 2>&1; then manuals=manuals; fi
 cmake --build --preset release --target surroundd surroundctl surround-synth surround-calibrate \
-  surround-bench changelog $manuals
+  surround-bench surround-gpu-check changelog $manuals
 # recordings/demo is the demo's own: made again (--force) only when the generator or its arguments
 # changed since (a recording of the same key is kept, "up to date").
 build/release/tools/synth/surround-synth --rig config/rigs/paper.yaml --out recordings/demo --force
