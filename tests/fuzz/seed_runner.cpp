@@ -15,8 +15,10 @@
 // Seeds are small; one past this is not one (libFuzzer's own default -max_len is 4 KiB).
 constexpr std::size_t kMaxSeedBytes = std::size_t{64} << 20;
 
+// NOLINTNEXTLINE(readability-identifier-naming): libFuzzer's interface names them.
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
 // Defined by the targets that set up something first.
+// NOLINTNEXTLINE(readability-identifier-naming)
 extern "C" __attribute__((weak)) int LLVMFuzzerInitialize(int* argc, char*** argv);
 
 int main(int argc, char** argv) {
