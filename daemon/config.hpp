@@ -23,7 +23,6 @@
 #include "processing/colour/poisson_correction.hpp"
 #include "processing/stitch/panorama_lut.hpp"
 #include "processing/surround_mesh.hpp"
-#include "render/car_model.hpp"
 #include "render/egl_context.hpp"
 #include "render/guidelines.hpp"
 #include "render/outputs/credentials.hpp"
@@ -126,9 +125,8 @@ struct RenderConfig {
   int heightPx = 720;
   render::EglPlatform platform = render::EglPlatform::kAuto;
   render::ViewSettings views;
-  std::string splitCamera;    // the camera beside the 3D view in the split view; empty: the first
-  render::CarDimensions car;  // from the vehicle
-  bool viewLut = true;        // top and 360 views gathered from the frames through a view LUT
+  std::string splitCamera;  // the camera beside the 3D view in the split view; empty: the first
+  bool viewLut = true;      // top and 360 views gathered from the frames through a view LUT
   GuidelineMode guidelines = GuidelineMode::kReverse;
   render::GuidelineSettings guide;
 
@@ -307,6 +305,9 @@ struct Config {
   // What is worth saying about a valid config (surroundd logs them at start, --check-config prints
   // them).
   std::vector<std::string> warnings;
+
+  // The vehicle drawn and guided: `vehicle`, else the default car.
+  processing::VehicleDimensions car() const { return vehicle.value_or(VehicleConfig{}); }
 };
 
 // Default sizes that follow the vehicle: a small robot in a room wants a closer look than a bus.

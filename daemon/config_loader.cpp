@@ -203,7 +203,6 @@ void checkCorrectionScale(YamlObject& root, const Config& config) {
 // The render's size and views, whose defaults follow the vehicle.
 void readRenderSection(YamlObject& root, Config& config) {
   const VehicleConfig vehicle = config.vehicle.value_or(VehicleConfig{});
-  config.render.car = vehicle.car();
   const VehicleSizes sizes = vehicleSizes(vehicle);
   auto& views = config.render.views;
   views.topRangeM = sizes.topRangeM;

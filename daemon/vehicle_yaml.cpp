@@ -11,45 +11,6 @@
 
 namespace surroundd::daemon {
 
-processing::VehicleBody VehicleConfig::body() const {
-  if (footprint.empty()) {
-    return processing::boxBody(lengthM, widthM, heightM, groundClearanceM, {xM, yM});
-  }
-  processing::VehicleBody body{{}, groundClearanceM, heightM};
-  for (const auto& [x, y] : footprint) body.footprint.emplace_back(x, y);
-  return body;
-}
-
-render::CarDimensions VehicleConfig::car() const {
-  render::CarDimensions car;
-  car.heightM = heightM;
-  car.groundClearanceM = groundClearanceM;
-  car.frontOverhangM = frontOverhangM;
-  car.rearOverhangM = rearOverhangM;
-  car.marginM = marginM;
-  car.model = model;
-  // The model is a box car: a footprint polygon draws as its bounding box.
-  const auto corners = body().footprint;
-  double minX = corners[0].x, maxX = minX, minY = corners[0].y, maxY = minY;
-  for (const auto& p : corners) {
-    minX = std::min(minX, p.x), maxX = std::max(maxX, p.x);
-    minY = std::min(minY, p.y), maxY = std::max(maxY, p.y);
-  }
-  car.lengthM = maxX - minX;
-  car.widthM = maxY - minY;
-  car.centreXM = (minX + maxX) / 2;
-  car.centreYM = (minY + maxY) / 2;
-  car.trackM = trackM > 0 ? trackM : std::max(0.1, car.widthM - 0.25);
-  car.steeringRatio = steeringRatio;
-  return car;
-}
-
-double VehicleConfig::reachM() const {
-  double reach = 0;
-  for (const auto& p : body().footprint) reach = std::max(reach, std::hypot(p.x, p.y));
-  return reach;
-}
-
 namespace {
 
 void readFootprint(YamlObject& v, VehicleConfig& c) {
@@ -62,7 +23,7 @@ void readModel(YamlObject& v, VehicleConfig& c) {
   c.model = v.existingFile("model").value_or("");
   if (c.model.empty()) return;
   try {
-    render::loadGltfCar(c.model, c.car());
+    render::loadGltfCar(c.model, c);
   } catch (const render::CarModelError& e) {
     v.error("model", e.what());
   }

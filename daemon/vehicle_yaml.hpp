@@ -10,35 +10,17 @@
 
 #include <array>
 #include <filesystem>
-#include <optional>
 #include <vector>
 
 #include "daemon/config_keys.hpp"
 #include "daemon/yaml_reader.hpp"
-#include "processing/vehicle_body.hpp"
-#include "render/car_model.hpp"
+#include "processing/vehicle_dimensions.hpp"
 
 namespace surroundd::daemon {
 
-struct VehicleConfig {
-  double lengthM = 4.5;
-  double widthM = 1.85;
-  double heightM = 1.5;
-  double groundClearanceM = 0.15;
-  double frontOverhangM = 0.9;
-  double rearOverhangM = 1.0;
-  double xM = 0.0, yM = 0.0;
-  std::vector<std::array<double, 2>> footprint;  // empty: the length x width box
-  double marginM = 0.3;
-  double trackM = 0;  // between the wheels' centres; 0: width_m less 0.25 m
-  double steeringRatio = 15;
+// The vehicle's measurements, and whether the cameras' views of its body are masked out.
+struct VehicleConfig : processing::VehicleDimensions {
   bool bodyMasks = true;
-  std::filesystem::path model;  // glTF 2.0; empty: the procedural car
-
-  processing::VehicleBody body() const;
-  render::CarDimensions car() const;
-  // The furthest the body reaches from the vehicle frame's origin, metres.
-  double reachM() const;
 
   bool operator==(const VehicleConfig&) const = default;
 };

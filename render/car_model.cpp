@@ -92,17 +92,18 @@ class CarBuilder {
 
 }  // namespace
 
-CarModel buildCarModel(const CarDimensions& car, double footprintRadiusM) {
+CarModel buildCarModel(const processing::VehicleDimensions& car, double footprintRadiusM) {
   CarModel model;
   if (!car.model.empty()) model = loadGltfCar(car.model, car);
   std::vector<CarVertex>& vertices = model.vertices;
   const std::size_t first = vertices.size();
   CarBuilder build(vertices);
-  const auto l = static_cast<float>(car.lengthM / 2);
-  const auto w = static_cast<float>(car.widthM / 2);
+  const processing::VehicleDimensions::Box box = car.box();
+  const auto l = static_cast<float>(box.lengthM / 2);
+  const auto w = static_cast<float>(box.widthM / 2);
   const auto h = static_cast<float>(car.heightM);
-  const auto cx = static_cast<float>(car.centreXM);
-  const auto cy = static_cast<float>(car.centreYM);
+  const auto cx = static_cast<float>(box.centreXM);
+  const auto cy = static_cast<float>(box.centreYM);
   const auto margin = static_cast<float>(car.marginM);
   const auto ring = static_cast<float>(footprintRadiusM) + 0.05F;
 

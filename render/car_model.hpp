@@ -10,24 +10,9 @@
 
 #include <opencv2/core.hpp>
 
+#include "processing/vehicle_dimensions.hpp"
+
 namespace surroundd::render {
-
-struct CarDimensions {
-  double lengthM = 4.5;
-  double widthM = 1.85;
-  double heightM = 1.5;
-  double groundClearanceM = 0.15;
-  double frontOverhangM = 0.9;  // bumper to axle: where the wheels go
-  double rearOverhangM = 1.0;
-  double centreXM = 0, centreYM = 0;  // the body's centre in the vehicle frame
-  double trackM = 1.6;                // between the wheels' centres (guidelines)
-  double steeringRatio = 15;          // steering-wheel angle over road-wheel angle (guidelines)
-  double marginM = 0.3;               // the dark footprint reaches this far past the body
-  // A glTF 2.0 file (.glb, .gltf) drawn in the box instead of the procedural car; empty: none.
-  std::filesystem::path model;
-
-  bool operator==(const CarDimensions&) const = default;
-};
 
 struct CarVertex {
   float position[3];
@@ -48,10 +33,10 @@ struct CarModel {
   std::vector<cv::Mat> textures;  // 8-bit RGBA
 };
 
-// The car `car` describes (its glTF model, or the procedural one) on its footprint, which reaches
-// `marginM` past the body and at least `footprintRadiusM` from the vehicle frame's origin in every
-// direction (the open ring of the surround mesh). Throws CarModelError for a model file that
-// cannot be used.
-CarModel buildCarModel(const CarDimensions& car, double footprintRadiusM);
+// The car `car` describes (its glTF model, or the procedural one), drawn in its box (car.box()),
+// on its footprint, which reaches `marginM` past the body and at least `footprintRadiusM` from the
+// vehicle frame's origin in every direction (the open ring of the surround mesh). Throws
+// CarModelError for a model file that cannot be used.
+CarModel buildCarModel(const processing::VehicleDimensions& car, double footprintRadiusM);
 
 }  // namespace surroundd::render

@@ -188,7 +188,7 @@ class CarLoader {
   }
 
   // The model's box scaled on each axis to the vehicle's, standing on the ground.
-  CarModel finish(const CarDimensions& car) {
+  CarModel finish(const processing::VehicleDimensions& car) {
     if (model_.vertices.empty()) reader_.fail("its default scene has no triangles");
     cv::Vec3d lo(std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
                  std::numeric_limits<double>::max());
@@ -207,8 +207,9 @@ class CarLoader {
       }
     }
     if (!finite(hi - lo)) reader_.fail("it is too large to measure (its size overflows)");
-    const cv::Vec3d target(car.lengthM, car.widthM, car.heightM);
-    const cv::Vec3d targetLow(car.centreXM - car.lengthM / 2, car.centreYM - car.widthM / 2, 0);
+    const processing::VehicleDimensions::Box box = car.box();
+    const cv::Vec3d target(box.lengthM, box.widthM, car.heightM);
+    const cv::Vec3d targetLow(box.centreXM - box.lengthM / 2, box.centreYM - box.widthM / 2, 0);
     const cv::Vec3d extent = hi - lo;
     const double largest = std::max({extent[0], extent[1], extent[2], 1e-9});
     cv::Vec3d scale;
@@ -431,7 +432,7 @@ std::string_view jsonOf(std::string_view bytes, bool binary) {
 
 }  // namespace
 
-CarModel loadGltfCar(const std::filesystem::path& file, const CarDimensions& car) {
+CarModel loadGltfCar(const std::filesystem::path& file, const processing::VehicleDimensions& car) {
   const std::string extension = file.extension().string();
   if (extension != ".glb" && extension != ".gltf") {
     throw CarModelError(

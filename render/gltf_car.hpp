@@ -21,6 +21,6 @@ class CarModelError : public std::runtime_error {
 };
 
 // The model's parts, without the footprint.
-CarModel loadGltfCar(const std::filesystem::path& file, const CarDimensions& car);
+CarModel loadGltfCar(const std::filesystem::path& file, const processing::VehicleDimensions& car);
 
 }  // namespace surroundd::render

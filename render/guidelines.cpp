@@ -11,15 +11,17 @@ constexpr double kStepM = 0.05;          // between path points: smooth at the t
 constexpr float kAboveGroundM = 0.03F;   // over the floor, under any kerb
 constexpr double kMaxRoadWheelDeg = 45;  // beyond any car's lock
 
-double rearAxleX(const CarDimensions& car) {
-  return car.centreXM - car.lengthM / 2 + car.rearOverhangM;
+double rearAxleX(const processing::VehicleDimensions& car) {
+  const auto box = car.box();
+  return box.centreXM - box.lengthM / 2 + car.rearOverhangM;
 }
-double frontAxleX(const CarDimensions& car) {
-  return car.centreXM + car.lengthM / 2 - car.frontOverhangM;
+double frontAxleX(const processing::VehicleDimensions& car) {
+  const auto box = car.box();
+  return box.centreXM + box.lengthM / 2 - car.frontOverhangM;
 }
 
 // How far the axle travels from the wheels to lengthM past the bumper, signed with the travel.
-double reachM(const CarDimensions& car, Travel travel, double pastBumperM) {
+double reachM(const processing::VehicleDimensions& car, Travel travel, double pastBumperM) {
   return travel == Travel::kReverse ? -(car.rearOverhangM + pastBumperM)
                                     : car.frontOverhangM + pastBumperM;
 }
@@ -40,25 +42,26 @@ void strip(cv::Point2d a, cv::Point2d b, double width, const cv::Vec3f& colour,
   }
 }
 
-std::size_t pathSteps(const CarDimensions& car, Travel travel, const GuidelineSettings& settings) {
+std::size_t pathSteps(const processing::VehicleDimensions& car, Travel travel,
+                      const GuidelineSettings& settings) {
   return static_cast<std::size_t>(
       std::ceil(std::abs(reachM(car, travel, settings.lengthM)) / kStepM));
 }
 
 }  // namespace
 
-cv::Point2d wheelPathPoint(const CarDimensions& car, Travel travel, double steeringDeg, int side,
-                           double distanceM) {
+cv::Point2d wheelPathPoint(const processing::VehicleDimensions& car, Travel travel,
+                           double steeringDeg, int side, double distanceM) {
   const double roadWheel =
       std::clamp(steeringDeg / car.steeringRatio, -kMaxRoadWheelDeg, kMaxRoadWheelDeg) *
       std::numbers::pi / 180;
   const double axleX = travel == Travel::kReverse ? rearAxleX(car) : frontAxleX(car);
-  const cv::Point2d wheel(axleX, car.centreYM + side * car.trackM / 2);
+  const cv::Point2d wheel(axleX, car.box().centreYM + side * car.wheelTrackM() / 2);
   if (std::abs(std::tan(roadWheel)) < 1e-9) return wheel + cv::Point2d(distanceM, 0);
   // The turn's centre, on the rear axle's line, left of it for a left turn; the vehicle turns
   // about it by the rear axle's distance over its radius.
   const double radius = (frontAxleX(car) - rearAxleX(car)) / std::tan(roadWheel);
-  const cv::Point2d centre(rearAxleX(car), car.centreYM + radius);
+  const cv::Point2d centre(rearAxleX(car), car.box().centreYM + radius);
   const double angle = distanceM / radius;
   const cv::Point2d from = wheel - centre;
   return centre + cv::Point2d(from.x * std::cos(angle) - from.y * std::sin(angle),
@@ -67,14 +70,14 @@ cv::Point2d wheelPathPoint(const CarDimensions& car, Travel travel, double steer
 
 std::size_t maxGuidelineVertices(const GuidelineSettings& settings) {
   // The longest overhang a vehicle may have (vehicle.*_overhang_m: up to 10 m) bounds the paths.
-  CarDimensions longest;
+  processing::VehicleDimensions longest;
   longest.frontOverhangM = longest.rearOverhangM = 10;
   const std::size_t steps = pathSteps(longest, Travel::kForward, settings) + 1;
   return 6 * (2 * steps + settings.markersM.size());
 }
 
-void guidelines(const CarDimensions& car, const GuidelineSettings& settings, Travel travel,
-                double steeringDeg, std::vector<GuidelineVertex>& vertices) {
+void guidelines(const processing::VehicleDimensions& car, const GuidelineSettings& settings,
+                Travel travel, double steeringDeg, std::vector<GuidelineVertex>& vertices) {
   vertices.clear();
   const double end = reachM(car, travel, settings.lengthM);
   const std::size_t steps = pathSteps(car, travel, settings);

@@ -36,8 +36,8 @@ struct GuidelineSettings {
 // Where a wheel is after the vehicle has gone `distanceM` (negative: backwards) at a steering-wheel
 // angle of `steeringDeg`, on the ground in the vehicle frame: `side` +1 the left wheel, -1 the
 // right, of the rear axle when reversing and of the front axle going forward.
-cv::Point2d wheelPathPoint(const CarDimensions& car, Travel travel, double steeringDeg, int side,
-                           double distanceM);
+cv::Point2d wheelPathPoint(const processing::VehicleDimensions& car, Travel travel,
+                           double steeringDeg, int side, double distanceM);
 
 // One vertex of the guidelines' triangles: on the ground (a little above it, so that it is drawn
 // over the floor), in the vehicle frame, with its colour.
@@ -52,7 +52,7 @@ std::size_t maxGuidelineVertices(const GuidelineSettings& settings);
 // The guidelines' triangles into `vertices` (cleared first; never above its capacity when that is
 // maxGuidelineVertices(settings)): the two wheel paths, from the wheels to lengthM past the
 // bumper, and a marker across them at each of markersM past the bumper.
-void guidelines(const CarDimensions& car, const GuidelineSettings& settings, Travel travel,
-                double steeringDeg, std::vector<GuidelineVertex>& vertices);
+void guidelines(const processing::VehicleDimensions& car, const GuidelineSettings& settings,
+                Travel travel, double steeringDeg, std::vector<GuidelineVertex>& vertices);
 
 }  // namespace surroundd::render

@@ -242,8 +242,8 @@ SurroundScene::PassPrograms::PassPrograms(const processing::PanoramaGeometry& pa
 }
 
 SurroundScene::SurroundScene(const processing::SurroundMesh& mesh,
-                             const processing::PanoramaGeometry& panorama, const CarDimensions& car,
-                             cv::Size cameraSize)
+                             const processing::PanoramaGeometry& panorama,
+                             const processing::VehicleDimensions& car, cv::Size cameraSize)
     : cameraSize_(cameraSize),
       picturePass_(panorama, false),
       positionsPass_(panorama, true),

@@ -25,7 +25,7 @@ class SurroundScene {
  public:
   // `cameraSize` is the size of the pictures the split view shows beside the 3D view.
   SurroundScene(const processing::SurroundMesh& mesh, const processing::PanoramaGeometry& panorama,
-                const CarDimensions& car, cv::Size cameraSize);
+                const processing::VehicleDimensions& car, cv::Size cameraSize);
 
   // 8-bit BGR, of the panorama's size (resp. cameraSize); throws std::invalid_argument otherwise.
   void uploadPanorama(const cv::Mat& bgr);

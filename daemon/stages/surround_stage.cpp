@@ -103,7 +103,7 @@ std::future<std::unique_ptr<SurroundRenderer>> openSurroundRenderer(const Config
     const std::size_t split = splitCameraOf(config);
     auto renderer = std::make_unique<SurroundRenderer>(
         std::move(gl), std::make_unique<render::SurroundScene>(
-                           mesh, settings.geometry, config.render.car,
+                           mesh, settings.geometry, config.car(),
                            config.cameras.at(split).calibration.intrinsics.imageSize));
     spdlog::info("render: {} mesh of {} triangles, split view shows '{}'",
                  config.mesh.model == MeshModel::kBowl   ? "bowl"
@@ -125,7 +125,7 @@ SurroundStage::SurroundStage(const Config& config, SurroundRenderer renderer,
       viewLut_(config.render.viewLut),
       guidelineMode_(config.render.guidelines),
       guide_(config.render.guide),
-      car_(config.render.car),
+      car_(config.car()),
       splitCamera_(splitCameraOf(config)) {
   if (guidelineMode_ != GuidelineMode::kOff) {
     const std::size_t vertices = render::maxGuidelineVertices(guide_);

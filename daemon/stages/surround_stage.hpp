@@ -196,7 +196,7 @@ class SurroundStage final : public PipelineStage {
   bool viewLut_;
   GuidelineMode guidelineMode_;
   render::GuidelineSettings guide_;
-  render::CarDimensions car_;
+  processing::VehicleDimensions car_;
   std::vector<render::GuidelineVertex> guideVertices_;  // reserved at start: filled in place
   // What the guidelines show now (travel, steering in tenths of a degree); none: not shown.
   std::optional<std::pair<render::Travel, long>> guidesShown_;

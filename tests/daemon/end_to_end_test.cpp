@@ -227,7 +227,7 @@ outputs:
   render::SurroundScene scene(
       processing::buildSurroundMesh(daemon::meshSettings(loaded),
                                     daemon::panoramaSettings(loaded).geometry),
-      daemon::panoramaSettings(loaded).geometry, loaded.render.car, replay.lut.cameraSizes[0]);
+      daemon::panoramaSettings(loaded).geometry, loaded.car(), replay.lut.cameraSizes[0]);
   render::ViewSettings cutting = loaded.render.views;  // the reference switches views at once
   cutting.transitionS = 0;
   render::SurroundView view(scene, {320, 240}, render::ViewKind::kOrbit, cutting);

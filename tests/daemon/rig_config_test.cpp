@@ -24,22 +24,22 @@ using ::testing::HasSubstr;
 TEST_F(ConfigTest, TheVehicleSizesTheCarTheViewsAndTheBowl) {
   const Config car = loadConfig(dir_.write("config.yaml", std::string(kGoodConfig)));
   EXPECT_EQ(car.vehicle, std::nullopt);
-  EXPECT_DOUBLE_EQ(car.render.car.lengthM, 4.5);
+  EXPECT_DOUBLE_EQ(car.car().lengthM, 4.5);
   const Config robot = loadConfig(dir_.write(
       "config.yaml",
       std::string(kGoodConfig) +
           "vehicle: {length_m: 0.5, width_m: 0.4, height_m: 0.3, ground_clearance_m: 0.05, "
           "front_overhang_m: 0.1, rear_overhang_m: 0.1, x_m: 0.1, margin_m: 0.05}\n"));
   ASSERT_TRUE(robot.vehicle.has_value());
-  EXPECT_TRUE(robot.render.car.model.empty());
+  EXPECT_TRUE(robot.car().model.empty());
   const std::filesystem::path model =
       std::filesystem::path(SURROUNDD_SOURCE_DIR) / "tests/render/models/test_car.gltf";
   const Config modelled = loadConfig(dir_.write(
       "modelled.yaml", std::string(kGoodConfig) + "vehicle: {model: " + model.string() + "}\n"));
-  EXPECT_EQ(modelled.render.car.model, model);
-  EXPECT_DOUBLE_EQ(robot.render.car.lengthM, 0.5);
-  EXPECT_DOUBLE_EQ(robot.render.car.centreXM, 0.1);
-  EXPECT_DOUBLE_EQ(robot.render.car.marginM, 0.05);
+  EXPECT_EQ(modelled.car().model, model);
+  EXPECT_DOUBLE_EQ(robot.car().lengthM, 0.5);
+  EXPECT_DOUBLE_EQ(robot.car().box().centreXM, 0.1);
+  EXPECT_DOUBLE_EQ(robot.car().marginM, 0.05);
   // A small vehicle gets a close look; a car the familiar 8 m.
   EXPECT_LT(robot.render.views.topRangeM, 2.0);
   EXPECT_NEAR(car.render.views.topRangeM, 8.0, 0.1);

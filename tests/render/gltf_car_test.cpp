@@ -33,8 +33,8 @@ std::filesystem::path testCar() {
 bool isMarker(const CarVertex& v) { return v.colour[0] > 0.99F && v.colour[2] < 0.01F; }
 
 TEST(GltfCar, FillsTheVehiclesBoxFrontForwardWithItsColoursAndTexture) {
-  CarDimensions car;  // 4.5 x 1.85 x 1.5
-  car.centreXM = 0.5;
+  processing::VehicleDimensions car;  // 4.5 x 1.85 x 1.5
+  car.xM = 0.5;
   const CarModel model = loadGltfCar(testCar(), car);
   ASSERT_FALSE(model.vertices.empty());
   cv::Vec3f lo(1e9F, 1e9F, 1e9F);
@@ -188,7 +188,7 @@ TEST(GltfCar, TheTopViewShowsTheModelTexturedTheRightWayRound) {
   const EglContext context;
   processing::PanoramaGeometry panorama;
   panorama.size = {512, 256};
-  CarDimensions car;
+  processing::VehicleDimensions car;
   car.model = testCar();
   SurroundScene scene(processing::buildSurroundMesh({}, panorama), panorama, car, {320, 180});
   scene.uploadPanorama(cv::Mat(panorama.size, CV_8UC3, cv::Scalar(90, 90, 90)));

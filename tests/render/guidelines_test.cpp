@@ -12,15 +12,15 @@
 namespace surroundd::render {
 namespace {
 
-const CarDimensions kCar;  // 4.5 m, wheelbase 2.6 m, track 1.6 m, ratio 15
+const processing::VehicleDimensions kCar;  // 4.5 m, wheelbase 2.6 m, track 1.6 m, ratio 15
 
-double rearAxleX() { return kCar.centreXM - kCar.lengthM / 2 + kCar.rearOverhangM; }
+double rearAxleX() { return kCar.xM - kCar.lengthM / 2 + kCar.rearOverhangM; }
 
 TEST(Guidelines, WithTheWheelStraightThePathsAreStraight) {
   for (const int side : {1, -1}) {
     const cv::Point2d start = wheelPathPoint(kCar, Travel::kReverse, 0, side, 0);
     EXPECT_DOUBLE_EQ(start.x, rearAxleX());
-    EXPECT_DOUBLE_EQ(start.y, side * kCar.trackM / 2);
+    EXPECT_DOUBLE_EQ(start.y, side * kCar.wheelTrackM() / 2);
     const cv::Point2d back = wheelPathPoint(kCar, Travel::kReverse, 0, side, -3);
     EXPECT_DOUBLE_EQ(back.x, rearAxleX() - 3);
     EXPECT_DOUBLE_EQ(back.y, start.y);
@@ -44,7 +44,7 @@ TEST(Guidelines, EveryWheelTurnsAboutOneCentreOnTheRearAxleLine) {
   // The rear wheels' circles are the track apart; the rear axle's centre turns on `radius`.
   EXPECT_NEAR(cv::norm(wheelPathPoint(kCar, Travel::kReverse, 300, -1, 0) - centre) -
                   cv::norm(wheelPathPoint(kCar, Travel::kReverse, 300, 1, 0) - centre),
-              kCar.trackM, 1e-9);
+              kCar.wheelTrackM(), 1e-9);
   // The rear axle's centre goes `distance` along its arc: 1 m is 1 / radius of a turn.
   const cv::Point2d left = wheelPathPoint(kCar, Travel::kReverse, 300, 1, -1);
   const double turned = std::atan2(left.x - centre.x, centre.y - left.y);
@@ -70,7 +70,7 @@ TEST(Guidelines, TrianglesStayWithinTheReservedBuffer) {
   settings.lengthM = 20;
   settings.markersM = {0.5, 1, 2, 4, 8, 12, 16, 20};
   settings.markerColours.assign(settings.markersM.size(), {1, 1, 1});
-  CarDimensions longest = kCar;
+  processing::VehicleDimensions longest = kCar;
   longest.rearOverhangM = longest.frontOverhangM = 10;
   longest.lengthM = 25;
   std::vector<GuidelineVertex> vertices;

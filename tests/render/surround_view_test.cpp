@@ -72,7 +72,7 @@ ViewSettings cutting() {
 
 struct Rendering {
   Rendering(processing::MeshModel model, cv::Size size, ViewKind view)
-      : scene(mesh(model), testPanorama(), CarDimensions{}, {320, 180}),
+      : scene(mesh(model), testPanorama(), processing::VehicleDimensions{}, {320, 180}),
         surround(scene, size, view, cutting()) {
     scene.uploadPanorama(codedPanorama(testPanorama().size));
     scene.uploadCamera(surroundd::testing::syntheticPicture({320, 180}, 3));
@@ -225,7 +225,7 @@ TEST_F(SurroundViewTest, GuidelinesLandWhereTheSteeringModelPutsThem) {
   GuidelineSettings settings;
   settings.pathColour = {1, 0, 1};
   settings.markerColours.assign(settings.markersM.size(), {0, 1, 1});
-  const CarDimensions car;
+  const processing::VehicleDimensions car;
   std::vector<GuidelineVertex> vertices;
   // The middle of the pixels of `colour` in a 9 x 9 window about `at`; none if there are none.
   const auto middleOf = [](const cv::Mat& picture, cv::Point2d at, const cv::Vec3b& colour) {
@@ -420,7 +420,7 @@ TEST_F(SurroundViewTest, OrbitMovesWithTimeAndReadBackIsCollectedOnce) {
 TEST_F(SurroundViewTest, APendingPictureOutlivesAGuidelineLayerDrawnBeforeItIsCollected) {
   Rendering rendering(processing::MeshModel::kBowl, {320, 240}, ViewKind::kTop);
   std::vector<GuidelineVertex> vertices;
-  guidelines(CarDimensions{}, GuidelineSettings{}, Travel::kReverse, 0, vertices);
+  guidelines(processing::VehicleDimensions{}, GuidelineSettings{}, Travel::kReverse, 0, vertices);
   rendering.scene.reserveGuidelines(vertices.size());
   rendering.scene.setGuidelines(vertices);
   const cv::Mat expected = rendering.draw();

@@ -99,11 +99,11 @@ std::optional<Span> roundedRectSpan(const cv::Vec2d& o, const cv::Vec2d& d, cons
 }  // namespace
 
 EgoBody::EgoBody(const daemon::VehicleConfig& vehicle) {
-  // car() reduces a footprint polygon to its bounding box and centre.
-  const auto car = vehicle.car();
-  centre_ = {car.centreXM, car.centreYM};
-  halfSize_ = {car.lengthM / 2, car.widthM / 2, (car.heightM - car.groundClearanceM) / 2};
-  centreZ_ = (car.heightM + car.groundClearanceM) / 2;
+  // A footprint polygon drawn as its bounding box.
+  const auto box = vehicle.box();
+  centre_ = {box.centreXM, box.centreYM};
+  halfSize_ = {box.lengthM / 2, box.widthM / 2, (vehicle.heightM - vehicle.groundClearanceM) / 2};
+  centreZ_ = (vehicle.heightM + vehicle.groundClearanceM) / 2;
 }
 
 std::optional<BodyHit> EgoBody::intersect(const cv::Vec3d& origin, const cv::Vec3d& direction,

@@ -41,7 +41,7 @@ class CardRenderer {
         scene_(std::make_unique<SurroundScene>(
             processing::buildSurroundMesh(processing::MeshSettings{},
                                           processing::PanoramaGeometry{}),
-            processing::PanoramaGeometry{}, CarDimensions{}, cv::Size{320, 180})) {
+            processing::PanoramaGeometry{}, processing::VehicleDimensions{}, cv::Size{320, 180})) {
     const cv::Size mode = KmsScreen(card_->fd(), card_->path(), "").size();
     // Even sizes, as views are.
     const cv::Size size(static_cast<int>(mode.width * viewScale) / 2 * 2,

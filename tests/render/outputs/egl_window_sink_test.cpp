@@ -45,7 +45,7 @@ class EglRenderer {
         scene_(std::make_unique<SurroundScene>(
             processing::buildSurroundMesh(processing::MeshSettings{},
                                           processing::PanoramaGeometry{}),
-            processing::PanoramaGeometry{}, CarDimensions{}, cv::Size{320, 180})),
+            processing::PanoramaGeometry{}, processing::VehicleDimensions{}, cv::Size{320, 180})),
         view_(
             std::make_unique<SurroundView>(*scene_, viewSize(), ViewKind::kOrbit, ViewSettings{})) {
     scene_->uploadPanorama(testing::syntheticPicture(processing::PanoramaGeometry{}.size, 5));
