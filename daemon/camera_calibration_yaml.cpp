@@ -96,10 +96,15 @@ void checkDistortion(YamlObject& lens, std::string_view camera, const processing
 
 processing::Intrinsics readLens(YamlObject& lens, std::string_view camera) {
   processing::Intrinsics in;
+  static constexpr auto kModels = [] {
+    std::array<std::pair<std::string_view, LensModel>, processing::kLensModels.size()> named{};
+    for (std::size_t i = 0; i < named.size(); ++i) {
+      named[i] = {lensModelName(processing::kLensModels[i]), processing::kLensModels[i]};
+    }
+    return named;
+  }();
   in.model = lens.choice("model", LensModel::kPinhole,
-                         {{"pinhole", LensModel::kPinhole},
-                          {"fisheye", LensModel::kFisheye},
-                          {"ocam", LensModel::kOcam}});
+                         std::span<const std::pair<std::string_view, LensModel>>(kModels));
   const int width = lens.requiredInteger("width_px", 16, 16384).value_or(0);
   const int height = lens.requiredInteger("height_px", 16, 16384).value_or(0);
   in.imageSize = cv::Size(width, height);

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <numbers>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
 namespace surroundd::processing {
 namespace {
 
@@ -269,6 +272,18 @@ bool CameraModel::inImage(const cv::Point2d& pixel) const {
   // Pixel centres are at integer coordinates, so the image covers [-0.5, size - 0.5).
   return pixel.x >= -0.5 && pixel.y >= -0.5 && pixel.x < intrinsics_.imageSize.width - 0.5 &&
          pixel.y < intrinsics_.imageSize.height - 0.5;
+}
+
+std::string lensKey(const Intrinsics& intrinsics) {
+  // As many names as Intrinsics (and its Ocam) has members: one more there is an error here.
+  const auto& [model, imageSize, fx, fy, cx, cy, distortion, maxFieldAngleRad, ocam] = intrinsics;
+  const auto& [c, d, e, worldToImage, imageToWorld] = ocam;
+  return fmt::format(
+      "{} {}x{} f {:a} {:a} c {:a} {:a} d {:a} fov {:a} ocam {:a} {:a} {:a} world to image {:a} "
+      "image to world {:a}",
+      lensModelName(model), imageSize.width, imageSize.height, fx, fy, cx, cy,
+      fmt::join(distortion, " "), maxFieldAngleRad, c, d, e, fmt::join(worldToImage, " "),
+      fmt::join(imageToWorld, " "));
 }
 
 }  // namespace surroundd::processing

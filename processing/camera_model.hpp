@@ -11,6 +11,7 @@
 
 #include <array>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -18,9 +19,12 @@
 
 namespace surroundd::processing {
 
+// A new model is one more name here and in kLensModels; each switch over the models below (no
+// default: the compiler names one that misses it) says what it is, and lensKey() what defines it.
 enum class LensModel { kPinhole, kFisheye, kOcam };
+inline constexpr std::array kLensModels{LensModel::kPinhole, LensModel::kFisheye, LensModel::kOcam};
 
-// The model's name as the rig file spells it (lens.model).
+// The model's name as the rig file and the tools' options spell it (lens.model, --lens).
 constexpr std::string_view lensModelName(LensModel model) {
   switch (model) {
     case LensModel::kPinhole:
@@ -31,6 +35,28 @@ constexpr std::string_view lensModelName(LensModel model) {
       return "ocam";
   }
   return "?";
+}
+
+// The model named `name` (lensModelName()'s spelling), or none.
+constexpr std::optional<LensModel> lensModelNamed(std::string_view name) {
+  for (const LensModel model : kLensModels) {
+    if (lensModelName(model) == name) return model;
+  }
+  return std::nullopt;
+}
+
+// Whether the model is a wide-angle lens's: its field may reach past 90 degrees, ends at
+// maxFieldAngleRad, and shows as an image circle in the picture. A pinhole lens sees only what is
+// in front of it, and its field is its picture's.
+constexpr bool isWideAngle(LensModel model) {
+  switch (model) {
+    case LensModel::kPinhole:
+      return false;
+    case LensModel::kFisheye:
+    case LensModel::kOcam:
+      return true;
+  }
+  return false;
 }
 
 struct Intrinsics {
@@ -59,6 +85,11 @@ struct Intrinsics {
 
   bool operator==(const Intrinsics&) const = default;
 };
+
+// Every number that defines the lens, exactly (hexadecimal floats), one line: what anything built
+// from the lens (the panorama's LUT cache) keys on. It names each member of Intrinsics, so a
+// member added there does not compile until it is added here too.
+std::string lensKey(const Intrinsics& intrinsics);
 
 class CameraModel {
  public:

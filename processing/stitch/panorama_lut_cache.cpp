@@ -150,17 +150,7 @@ std::string panoramaLutKey(const Rig& rig, const PanoramaSettings& settings) {
   // Hexadecimal floats: exact, so any change of any input changes the key.
   std::string key = fmt::format("surroundd panorama LUT, format {}\n", kFormatVersion);
   for (const auto& camera : rig.cameras) {
-    const Intrinsics& in = camera.intrinsics;
-    key +=
-        fmt::format("camera {} {}x{} f {:a} {:a} c {:a} {:a} d {:a} {:a} {:a} {:a} {:a} fov {:a}\n",
-                    lensModelName(in.model), in.imageSize.width, in.imageSize.height, in.fx, in.fy,
-                    in.cx, in.cy, in.distortion[0], in.distortion[1], in.distortion[2],
-                    in.distortion[3], in.distortion[4], in.maxFieldAngleRad);
-    if (in.model == LensModel::kOcam) {
-      const auto& o = in.ocam;
-      key += fmt::format("  ocam {:a} {:a} {:a} world to image {:a} image to world {:a}\n", o.c,
-                         o.d, o.e, fmt::join(o.worldToImage, " "), fmt::join(o.imageToWorld, " "));
-    }
+    key += fmt::format("camera {}\n", lensKey(camera.intrinsics));
     const auto& r = camera.pose.rotation;
     const auto& t = camera.pose.position;
     key += fmt::format("  pose {:a} {:a} {:a} {:a} {:a} {:a} {:a} {:a} {:a} at {:a} {:a} {:a}\n",

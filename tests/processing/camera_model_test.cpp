@@ -5,6 +5,7 @@
 #include "processing/camera_model.hpp"
 
 #include <filesystem>
+#include <functional>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -382,6 +383,48 @@ TEST(CameraModel, RaysOutsideTheLensHaveNoPixel) {
   const CameraModel wide(ocam());
   EXPECT_FALSE(wide.project(cv::Vec3d(1, 0, -0.2)));  // 101 degrees
   EXPECT_FALSE(wide.unproject(cv::Point2d(-2000, 481)));
+}
+
+// The lens's key (the LUT cache's) changes with every number of every model, and only with those:
+// a parameter it left out would give a stale table with no error.
+TEST(CameraModel, TheLensKeyChangesWithEveryParameter) {
+  for (const LensModel model : kLensModels) {
+    EXPECT_EQ(lensModelNamed(lensModelName(model)), model);
+  }
+  EXPECT_EQ(lensModelNamed("equidistant"), std::nullopt);
+  EXPECT_FALSE(isWideAngle(LensModel::kPinhole));
+  EXPECT_TRUE(isWideAngle(LensModel::kFisheye));
+  EXPECT_TRUE(isWideAngle(LensModel::kOcam));
+
+  Intrinsics base = ocam();
+  base.fx = 300;
+  base.fy = 301;
+  base.distortion = {0.1, 0.2, 0.3, 0.4, 0.5};
+  base.ocam.imageToWorld = {-200, 0, 1e-3};
+  const std::string key = lensKey(base);
+  EXPECT_EQ(lensKey(base), key);
+  const std::vector<std::pair<const char*, std::function<void(Intrinsics&)>>> changes{
+      {"model", [](Intrinsics& in) { in.model = LensModel::kFisheye; }},
+      {"width", [](Intrinsics& in) { ++in.imageSize.width; }},
+      {"height", [](Intrinsics& in) { ++in.imageSize.height; }},
+      {"fx", [](Intrinsics& in) { in.fx = std::nextafter(in.fx, 1e9); }},
+      {"fy", [](Intrinsics& in) { in.fy += 1e-9; }},
+      {"cx", [](Intrinsics& in) { in.cx += 1e-9; }},
+      {"cy", [](Intrinsics& in) { in.cy += 1e-9; }},
+      {"k5", [](Intrinsics& in) { in.distortion[4] = 0.6; }},
+      {"field", [](Intrinsics& in) { in.maxFieldAngleRad += 1e-9; }},
+      {"c", [](Intrinsics& in) { in.ocam.c += 1e-9; }},
+      {"d", [](Intrinsics& in) { in.ocam.d += 1e-9; }},
+      {"e", [](Intrinsics& in) { in.ocam.e += 1e-9; }},
+      {"world to image", [](Intrinsics& in) { in.ocam.worldToImage.back() *= 1.0000001; }},
+      {"world to image's degree", [](Intrinsics& in) { in.ocam.worldToImage.push_back(0); }},
+      {"image to world", [](Intrinsics& in) { in.ocam.imageToWorld.clear(); }},
+  };
+  for (const auto& [what, change] : changes) {
+    Intrinsics changed = base;
+    change(changed);
+    EXPECT_NE(lensKey(changed), key) << what;
+  }
 }
 
 TEST(Rig, MountAnglesRoundTrip) {

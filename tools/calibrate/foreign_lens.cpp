@@ -207,7 +207,7 @@ processing::Intrinsics importedLens(const std::string& camera, const ForeignCali
         "img_dist_h, image_size); give --image-size WxH or the pictures with --images",
         camera, filesOf(found)));
   }
-  if (lens.model != LensModel::kPinhole) {
+  if (processing::isWideAngle(lens.model)) {
     const double degrees =
         options.fieldOfViewDeg
             ? *options.fieldOfViewDeg

@@ -217,9 +217,7 @@ void parseGround(ImportOptions& o, std::string_view text) {
 }
 
 processing::LensModel parseLens(std::string_view text) {
-  if (text == "pinhole") return processing::LensModel::kPinhole;
-  if (text == "fisheye") return processing::LensModel::kFisheye;
-  if (text == "ocam") return processing::LensModel::kOcam;
+  if (const auto model = processing::lensModelNamed(text)) return *model;
   throw UsageError(fmt::format("--lens: expected pinhole, fisheye or ocam, got '{}'", text));
 }
 

@@ -6,7 +6,7 @@
 namespace surroundd::calibrate {
 
 processing::ImageCircle lensCircle(processing::LensModel model, const cv::Mat& brightest) {
-  if (model == processing::LensModel::kPinhole) {
+  if (!processing::isWideAngle(model)) {
     return {cv::Mat(brightest.size(), CV_8U, cv::Scalar(255)), false};
   }
   return processing::findImageCircle(brightest);
@@ -18,7 +18,7 @@ processing::FieldOfView limitField(processing::Intrinsics& lens,
                                    std::optional<double> givenDeg) {
   // A pinhole lens's field is its picture's (what it writes has none): only a wide lens is
   // extrapolated far past its corners.
-  const bool wide = lens.model != processing::LensModel::kPinhole;
+  const bool wide = processing::isWideAngle(lens.model);
   auto field = processing::fieldOfViewOf(
       lens, circle,
       wide ? std::optional(processing::widestCornerAngleRad(lens, views)) : std::nullopt);

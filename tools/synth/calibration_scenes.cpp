@@ -137,7 +137,7 @@ std::vector<processing::Pose> boardPosesCoveringField(const processing::Intrinsi
                                                       int count, std::uint64_t seed) {
   const processing::CameraModel model(intrinsics);
   const cv::Size size = intrinsics.imageSize;
-  const bool fisheye = intrinsics.model != processing::LensModel::kPinhole;  // a wide lens
+  const bool fisheye = processing::isWideAngle(intrinsics.model);
   const double maxCornerAngle = (fisheye ? 80 : 89) * kDegToRad;
   const int cols = std::max(1, static_cast<int>(std::lround(std::sqrt(
                                    count * static_cast<double>(size.width) / size.height))));

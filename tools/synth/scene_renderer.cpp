@@ -23,7 +23,7 @@ constexpr int kChunk = CameraRays::kTileSize;
 CameraRays::CameraRays(const processing::CameraCalibration& camera, const EgoBody* body)
     : size_(camera.intrinsics.imageSize),
       position_(camera.pose.position),
-      fisheye_(camera.intrinsics.model != processing::LensModel::kPinhole),
+      fisheye_(processing::isWideAngle(camera.intrinsics.model)),
       pixels_(static_cast<std::size_t>(size_.area())),
       offAxis_(size_, CV_32F) {
   const processing::CameraModel model(camera.intrinsics);

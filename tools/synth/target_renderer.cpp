@@ -112,7 +112,7 @@ TargetPattern TargetPattern::charuco(cv::Size squares, int dictionary, double ma
 TargetRenderer::TargetRenderer(const processing::Intrinsics& intrinsics, int supersampling)
     : size_(intrinsics.imageSize),
       samples_(supersampling),
-      fisheye_(intrinsics.model != processing::LensModel::kPinhole),
+      fisheye_(processing::isWideAngle(intrinsics.model)),
       rays_(static_cast<std::size_t>(size_.area() * supersampling * supersampling)),
       offAxisAngle_(size_, CV_32F) {
   const processing::CameraModel model(intrinsics);
