@@ -74,9 +74,7 @@ Pipeline::Pipeline(const Config& config, RunStart start)
     auto stage = std::make_unique<PanoramaStage>(config, pool_);
     panorama = stage.get();
     stages_.push_back(std::move(stage));
-    auto watch = std::make_unique<CalibrationWatchStage>(config, panorama->rig());
-    watch_ = watch.get();
-    stages_.push_back(std::move(watch));
+    stages_.push_back(std::make_unique<CalibrationWatchStage>(config, panorama->rig()));
   }
   if (configured(config, OutputStream::kSurround)) {
     auto stage = std::make_unique<SurroundStage>(config, std::move(*renderer_.get()), *panorama,
@@ -158,11 +156,10 @@ PipelineReport Pipeline::report() const {
   report.frameSets = frameSets_;
   report.staleDropped = staleDropped_;
   report.sync = synchronizer_.stats();
-  for (std::size_t c = 0; c < cameras_.size(); ++c) {
-    report.cameras.push_back({cameras_[c]->name(), health_->health(c), cameras_[c]->stats(),
-                              cameras_[c]->queued(), watch_ != nullptr && watch_->drifting(c)});
+  for (const auto& camera : cameras_) {
+    report.cameras.push_back(
+        {.name = camera->name(), .stats = camera->stats(), .queued = camera->queued()});
   }
-  if (watch_ != nullptr) report.seams = watch_->seams();
   report.stages = times_.histograms();
   report.latency = outputs_.latency();
   if (const auto first = outputs_.firstPictureAt()) report.startup = *first - runStart_.at;
@@ -172,11 +169,7 @@ PipelineReport Pipeline::report() const {
   report.failedOutputs = outputs_.failures();
   report.failedSets = failedSets_;
   report.outputDropped = outputs_.dropped();
-  if (surround_ != nullptr) {
-    report.renderer = surround_->description();
-    report.gpuTimed = surround_->gpuTimed();
-    report.gpuSteps = surround_->gpuTimes();
-  }
+  for (const auto& stage : stages_) stage->report(report);
   return report;
 }
 
@@ -204,8 +197,8 @@ RunSummary Pipeline::run(const std::atomic<bool>& stop, PipelineObserver* observ
       }
     }
     if (summary.rebuild) break;
-    // No set to work on: what has been drawn meanwhile goes out now, not with the next set.
-    if (surround_ != nullptr) surround_->deliverFinished(outputs_, times_);
+    // No set to work on: what has been made meanwhile goes out now, not with the next set.
+    for (const auto& stage : stages_) stage->idle(outputs_, times_);
     logFirstPicture();
     const auto now = Clock::now();
     outputs_.retry(now);

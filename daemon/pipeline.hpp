@@ -43,7 +43,6 @@
 
 namespace surroundd::daemon {
 
-class CalibrationWatchStage;
 class CameraHealthStage;
 class MosaicStage;
 class PanoramaStage;
@@ -147,11 +146,12 @@ class Pipeline {
   capture::Timestamp lateAfter_;
   WorkPool pool_;
   // The stages, in their order; before the outputs, whose surround views need the surround
-  // stage's GL context to the end. The named ones are in the list too (for the report).
+  // stage's GL context to the end. Each reports itself (PipelineStage::report()); the two named
+  // here are in the list too: the run's summary lists the health changes, and the surround
+  // views' outputs are opened and redrawn through their stage.
   std::vector<std::unique_ptr<PipelineStage>> stages_;
   CameraHealthStage* health_ = nullptr;
-  SurroundStage* surround_ = nullptr;       // when an output shows a surround view
-  CalibrationWatchStage* watch_ = nullptr;  // with the panorama stage
+  SurroundStage* surround_ = nullptr;  // when an output shows a surround view
   PipelineOutputs outputs_;
   StageTimes times_;
   std::array<cv::Mat, kMaxCameras> bgrBuffers_;  // FrameWork::bgr()'s, one per camera

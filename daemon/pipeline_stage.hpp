@@ -17,6 +17,7 @@
 #include "capture/frame_set.hpp"
 #include "common/camera_limit.hpp"
 #include "daemon/pipeline_outputs.hpp"
+#include "daemon/pipeline_report.hpp"
 #include "daemon/stage_times.hpp"
 
 namespace surroundd::daemon {
@@ -50,6 +51,11 @@ class PipelineStage {
   PipelineStage& operator=(const PipelineStage&) = delete;
 
   virtual void process(FrameWork& work, StageTimes& times) = 0;
+  // No set is waiting: hand over what has finished meanwhile rather than with the next set.
+  virtual void idle(PipelineOutputs& /*outputs*/, StageTimes& /*times*/) {}
+  // Adds what the stage knows to the pipeline's report, whose cameras are listed already (in the
+  // rig's order).
+  virtual void report(PipelineReport& /*report*/) const {}
   // The cameras have stopped and the outputs are about to be finalized: hand over what is still
   // in flight.
   virtual void finish(PipelineOutputs& /*outputs*/) {}

@@ -98,20 +98,20 @@ void CalibrationWatchStage::judge() {
   }
 }
 
-std::vector<SeamReport> CalibrationWatchStage::seams() const {
-  std::vector<SeamReport> reports;
+void CalibrationWatchStage::report(PipelineReport& report) const {
   for (const Seam& seam : seams_) {
-    SeamReport report;
-    report.name = seam.probe.seam().name;
-    report.distanceM = seam.probe.distanceM();
+    SeamReport& measured = report.seams.emplace_back();
+    measured.name = seam.probe.seam().name;
+    measured.distanceM = seam.probe.distanceM();
     if (seam.last) {
-      report.shiftCm = seam.last->shiftCm;
-      report.response = seam.last->response;
-      report.misaligned = seam.last->shiftCm > thresholdCm_;
+      measured.shiftCm = seam.last->shiftCm;
+      measured.response = seam.last->response;
+      measured.misaligned = seam.last->shiftCm > thresholdCm_;
     }
-    reports.push_back(std::move(report));
   }
-  return reports;
+  for (std::size_t c = 0; c < report.cameras.size() && c < drifting_.size(); ++c) {
+    report.cameras[c].calibrationDrifting = drifting_[c];
+  }
 }
 
 }  // namespace surroundd::daemon

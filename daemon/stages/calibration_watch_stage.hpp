@@ -41,11 +41,9 @@ class CalibrationWatchStage final : public PipelineStage {
   CalibrationWatchStage(const Config& config, const processing::Rig& rig);
 
   void process(FrameWork& work, StageTimes& times) override;
-
   // Each seam's last measurement (none before the first, or where the ground could not be
-  // compared).
-  std::vector<SeamReport> seams() const;
-  bool drifting(std::size_t camera) const { return drifting_.at(camera); }
+  // compared), and each camera's verdict.
+  void report(PipelineReport& report) const override;
 
  private:
   struct Seam {

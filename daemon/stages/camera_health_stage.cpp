@@ -32,4 +32,10 @@ void CameraHealthStage::process(FrameWork& work, StageTimes& /*times*/) {
   work.faults = faults_;
 }
 
+void CameraHealthStage::report(PipelineReport& report) const {
+  for (std::size_t c = 0; c < report.cameras.size(); ++c) {
+    report.cameras[c].health = monitor_.health(c);
+  }
+}
+
 }  // namespace surroundd::daemon

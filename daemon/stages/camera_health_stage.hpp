@@ -23,8 +23,9 @@ class CameraHealthStage final : public PipelineStage {
                     const capture::Synchronizer& synchronizer);
 
   void process(FrameWork& work, StageTimes& times) override;
+  // Each camera's health.
+  void report(PipelineReport& report) const override;
 
-  capture::CameraHealth health(std::size_t camera) const { return monitor_.health(camera); }
   // Every change so far, in order; `at` is stream time.
   const std::vector<capture::HealthChange>& changes() const { return changes_; }
 

@@ -470,4 +470,10 @@ cv::Mat SurroundStage::redraw(PipelineOutputs::PictureOutput& output) {
   return output.view->collect();
 }
 
+void SurroundStage::report(PipelineReport& report) const {
+  report.renderer = description();
+  report.gpuTimed = gpuTimer_.available();
+  report.gpuSteps = gpuTimes_;
+}
+
 }  // namespace surroundd::daemon

@@ -105,11 +105,13 @@ class SurroundStage final : public PipelineStage {
   void finish(PipelineOutputs& outputs) override;
   // Whether a working output's view has a picture drawn and not yet handed over.
   static bool drawing(const PipelineOutputs& outputs);
-  // Hands over the pictures whose drawing has finished: for when no set is waiting, so that a
-  // picture goes out as soon as it is drawn rather than when the next set comes.
-  void deliverFinished(PipelineOutputs& outputs, StageTimes& times) {
+  // Hands over the pictures whose drawing has finished, so that a picture goes out as soon as it
+  // is drawn rather than when the next set comes.
+  void idle(PipelineOutputs& outputs, StageTimes& times) override {
     deliver(outputs, &times, Pending::kFinished);
   }
+  // The renderer, and the GPU's times of its steps.
+  void report(PipelineReport& report) const override;
   // The view of the last set, drawn again for an output that writes it at the end.
   cv::Mat redraw(PipelineOutputs::PictureOutput& output);
 
@@ -124,10 +126,6 @@ class SurroundStage final : public PipelineStage {
   // Why the GPU stitch cannot import camera frames from their DMABUFs (render/dmabuf_import.hpp);
   // empty when it can.
   const std::string& dmabufImportRefusal() const { return importRefusal_; }
-  // The GPU's own time of each run of its steps so far (render/gpu_timer.hpp), read a set or two
-  // after the run; none where the driver cannot time them (gpuTimed() false).
-  const std::array<DurationHistogram, render::kGpuSteps>& gpuTimes() const { return gpuTimes_; }
-  bool gpuTimed() const { return gpuTimer_.available(); }
 
   // The vehicle's signals as they are now: the guidelines follow its gear and steering (drawn
   // again only when they change by a tenth of a degree or more).
@@ -186,6 +184,8 @@ class SurroundStage final : public PipelineStage {
   std::unique_ptr<render::EglContext> gl_;
   std::unique_ptr<render::SurroundScene> scene_;
   render::GpuTimer gpuTimer_;  // borrowed by the outputs' views
+  // The GPU's own time of each run of its steps so far (render/gpu_timer.hpp), read a set or two
+  // after the run; none where the driver cannot time them.
   std::array<DurationHistogram, render::kGpuSteps> gpuTimes_{};
   PanoramaStage& panoramaStage_;
   const cv::Mat& panorama_;
