@@ -47,8 +47,8 @@ void summary(std::string& out, std::string_view name, std::string_view labels,
 }  // namespace
 
 const char* toString(Stage stage) {
-  constexpr std::array<const char*, kStageCount> kNames{"sync",   "mosaic",    "stitch", "correct",
-                                                        "render", "read-back", "output"};
+  constexpr std::array<const char*, kStageCount> kNames{"sync",  "mosaic", "stitch",    "correct",
+                                                        "watch", "render", "read-back", "output"};
   return kNames.at(static_cast<std::size_t>(stage));
 }
 

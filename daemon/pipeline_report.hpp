@@ -18,8 +18,11 @@
 
 namespace surroundd::daemon {
 
-// The pipeline thread's stages, timed per frame set.
-enum class Stage { kSync, kMosaic, kStitch, kCorrect, kRender, kReadBack, kOutput, kCount };
+// Where the pipeline thread's time goes, per frame set: each kind of work, whichever pipeline
+// stage does it (the panorama's stitch and a fixed view's gather are both "stitch"). "sync" is
+// the wait for a set's frames and the check of its cameras' health; "watch" the drift watch's
+// measurements.
+enum class Stage { kSync, kMosaic, kStitch, kCorrect, kWatch, kRender, kReadBack, kOutput, kCount };
 inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::kCount);
 const char* toString(Stage stage);
 

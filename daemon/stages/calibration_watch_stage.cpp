@@ -34,7 +34,7 @@ CalibrationWatchStage::CalibrationWatchStage(const Config& config, const process
   }
 }
 
-void CalibrationWatchStage::process(FrameWork& work, StageTimes& /*times*/) {
+void CalibrationWatchStage::process(FrameWork& work, StageTimes& times) {
   if (seams_.empty()) return;
   if (next_ && work.streamTime < *next_) return;
   next_ = work.streamTime + interval_;
@@ -51,6 +51,7 @@ void CalibrationWatchStage::process(FrameWork& work, StageTimes& /*times*/) {
     if (measured.response >= kMinResponse) seam.last = measured;
   }
   judge();
+  times.lap(Stage::kWatch);
 }
 
 std::vector<bool> driftingCameras(std::size_t cameras, std::span<const SeamShift> seams,

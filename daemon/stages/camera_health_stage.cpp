@@ -13,7 +13,7 @@ CameraHealthStage::CameraHealthStage(
   setUpHealthChecks(config, cameras, monitor_);
 }
 
-void CameraHealthStage::process(FrameWork& work, StageTimes& /*times*/) {
+void CameraHealthStage::process(FrameWork& work, StageTimes& times) {
   for (const capture::HealthChange& change : monitor_.observe(work.set, synchronizer_.stats())) {
     const auto& name = cameras_[change.camera]->name();
     const double at = std::chrono::duration<double>(work.streamTime).count();
@@ -30,6 +30,7 @@ void CameraHealthStage::process(FrameWork& work, StageTimes& /*times*/) {
     changes_.back().at = work.streamTime;
   }
   work.faults = faults_;
+  times.lap(Stage::kSync);
 }
 
 void CameraHealthStage::report(PipelineReport& report) const {

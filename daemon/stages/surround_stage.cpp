@@ -364,6 +364,7 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
         // Without a panorama this set, also when not wanted: the run's end hands over the last
         // set's picture, and there is no panorama to draw it from.
         if (!wanted && !panoramaSkipped_) return;
+        times.lap(Stage::kRender);  // the views drawn before this one
         // The car, the background and the split view's camera go where the view shows no
         // panorama, before the correction, which leaves those pixels as they are; the guidelines
         // over the corrected picture.
@@ -376,6 +377,7 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
           cv::Mat into = fixed->picture(*area);
           cv::resize(*camera, into, area->size(), 0, 0, cv::INTER_LINEAR);
         }
+        times.lap(Stage::kStitch);
         // An encoder's picture is made in I420 as it is corrected; with guidelines, after them.
         const bool guided = scene_->hasGuidelines();
         fixed->inI420 = output.sink->takesI420();
@@ -387,6 +389,7 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
             processing::bgrToI420(fixed->picture, fixed->i420, panoramaStage_.pool());
           }
         }
+        times.lap(Stage::kCorrect);
         fixed->drawnAt = work.streamTime;
         fixed->handOver = wanted;
         anyFixed = anyFixed || wanted;
