@@ -26,7 +26,8 @@ namespace surroundd::daemon {
 std::optional<std::string> outputFileClash(const OutputConfig& a, const OutputConfig& b);
 
 // The path this run writes `output` to: its own, or <stem>-N<ext> with N one past the highest
-// present when its own holds data. Outputs without a file (or segmented ones, or snapshots) keep theirs.
+// present when its own holds data. Outputs without a file (or segmented ones, or snapshots) keep
+// theirs.
 std::filesystem::path unusedOutputPath(const OutputConfig& output);
 
 // Creates `folder` for output `output`'s files; throws std::runtime_error naming both.

@@ -49,9 +49,10 @@ cv::Mat bodyMaskOf(const Config& config, std::size_t index, WorkPool& pool) {
       }
       mask |= picture > 127;
     }
-    if (!own.polygon.empty()) {
+    // One at a time: where two overlap, both are body (fillPoly of several would leave a hole).
+    for (const auto& polygon : own.polygons) {
       std::vector<cv::Point> corners;
-      for (const auto& [u, v] : own.polygon) {
+      for (const auto& [u, v] : polygon) {
         corners.emplace_back(static_cast<int>(std::lround(u)), static_cast<int>(std::lround(v)));
       }
       cv::fillPoly(mask, std::vector{corners}, cv::Scalar(255));
@@ -109,8 +110,10 @@ std::filesystem::path lutCacheDir(const Config& config) {
   return std::filesystem::temp_directory_path() / "surroundd";
 }
 
-processing::PanoramaLut obtainPanoramaLut(const Config& config, const processing::Rig& rig,
-                                          WorkPool& pool) {
+namespace {
+
+processing::PanoramaLut loadOrBuildLut(const Config& config, const processing::Rig& rig,
+                                       WorkPool& pool) {
   const processing::PanoramaSettings settings = panoramaSettings(config);
   const std::string key = processing::panoramaLutKey(rig, settings);
   const processing::PanoramaLutCache cache(lutCacheDir(config));
@@ -143,6 +146,31 @@ processing::PanoramaLut obtainPanoramaLut(const Config& config, const processing
   } catch (const std::exception& e) {
     spdlog::warn("panorama LUT not cached: {}", e.what());
   }
+  return lut;
+}
+
+// A camera the LUT takes nothing from: its body mask hides all it would show (buildPanoramaLut()
+// refuses a camera that sees nothing for any other reason).
+void warnOfHiddenCameras(const processing::Rig& rig, const processing::PanoramaLut& lut) {
+  for (const std::size_t c : lut.camerasWithoutTaps()) {
+    const auto& camera = rig.cameras[c];
+    const double masked = 100.0 * cv::countNonZero(camera.bodyMask) /
+                          static_cast<double>(std::max<std::size_t>(camera.bodyMask.total(), 1));
+    spdlog::warn(
+        "camera '{}' contributes nothing to the panorama: its body mask ({:.0f} % of its picture) "
+        "hides all it would show; the panorama is made from the other cameras. Check vehicle: (a "
+        "camera inside the body's box sees only the body: give the footprint instead, or find the "
+        "body with surround-calibrate mask --from a recorded drive) and the camera's body_mask:",
+        camera.name, masked);
+  }
+}
+
+}  // namespace
+
+processing::PanoramaLut obtainPanoramaLut(const Config& config, const processing::Rig& rig,
+                                          WorkPool& pool) {
+  processing::PanoramaLut lut = loadOrBuildLut(config, rig, pool);
+  warnOfHiddenCameras(rig, lut);
   return lut;
 }
 

@@ -198,10 +198,20 @@ void emitCamera(YAML::Emitter& out, const RigCamera& camera, const std::filesyst
       out << YAML::Key << "file" << YAML::Value
           << (inside ? mask.file.filename() : mask.file).string();
     }
-    if (!mask.polygon.empty()) {
-      out << YAML::Key << "polygon" << YAML::Value << YAML::BeginSeq;
-      for (const auto& [u, v] : mask.polygon) out << YAML::BeginSeq << u << v << YAML::EndSeq;
-      out << YAML::EndSeq;
+    if (!mask.polygons.empty()) {
+      const auto emit = [&](const auto& polygon) {
+        out << YAML::BeginSeq;
+        for (const auto& [u, v] : polygon) out << YAML::BeginSeq << u << v << YAML::EndSeq;
+        out << YAML::EndSeq;
+      };
+      out << YAML::Key << "polygon" << YAML::Value;
+      if (mask.polygons.size() == 1) {
+        emit(mask.polygons.front());
+      } else {
+        out << YAML::BeginSeq;
+        for (const auto& polygon : mask.polygons) emit(polygon);
+        out << YAML::EndSeq;
+      }
     }
     out << YAML::EndMap;
   }

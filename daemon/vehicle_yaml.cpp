@@ -124,9 +124,11 @@ BodyMaskConfig readBodyMask(YamlObject& m, cv::Size lensSize) {
                                           : fmt::format("{}x{}", picture.cols, picture.rows)));
     }
   }
-  if (auto polygon = m.points("polygon", 3)) c.polygon = *polygon;
+  if (auto polygons = m.pointLists("polygon", 3)) c.polygons = std::move(*polygons);
   if (!m.has("file") && !m.has("polygon")) {
-    m.errorHere("expected 'file' (a mask picture, white = body) and/or 'polygon' (pixels)");
+    m.errorHere(
+        "expected 'file' (a mask picture, white = body) and/or 'polygon' (pixels: one, or a list "
+        "of them)");
   }
   m.finish();
   return c;

@@ -6,7 +6,8 @@
 // vehicleKeys()'s table, with their ranges and docs; config/surroundd.reference.yaml shows them.
 //
 // Per camera, `body_mask:` adds to or replaces the computed mask: `{file: mask.png}` (white =
-// body, the lens's size) and/or `{polygon: [[u, v], ...]}` in pixels, `mode: add | replace`.
+// body, the lens's size) and/or `{polygon: [[u, v], ...]}` in pixels (or several:
+// `[[[u, v], ...], ...]`, as surround-calibrate mask --from writes them), `mode: add | replace`.
 
 #include <array>
 #include <filesystem>
@@ -27,8 +28,8 @@ struct VehicleConfig : processing::VehicleDimensions {
 
 struct BodyMaskConfig {
   enum class Mode { kAdd, kReplace } mode = Mode::kAdd;
-  std::filesystem::path file;                  // white = body; empty: none
-  std::vector<std::array<double, 2>> polygon;  // pixels; empty: none
+  std::filesystem::path file;                                // white = body; empty: none
+  std::vector<std::vector<std::array<double, 2>>> polygons;  // pixels; empty: none
 
   bool operator==(const BodyMaskConfig&) const = default;
 };

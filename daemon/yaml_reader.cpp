@@ -295,13 +295,40 @@ std::optional<std::vector<double>> YamlObject::numberList(
 std::optional<std::vector<std::array<double, 2>>> YamlObject::points(std::string_view key,
                                                                      std::size_t minCount) {
   if (!has(key)) return std::nullopt;
+  return pointsIn(at(key), key, minCount);
+}
+
+std::optional<std::vector<std::vector<std::array<double, 2>>>> YamlObject::pointLists(
+    std::string_view key, std::size_t minCount) {
+  if (!has(key)) return std::nullopt;
+  const YAML::Node list = at(key);
+  // [[x, y], ...] is one list; [[[x, y], ...], ...] several.
+  const bool several = list.IsSequence() && list.size() > 0 && list[0].IsSequence() &&
+                       list[0].size() > 0 && list[0][0].IsSequence();
+  if (!several) {
+    auto one = pointsIn(list, key, minCount);
+    if (!one) return std::nullopt;
+    return std::vector<std::vector<std::array<double, 2>>>{std::move(*one)};
+  }
+  std::vector<std::vector<std::array<double, 2>>> result;
+  for (const auto& item : list) {
+    auto points = pointsIn(item, key, minCount);
+    if (!points) return std::nullopt;
+    result.push_back(std::move(*points));
+  }
+  return result;
+}
+
+std::optional<std::vector<std::array<double, 2>>> YamlObject::pointsIn(const YAML::Node& list,
+                                                                       std::string_view key,
+                                                                       std::size_t minCount) {
   const std::string expected =
       fmt::format("a list of at least {} [x, y] pairs of numbers", minCount);
-  YAML::Node list = at(key);
   if (!list.IsSequence() || list.size() < minCount) {
-    error(key,
-          fmt::format("expected {}, got {}", expected,
-                      list.IsSequence() ? fmt::format("{} items", list.size()) : describe(list)));
+    diag_->error(
+        file_, list.Mark(), childPath(key),
+        fmt::format("expected {}, got {}", expected,
+                    list.IsSequence() ? fmt::format("{} items", list.size()) : describe(list)));
     return std::nullopt;
   }
   std::vector<std::array<double, 2>> result;

@@ -84,6 +84,9 @@ class YamlObject {
   // A list of [x, y] pairs, at least `minCount` of them (a polygon).
   std::optional<std::vector<std::array<double, 2>>> points(std::string_view key,
                                                            std::size_t minCount);
+  // One such list, or a list of them (polygons): each at least `minCount` pairs.
+  std::optional<std::vector<std::vector<std::array<double, 2>>>> pointLists(std::string_view key,
+                                                                            std::size_t minCount);
 
   template <class E>
   E choice(std::string_view key, E fallback,
@@ -120,6 +123,10 @@ class YamlObject {
   }
   std::optional<YAML::Node> scalar(std::string_view key, std::string_view expected);
   std::string childPath(std::string_view key) const;
+  // points()'s reading of `list`, found at `key`.
+  std::optional<std::vector<std::array<double, 2>>> pointsIn(const YAML::Node& list,
+                                                             std::string_view key,
+                                                             std::size_t minCount);
   YAML::Mark markOf(std::string_view key) const;
   std::optional<std::vector<double>> numberList(std::string_view key, const std::string& expected,
                                                 const std::function<bool(std::size_t)>& sizeFits);

@@ -41,3 +41,9 @@ set(body --size 640x360 --panorama-size 256x128 --seconds 0.2 --photometrics ide
 surroundd_fixture(synth_body_paper --rig ${paper_body} ${body} --seed 3)
 surroundd_fixture(synth_body_paper_plain --rig ${paper_body} ${body} --seed 3 --no-body)
 surroundd_fixture(synth_body_fisheye --rig ${fisheye_body} ${body} --seed 3 --scene near-objects)
+# A drive with the body in view, as a user records one for surround-calibrate mask --from: four
+# ten seconds at two pictures a second (15 m, turning 23 degrees), the photometrics random (noise,
+# exposure drift).
+set(drive --size 640x360 --panorama-size 256x128 --seconds 10 --fps 2)
+surroundd_fixture(synth_drive_paper --rig ${paper_body} ${drive} --seed 3)
+surroundd_fixture(synth_drive_fisheye --rig ${fisheye_body} ${drive} --seed 3 --scene near-objects)

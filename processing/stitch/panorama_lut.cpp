@@ -72,6 +72,25 @@ std::vector<ColumnPlan> planColumns(const PanoramaProjector& projector) {
   return columns;
 }
 
+// Whether camera `camera`, which the LUT takes nothing from, would show part of its sector but
+// for its body mask: then the rig is sound, the camera sees only its own car there.
+bool hiddenByBody(const Rig& rig, const PanoramaSettings& settings,
+                  const std::vector<ColumnPlan>& columns, std::size_t camera) {
+  if (rig.cameras[camera].bodyMask.empty()) return false;
+  Rig bare = rig;
+  bare.cameras[camera].bodyMask = cv::Mat();
+  const PanoramaProjector withoutBody(bare, settings);
+  const cv::Size size = settings.geometry.size;
+  constexpr int kStep = 4;  // a coarse look is enough to tell none from some
+  for (int u = 0; u < size.width; u += kStep) {
+    if (columns[static_cast<std::size_t>(u)].owner != camera) continue;
+    for (int v = 0; v < size.height; v += kStep) {
+      if (withoutBody.cameraPixel(camera, cv::Point2d(u, v))) return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 LutTap encodeTap(const cv::Point2d& p, cv::Size size, std::uint8_t camera) {
@@ -225,7 +244,7 @@ PanoramaLut buildPanoramaLut(const Rig& rig, const PanoramaSettings& settings, W
   for (std::size_t camera = 0; camera < n; ++camera) {
     int total = 0;
     for (int v = 0; v < size.height; ++v) total += used[static_cast<std::size_t>(v) * n + camera];
-    if (total == 0) {
+    if (total == 0 && !hiddenByBody(rig, settings, columns, camera)) {
       throw RigError(fmt::format(
           "camera '{}' contributes nothing to the panorama (elevation {:.1f} to {:.1f} deg): it "
           "sees none of it, or only what other cameras see nearer their axes; check its mount",
@@ -241,6 +260,19 @@ cv::Mat PanoramaLut::ownerMap() const {
   auto* out = owner.ptr<std::uint8_t>();
   for (std::size_t i = 0; i < taps.size(); ++i) out[i] = taps[i].camera;
   return owner;
+}
+
+std::vector<std::size_t> PanoramaLut::camerasWithoutTaps() const {
+  std::vector<char> sampled(cameraSizes.size(), 0);
+  for (const LutTap& tap : taps) {
+    if (tap.camera != kUnseen) sampled[tap.camera] = 1;
+  }
+  for (const BlendTap& blend : blendTaps) sampled[blend.tap.camera] = 1;
+  std::vector<std::size_t> without;
+  for (std::size_t camera = 0; camera < sampled.size(); ++camera) {
+    if (sampled[camera] == 0) without.push_back(camera);
+  }
+  return without;
 }
 
 cv::Mat PanoramaLut::validMask() const {

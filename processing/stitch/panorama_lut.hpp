@@ -85,6 +85,8 @@ struct PanoramaLut {
 
   cv::Mat ownerMap() const;   // CV_8U: the primary camera of each pixel, kUnseen where none
   cv::Mat validMask() const;  // CV_8U: 255 where a camera sees the pixel, else 0
+  // The cameras no tap samples (each one's body mask hides all it would show), in rig order.
+  std::vector<std::size_t> camerasWithoutTaps() const;
 
   bool operator==(const PanoramaLut&) const = default;
 };
@@ -127,7 +129,8 @@ using LutProgress = std::function<void(double)>;
 
 // Builds the LUT row-parallel on `pool`. Throws RigError naming a camera that sees none of the
 // panorama, and std::invalid_argument for a rig of more than kMaxCameras
-// (common/camera_limit.hpp).
+// (common/camera_limit.hpp). A camera whose body mask hides all it would show gives the LUT
+// nothing and is no error (camerasWithoutTaps() names it): the others make the panorama.
 PanoramaLut buildPanoramaLut(const Rig& rig, const PanoramaSettings& settings, WorkPool& pool,
                              const LutProgress& progress = {});
 

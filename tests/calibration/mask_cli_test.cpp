@@ -245,5 +245,95 @@ TEST(MaskCli, BadInputExitsTwoNamingIt) {
   EXPECT_THAT(run.output, HasSubstr("usage: surround-calibrate mask --config FILE --out DIR"));
 }
 
+// mask --from a drive: the polygons it prints, pasted into the rig as each camera's body_mask:,
+// mask what the generator's true body masks say is body (the paper rig's roofs: IoU >= 0.95), and
+// so does each -found-body.png.
+TEST(MaskFromDrive, ThePolygonsPastedIntoTheRigMaskTheBody) {
+  const TempDir dir;
+  const auto drive = std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_drive_paper";
+  const CalibrateRun run =
+      calibrate(dir, {"mask", "--from", drive.string(), "--out", (dir / "masks").string()});
+  ASSERT_EQ(run.status, 0) << run.output;
+  const YAML::Node truth = YAML::LoadFile((drive / "ground_truth.yaml").string());
+  daemon::RigFile rig = daemon::loadRig(drive / "rig.yaml");
+  for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+    const std::string name = rig.cameras[c].calibration.name;
+    SCOPED_TRACE(name);
+    EXPECT_THAT(run.output,
+                ::testing::ContainsRegex(name + ": [0-9.]+ % of the picture is body \\(20 "
+                                                "pictures, [0-9]+ % of the ground moved\\)"));
+    // The printed YAML: "  - name: NAME\n    body_mask: {mode: add, polygon: ...}".
+    const std::string heading = "  - name: " + name + "\n    body_mask: ";
+    const auto at = run.output.find(heading);
+    ASSERT_NE(at, std::string::npos) << run.output;
+    const auto start = at + heading.size();
+    YAML::Node mask = YAML::Load(run.output.substr(start, run.output.find('\n', start) - start));
+    EXPECT_EQ(mask["mode"].as<std::string>(), "add");
+    mask["mode"] = "replace";  // the polygons alone, for the comparison
+    daemon::Diagnostics diagnostics;
+    daemon::YamlObject object(mask, "body_mask", dir / "pasted.yaml", diagnostics);
+    rig.cameras[c].bodyMask =
+        daemon::readBodyMask(object, rig.cameras[c].calibration.intrinsics.imageSize);
+    ASSERT_TRUE(diagnostics.empty()) << diagnostics.messages().front();
+
+    const cv::Mat trueBody =
+        cv::imread((drive / truth["cameras"][c]["body_mask"].as<std::string>()).string(),
+                   cv::IMREAD_GRAYSCALE) > 0;
+    const auto iou = [&](const cv::Mat& found) {
+      return cv::countNonZero(found & trueBody) /
+             static_cast<double>(cv::countNonZero(found | trueBody));
+    };
+    EXPECT_GE(iou(readMask(dir / "masks" / (name + "-found-body.png")) > 0), 0.95);
+    daemon::Config config;
+    config.cameras = rig.cameras;
+    WorkPool pool(1);
+    EXPECT_GE(iou(daemon::bodyMaskOf(config, c, pool) > 0), 0.95);
+    EXPECT_TRUE(std::filesystem::exists(dir / "masks" / (name + "-found-overlay.png")));
+  }
+}
+
+TEST(MaskFromDrive, TooShortALiveOrAStillDriveExitsTwoNamingIt) {
+  const TempDir dir;
+  const auto fixtures = std::filesystem::path(SURROUNDD_FIXTURE_DIR);
+  // 0.2 s of the paper rig: six pictures.
+  CalibrateRun run = calibrate(dir, {"mask", "--from", (fixtures / "synth_body_paper").string(),
+                                     "--out", (dir / "masks").string(), "--every", "0.1"});
+  EXPECT_EQ(run.status, 2) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("camera 'front': "));
+  EXPECT_THAT(run.output,
+              HasSubstr("gives 2 pictures 0.1 s apart; at least 16 are needed (a drive of 1.6 s"));
+
+  // Ten seconds of one picture: the car stood still.
+  const cv::Mat still = firstFrame(daemon::loadRig(kRecording / "rig.yaml").cameras.front());
+  for (int i = 0; i < 20; ++i) {
+    cv::imwrite((dir / fmt::format("still_{:04d}.png", i)).string(), still);
+  }
+  const auto rig = writeRig(dir, [&](YAML::Node& yaml) {
+    for (YAML::Node camera : yaml["cameras"]) {
+      camera["source"] =
+          YAML::Load("{file: " + (dir / "still_%04d.png").string() + ", sequence_fps: 2}");
+    }
+  });
+  run = calibrate(dir, {"mask", "--from", rig.string(), "--out", (dir / "masks").string(),
+                        "--camera", "front"});
+  EXPECT_EQ(run.status, 2) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("the car must drive while it records"));
+
+  const auto live = writeRig(dir, [](YAML::Node& yaml) {
+    for (YAML::Node camera : yaml["cameras"]) {
+      camera["source"] = YAML::Load("{device: /dev/video-not-opened}");
+    }
+  });
+  run = calibrate(dir, {"mask", "--from", live.string(), "--out", (dir / "masks").string()});
+  EXPECT_EQ(run.status, 2) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("camera 'front' is live, not recorded"));
+
+  run = calibrate(dir, {"mask", "--from", live.string(), "--config", live.string(), "--out",
+                        (dir / "masks").string()});
+  EXPECT_EQ(run.status, 2) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("expected either --config"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "masks"));
+}
+
 }  // namespace
 }  // namespace surroundd::calibration::testing

@@ -2,6 +2,8 @@
 // the service, losing the recording's end. Now a frame set a stage fails on is dropped and
 // counted, the run goes on and finalizes its outputs; many failures in a row end the run asking
 // for a rebuild. The failures come through the observer's per-set hook, which counts as a stage.
+// And a camera that sees only its own car (issue 47: a real camera inside the body's box) is
+// named with the body as the cause, and the daemon runs with the others.
 
 #include <stdexcept>
 
@@ -10,6 +12,7 @@
 
 #include "daemon/pipeline.hpp"
 #include "tests/daemon/replay_config.hpp"
+#include "tests/support/log_capture.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -63,6 +66,35 @@ TEST(FaultIsolation, FailuresInARowEndTheRunForARebuild) {
   EXPECT_EQ(summary.failedSets, static_cast<std::uint64_t>(Pipeline::kRebuildAfterFailures));
   // What it wrote before is finalized, not lost.
   EXPECT_EQ(surroundd::testing::decodeAll(dir / "mosaic.mkv").images.size(), 2u);
+}
+
+TEST(FaultIsolation, ACameraThatSeesOnlyTheBodyIsNamedAndTheOthersRun) {
+  const testing::TempDir dir;
+  OutputConfig video = videoOutputAt(dir / "panorama.mp4");
+  video.stream = OutputStream::kPanorama;
+  Config config = fixtureReplay("synth_small", {video});
+  useSmallPanorama(config, dir / "lut");
+  const cv::Size size = config.cameras[2].calibration.intrinsics.imageSize;
+  const double right = size.width - 1, bottom = size.height - 1;
+  BodyMaskConfig everything;  // the whole picture is body
+  everything.mode = BodyMaskConfig::Mode::kReplace;
+  everything.polygons = {{{0.0, 0.0}, {right, 0.0}, {right, bottom}, {0.0, bottom}}};
+  config.cameras[2].bodyMask = everything;
+  std::vector<std::string> log;
+  RunSummary summary;
+  {
+    const testing::LogCapture capture;
+    Pipeline pipeline(config);
+    const std::atomic<bool> stop{false};
+    summary = pipeline.run(stop);
+    log = capture.lines();
+  }
+  EXPECT_THAT(log, ::testing::Contains(::testing::HasSubstr(
+                       "camera 'back' contributes nothing to the panorama: its body mask (100 % "
+                       "of its picture) hides all it would show; the panorama is made from the "
+                       "other cameras")));
+  EXPECT_EQ(summary.frameSets, 30U);
+  EXPECT_EQ(testing::decodeAll(dir / "panorama.mp4").images.size(), 30U);
 }
 
 }  // namespace

@@ -57,6 +57,7 @@ that share a board; writes only when every camera and seam passes, and exits 1 o
 
 constexpr std::string_view kMaskUsage =
     R"(usage: surround-calibrate mask --config FILE --out DIR [--camera NAME]
+       surround-calibrate mask --from RECORDING --out DIR [--camera NAME] [--every S]
 
 Each camera's body mask (the pixels that see the vehicle, left out of the panorama and colour
 correction) drawn on the camera's first picture, to check it, and the mask itself, to edit it. The
@@ -72,6 +73,22 @@ camera's body_mask: added or put in its place. Writes, per camera:
   --config FILE              the surroundd config
   --out DIR                  folder for the pictures (made when missing)
   --camera NAME              only this camera
+
+With --from, the body is found in a recording of a drive instead (a surroundd recording output's
+folder, or a rig file whose cameras are recordings): where a camera looks down at the road, what
+keeps its place while the ground slides past is its own car — a bumper, the grille, a mirror's
+housing, the roof — which no measured box may fit. Record a drive of at least ten seconds (a few
+metres, turning a little, in daylight). Writes, per camera:
+
+  DIR/NAME-found-body.png     the body found, white = body
+  DIR/NAME-found-overlay.png  the drive's last picture with it tinted red
+
+and prints each camera's body_mask: with the outlines as polygons (mode: add, so that the mask
+computed from vehicle: stays: a body that mirrors the road at a grazing angle, a glossy flank,
+shows no still picture and is only found there).
+
+  --from RECORDING           the recording's rig file, or its folder (with rig.yaml)
+  --every S                  seconds of the drive between the pictures compared (default 0.5)
 )";
 
 constexpr std::string_view kUpdateRigUsage =
@@ -119,12 +136,19 @@ ExtrinsicsOptions parseExtrinsics(std::span<const std::string_view> arguments) {
 
 MaskOptions parseMask(std::span<const std::string_view> arguments) {
   MaskOptions o;
-  parseOptions(arguments,
-               {{"--config", [&](auto v) { o.config = std::string(v); }},
-                {"--out", [&](auto v) { o.out = std::string(v); }},
-                {"--camera", [&](auto v) { o.camera = std::string(v); }}},
-               {});
-  if (o.config.empty()) throw UsageError("--config: missing (the surroundd config)");
+  parseOptions(
+      arguments,
+      {{"--config", [&](auto v) { o.config = std::string(v); }},
+       {"--from", [&](auto v) { o.from = std::string(v); }},
+       {"--every", [&](auto v) { o.everyS = parseDouble("--every", v, 0.02, 60, "seconds"); }},
+       {"--out", [&](auto v) { o.out = std::string(v); }},
+       {"--camera", [&](auto v) { o.camera = std::string(v); }}},
+      {});
+  if (o.config.empty() == o.from.empty()) {
+    throw UsageError(
+        "expected either --config (the surroundd config: its masks drawn) or --from (a recording "
+        "of a drive: the body found in it)");
+  }
   if (o.out.empty()) throw UsageError("--out: missing (the folder to write the pictures to)");
   return o;
 }

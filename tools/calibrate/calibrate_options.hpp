@@ -50,8 +50,12 @@ struct ExtrinsicsOptions {
 
 struct MaskOptions {
   std::filesystem::path config;  // the surroundd config (its rig, vehicle: and body_mask:s)
-  std::filesystem::path out;     // folder for the pictures
-  std::string camera;            // empty: every camera
+  // Or a recording of a drive (its rig file, or the folder that holds rig.yaml): the body found in
+  // its pictures.
+  std::filesystem::path from;
+  std::filesystem::path out;  // folder for the pictures
+  std::string camera;         // empty: every camera
+  double everyS = 0.5;        // --every: seconds of the drive between the pictures looked at
 };
 
 struct HelpRequest {

@@ -14,15 +14,12 @@
 #include "daemon/config.hpp"
 #include "daemon/panorama_setup.hpp"
 #include "tools/calibrate/calibration_output.hpp"
+#include "tools/calibrate/drive_mask_command.hpp"
+#include "tools/calibrate/mask_overlay.hpp"
 
 namespace surroundd::calibrate {
 namespace {
 
-// BGR. Yellow outlines stand out on the red tint and on most road scenes.
-const cv::Scalar kTint(0, 0, 255);
-const cv::Scalar kOutline(0, 255, 255);
-const cv::Scalar kLabelBackground(0, 0, 0);
-const cv::Scalar kLabelText(255, 255, 255);
 // A live camera's stand-in picture: dark, so that the tint and the outline still show.
 const cv::Scalar kLiveGrey = cv::Scalar::all(64);
 
@@ -62,66 +59,13 @@ std::string maskOrigin(const daemon::Config& config, const daemon::RigCamera& ca
     parts.emplace_back("computed from vehicle:");
   }
   if (own && !own->file.empty()) parts.push_back("file " + own->file.filename().string());
-  if (own && !own->polygon.empty()) parts.emplace_back("polygon");
+  if (own && !own->polygons.empty()) parts.emplace_back("polygon");
   if (parts.empty()) {
     return config.vehicle ? "nothing: vehicle.body_masks is false" : "nothing: no vehicle";
   }
   std::string joined = parts.front();
   for (std::size_t i = 1; i < parts.size(); ++i) joined += " + " + parts[i];
   return joined;
-}
-
-// White text on black, sized to the picture (legible from a 320-pixel test picture to a 4K one),
-// in the corner where it hides the least of the mask.
-void drawLabel(cv::Mat& picture, const cv::Mat& mask, const std::vector<std::string>& lines) {
-  constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
-  const double scale = std::clamp(picture.cols / 1280.0, 0.35, 2.0);
-  const int thickness = scale < 1 ? 1 : 2;
-  const int pad = static_cast<int>(std::lround(6 * scale)) + 2;
-  int width = 0, textHeight = 0, descent = 0;
-  for (const auto& line : lines) {
-    int baseline = 0;
-    const cv::Size size = cv::getTextSize(line, kFont, scale, thickness, &baseline);
-    width = std::max(width, size.width);
-    textHeight = std::max(textHeight, size.height);
-    descent = std::max(descent, baseline);
-  }
-  const int lineHeight = textHeight + descent + pad;
-  const int count = static_cast<int>(lines.size());
-  const cv::Size box(std::min(width + 2 * pad, picture.cols),
-                     std::min(lineHeight * count + pad, picture.rows));
-  const int right = picture.cols - box.width, bottom = picture.rows - box.height;
-  cv::Rect best;
-  int bestHidden = -1;
-  for (const cv::Point corner :
-       {cv::Point(0, 0), cv::Point(right, 0), cv::Point(0, bottom), cv::Point(right, bottom)}) {
-    const cv::Rect rect(corner, box);
-    const int hidden = cv::countNonZero(mask(rect));
-    if (bestHidden < 0 || hidden < bestHidden) {
-      best = rect;
-      bestHidden = hidden;
-    }
-  }
-  cv::rectangle(picture, best, kLabelBackground, cv::FILLED);
-  for (int i = 0; i < count; ++i) {
-    cv::putText(picture, lines[static_cast<std::size_t>(i)],
-                best.tl() + cv::Point(pad, pad + lineHeight * i + textHeight), kFont, scale,
-                kLabelText, thickness, cv::LINE_AA);
-  }
-}
-
-// The picture with the body blended half with red and its outline (holes too) drawn 2 px wide.
-cv::Mat overlay(const cv::Mat& picture, const cv::Mat& mask,
-                const std::vector<std::string>& label) {
-  cv::Mat out = picture.clone();
-  cv::Mat tinted;
-  cv::addWeighted(picture, 0.5, cv::Mat(picture.size(), picture.type(), kTint), 0.5, 0, tinted);
-  tinted.copyTo(out, mask);
-  std::vector<std::vector<cv::Point>> contours;
-  cv::findContours(mask, contours, cv::RETR_LIST, cv::CHAIN_APPROX_SIMPLE);
-  cv::drawContours(out, contours, -1, kOutline, 2);
-  drawLabel(out, mask, label);
-  return out;
 }
 
 // `{file: PATH, mode: replace}`, quoted where the path needs it.
@@ -135,6 +79,10 @@ std::string replaceMaskYaml(const std::filesystem::path& file) {
 }  // namespace
 
 void runMask(const MaskOptions& options, std::ostream& log) {
+  if (!options.from.empty()) {
+    runDriveMask(options, log);
+    return;
+  }
   const daemon::Config config = daemon::loadConfig(options.config);
   std::vector<std::size_t> chosen;
   std::string names;
@@ -179,7 +127,7 @@ void runMask(const MaskOptions& options, std::ostream& log) {
     const auto overlayFile = options.out / (name + "-mask-overlay.png");
     const auto bodyFile = options.out / (name + "-body.png");
     writePng(bodyFile, mask);
-    writePng(overlayFile, overlay(picture, mask, label));
+    writePng(overlayFile, maskOverlay(picture, mask, label));
     bodyFiles.emplace_back(name, bodyFile);
     log << fmt::format("{}: {:.1f} % masked ({}){}: {}, {}\n", name, share, origin,
                        camera.live() ? ", live camera: drawn on grey" : "", overlayFile.string(),

@@ -186,6 +186,33 @@ TEST(PanoramaLut, ACameraThatSeesNothingIsNamed) {
                   ::testing::HasSubstr("camera 'back' contributes nothing to the panorama")));
 }
 
+// A camera that sees only its own car (its body mask hides all it would show: a camera inside
+// the body's box) is no rig error: the LUT takes nothing from it and names it, the other cameras
+// make the panorama as they would beside it.
+TEST(PanoramaLut, ACameraHiddenByTheBodyGivesNothingAndTheOthersGoOn) {
+  Rig rig = smallRecording().rig;
+  const cv::Size size = rig.cameras[2].intrinsics.imageSize;
+  rig.cameras[2].bodyMask = cv::Mat(size, CV_8U, cv::Scalar(255));
+  WorkPool pool(1);
+  const PanoramaLut lut = buildPanoramaLut(rig, settingsFor(smallRecording()), pool);
+  EXPECT_EQ(lut.camerasWithoutTaps(), std::vector<std::size_t>{2});
+  const PanoramaLut whole =
+      buildPanoramaLut(smallRecording().rig, settingsFor(smallRecording()), pool);
+  EXPECT_TRUE(whole.camerasWithoutTaps().empty());
+  // Where the back camera was the only one to see the ground, nothing does now; elsewhere the
+  // others' taps are those of the whole rig.
+  std::size_t same = 0, lost = 0;
+  for (std::size_t i = 0; i < lut.taps.size(); ++i) {
+    if (whole.taps[i].camera == 2) {
+      lost += lut.taps[i].camera == PanoramaLut::kUnseen ? 1 : 0;
+    } else {
+      same += lut.taps[i].camera == whole.taps[i].camera ? 1 : 0;
+    }
+  }
+  EXPECT_GT(lost, 0U);
+  EXPECT_GT(same, lut.taps.size() / 2);
+}
+
 TEST(PanoramaLut, ProgressIsReportedUpToTheEnd) {
   WorkPool pool(2);
   std::vector<double> reports;
