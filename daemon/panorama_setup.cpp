@@ -52,6 +52,7 @@ cv::Mat bodyMaskOf(const Config& config, std::size_t index, WorkPool& pool) {
     // One at a time: where two overlap, both are body (fillPoly of several would leave a hole).
     for (const auto& polygon : own.polygons) {
       std::vector<cv::Point> corners;
+      corners.reserve(polygon.size());
       for (const auto& [u, v] : polygon) {
         corners.emplace_back(static_cast<int>(std::lround(u)), static_cast<int>(std::lround(v)));
       }

@@ -20,13 +20,11 @@
 namespace surroundd::calibrate {
 namespace {
 
-// A live camera's stand-in picture: dark, so that the tint and the outline still show.
-const cv::Scalar kLiveGrey = cv::Scalar::all(64);
-
 // The camera's first frame. A live camera is not opened: a running surroundd may hold the device.
 cv::Mat firstPicture(const daemon::RigCamera& camera) {
   const cv::Size size = camera.calibration.intrinsics.imageSize;
-  if (!camera.source) return {size, CV_8UC3, kLiveGrey};
+  // A live camera's stand-in picture: dark, so that the tint and the outline still show.
+  if (!camera.source) return {size, CV_8UC3, cv::Scalar::all(64)};
   const std::string& name = camera.calibration.name;
   auto settings = *camera.source;
   settings.pacing = capture::Pacing::kAsFastAsPossible;  // no wait for the first frame's time

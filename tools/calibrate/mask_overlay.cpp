@@ -8,15 +8,11 @@
 namespace surroundd::calibrate {
 namespace {
 
-// BGR. Yellow outlines stand out on the red tint and on most road scenes.
-const cv::Scalar kTint(0, 0, 255);
-const cv::Scalar kOutline(0, 255, 255);
-const cv::Scalar kLabelBackground(0, 0, 0);
-const cv::Scalar kLabelText(255, 255, 255);
-
 // White text on black, sized to the picture (legible from a 320-pixel test picture to a 4K one),
 // in the corner where it hides the least of the mask.
 void drawLabel(cv::Mat& picture, const cv::Mat& mask, const std::vector<std::string>& lines) {
+  const cv::Scalar background(0, 0, 0);
+  const cv::Scalar text(255, 255, 255);
   constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
   const double scale = std::clamp(picture.cols / 1280.0, 0.35, 2.0);
   const int thickness = scale < 1 ? 1 : 2;
@@ -45,11 +41,11 @@ void drawLabel(cv::Mat& picture, const cv::Mat& mask, const std::vector<std::str
       bestHidden = hidden;
     }
   }
-  cv::rectangle(picture, best, kLabelBackground, cv::FILLED);
+  cv::rectangle(picture, best, background, cv::FILLED);
   for (int i = 0; i < count; ++i) {
     cv::putText(picture, lines[static_cast<std::size_t>(i)],
-                best.tl() + cv::Point(pad, pad + lineHeight * i + textHeight), kFont, scale,
-                kLabelText, thickness, cv::LINE_AA);
+                best.tl() + cv::Point(pad, pad + lineHeight * i + textHeight), kFont, scale, text,
+                thickness, cv::LINE_AA);
   }
 }
 
@@ -57,13 +53,16 @@ void drawLabel(cv::Mat& picture, const cv::Mat& mask, const std::vector<std::str
 
 cv::Mat maskOverlay(const cv::Mat& picture, const cv::Mat& mask,
                     const std::vector<std::string>& label) {
+  // BGR. Yellow outlines stand out on the red tint and on most road scenes.
+  const cv::Scalar tint(0, 0, 255);
+  const cv::Scalar outline(0, 255, 255);
   cv::Mat out = picture.clone();
   cv::Mat tinted;
-  cv::addWeighted(picture, 0.5, cv::Mat(picture.size(), picture.type(), kTint), 0.5, 0, tinted);
+  cv::addWeighted(picture, 0.5, cv::Mat(picture.size(), picture.type(), tint), 0.5, 0, tinted);
   tinted.copyTo(out, mask);
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(mask, contours, cv::RETR_LIST, cv::CHAIN_APPROX_SIMPLE);
-  cv::drawContours(out, contours, -1, kOutline, 2);
+  cv::drawContours(out, contours, -1, outline, 2);
   drawLabel(out, mask, label);
   return out;
 }
