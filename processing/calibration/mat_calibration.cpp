@@ -58,18 +58,11 @@ std::vector<MatBoardResidual> boardResiduals(const MatBoardDetection& detection,
   return boards;
 }
 
-MatCameraResult calibrateCamera(const MatLayout& layout, const MatView& view,
-                                const MatLimits& limits, const MatDetectionSettings& detection,
-                                const ExtrinsicSettings& settings) {
-  MatCameraResult result;
-  result.camera = view.nominal.name;
-  result.detection = findMatBoards(view.gray, layout, view.nominal, detection);
-  for (const auto& miss : result.detection.missed) {
-    result.problems.push_back(
-        fmt::format("board '{}': {}", layout.boards[miss.board].print.name, miss.reason));
-  }
+// Every found board's corners with their place on the ground.
+std::vector<PointCorrespondence> cornersOf(const MatLayout& layout,
+                                           const MatBoardDetection& detection) {
   std::vector<PointCorrespondence> points;
-  for (const auto& sighting : result.detection.found) {
+  for (const auto& sighting : detection.found) {
     const GroundMarker& print = layout.boards[sighting.board].print;
     const auto corners = print.corners();
     for (std::size_t k = 0; k < corners.size(); ++k) {
@@ -77,6 +70,41 @@ MatCameraResult calibrateCamera(const MatLayout& layout, const MatView& view,
                         fmt::format("board '{}' corner {}", print.name, k)});
     }
   }
+  return points;
+}
+
+// The boards, looked for through the nominal mount (a tape's and a protractor's); where some are
+// missed, looked for again through the pose the found ones give: a mount a few degrees off puts a
+// board 5 m away half a metre from where the picture shows it, beyond the search's margin.
+MatBoardDetection detectBoards(const MatLayout& layout, const MatView& view,
+                               const MatLimits& limits, const MatDetectionSettings& detection,
+                               const ExtrinsicSettings& settings) {
+  MatBoardDetection first = findMatBoards(view.gray, layout, view.nominal, detection);
+  const auto points = cornersOf(layout, first);
+  if (first.missed.empty() || std::ssize(points) < limits.minCorners) return first;
+  CameraCalibration found = view.nominal;
+  try {
+    ExtrinsicSettings withPrior = settings;
+    withPrior.prior = view.nominal.pose;
+    found.pose = calibrateExtrinsics(view.nominal.intrinsics, points, withPrior).pose;
+  } catch (const CalibrationError&) {
+    return first;  // the solve over what was found says why
+  }
+  MatBoardDetection again = findMatBoards(view.gray, layout, found, detection);
+  return again.found.size() > first.found.size() ? again : first;
+}
+
+MatCameraResult calibrateCamera(const MatLayout& layout, const MatView& view,
+                                const MatLimits& limits, const MatDetectionSettings& detection,
+                                const ExtrinsicSettings& settings) {
+  MatCameraResult result;
+  result.camera = view.nominal.name;
+  result.detection = detectBoards(layout, view, limits, detection, settings);
+  for (const auto& miss : result.detection.missed) {
+    result.problems.push_back(
+        fmt::format("board '{}': {}", layout.boards[miss.board].print.name, miss.reason));
+  }
+  const std::vector<PointCorrespondence> points = cornersOf(layout, result.detection);
   result.corners = static_cast<int>(points.size());
   if (result.corners < limits.minCorners) {
     result.problems.push_back(fmt::format("too few corners: {}, at least {} are needed",

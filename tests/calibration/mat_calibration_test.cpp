@@ -158,6 +158,33 @@ TEST(MatCalibration, ABoardTurnedFromItsLayoutYawIsRefused) {
                             "or the camera's mount that far off?"))));
 }
 
+// A front camera's mount taken with a protractor 4 degrees off (and a tape 5 cm): through it the
+// board at its front right corner lies beyond the search's margin. The pose its other board gives
+// finds it, and the camera is posed from both.
+TEST(MatCalibration, ABoardTheNominalMountMissesIsFoundThroughTheOthersPose) {
+  const MatScene& scene = fisheyeScene();
+  auto views = nominalViews(scene, scene.pictures);
+  processing::Pose& front = views[0].nominal.pose;
+  processing::MountAngles angles =
+      processing::mountAnglesFromRotation(scene.truth[0].pose.rotation);
+  angles.pitchDeg += 4;
+  front.rotation = processing::rotationFromMountAngles(angles);
+  front.position = scene.truth[0].pose.position + cv::Vec3d(-0.05, 0, 0.05);
+  const auto first = processing::findMatBoards(views[0].gray, scene.mat, views[0].nominal);
+  ASSERT_EQ(first.missed.size(), 1U) << "the nominal mount finds every board: no test";
+
+  const auto result = processing::calibrateFromMat(scene.mat, views);
+  EXPECT_THAT(result.problems, IsEmpty());
+  const auto& camera = result.cameras[0];
+  EXPECT_THAT(camera.problems, IsEmpty());
+  EXPECT_EQ(camera.detection.found.size(), 2U);
+  ASSERT_TRUE(camera.solve);
+  const PoseError error = poseError(camera.solve->pose, scene.truth[0].pose);
+  EXPECT_LT(error.positionCm, 1.0);
+  EXPECT_LT(error.rotationDeg, 0.2);
+  EXPECT_TRUE(result.passed());
+}
+
 TEST(MatCalibration, TooFewCornersAndImplausiblePosesAreRefused) {
   const MatScene& scene = fisheyeScene();
   processing::MatLimits limits;

@@ -123,7 +123,8 @@ void runDriveMask(const MaskOptions& options, std::ostream& log) {
   config.vehicle = rig.vehicle;
   WorkPool pool;
 
-  std::vector<std::pair<std::string, std::string>> yaml;
+  std::vector<std::pair<std::string, std::string>> yaml;  // cameras with a body found
+  int looked = 0;
   std::string names;
   for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
     const daemon::RigCamera& camera = rig.cameras[c];
@@ -151,11 +152,16 @@ void runDriveMask(const MaskOptions& options, std::ostream& log) {
         "{:.1f} % is body the vehicle's mask leaves out: {}, {}\n",
         name, share, found.pictures, 100 * found.movingShare, missed, overlayFile.string(),
         bodyFile.string());
-    yaml.emplace_back(name, addedPolygonsYaml(polygons));
+    if (!polygons.empty()) yaml.emplace_back(name, addedPolygonsYaml(polygons));
+    ++looked;
   }
-  if (yaml.empty()) {
+  if (looked == 0) {
     throw UsageError(fmt::format("--camera: {} has no camera '{}' (its cameras: {})",
                                  rigFile.string(), options.camera, names));
+  }
+  if (yaml.empty()) {
+    log << "\nNo camera shows a body that stays: nothing to add to the rig.\n";
+    return;
   }
   log << "\nTo mask the body found besides the vehicle's, give each camera in the rig (a camera "
          "with a body_mask: already: join the polygons to its own):\n";
