@@ -6,13 +6,19 @@
 // looks through, a mirror that sticks out, a bumper below a camera that sits inside the body's box
 // — the pictures do.
 //
-// Per pixel it counts the pairs of consecutive pictures in which its content changed by more than
-// a few levels (the pictures blurred against sensor noise and compression, and brought to one
-// brightness against the camera's auto exposure). A pixel that changed in at most a quarter of the
-// pairs is still. Only rays that point down are candidates (the sky and far walls hardly move in a
-// short drive); the body is the still pixels' regions that reach the picture's edge (a camera sees
-// its own car from the edge in), with the holes they enclose filled (a glossy roof mirrors the
-// moving sky, a window shows the street through it), small specks dropped.
+// Per pixel it counts the pairs of pictures `span` apart in which its content changed by more
+// than a few levels (the pictures blurred against sensor noise and compression, and brought to one
+// brightness against the camera's auto exposure); a pixel that changed in more than a quarter of
+// them moved. The scene is then flooded in from the rays above the horizon (the sky, far walls)
+// through what moved, stopped by what did not and by static edges — an edge of one orientation,
+// in the same place in most pictures: the body's outline, which stays put even where the body
+// mirrors the moving sky (a glossy roof) or a window shows the street. What the flood leaves below
+// the horizon, in regions that reach the picture's or the lens's edge (a camera sees its own car
+// from the edge in), is body; ground with no texture that the scene surrounds is not.
+//
+// Where paint mirrors the road at a grazing angle (a flank seen from a mirror's camera) the body's
+// picture moves with the road and is not found: a mask found this way is added to the one computed
+// from the vehicle's measures, not put in its place.
 
 #include <cstdint>
 #include <vector>
