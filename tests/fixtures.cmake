@@ -47,3 +47,7 @@ surroundd_fixture(synth_body_fisheye --rig ${fisheye_body} ${body} --seed 3 --sc
 set(drive --size 640x360 --panorama-size 256x128 --seconds 10 --fps 2)
 surroundd_fixture(synth_drive_paper --rig ${paper_body} ${drive} --seed 3)
 surroundd_fixture(synth_drive_fisheye --rig ${fisheye_body} ${drive} --seed 3 --scene near-objects)
+# The same drive at 1280x720, where a picture's pixel spans about a centimetre of the overlaps'
+# ground: for the mounts corrected from the road.
+surroundd_fixture(synth_drive_fisheye_hd --rig ${fisheye_body} --size 1280x720 --panorama-size 256x128
+                  --seconds 10 --fps 2 --seed 3 --scene near-objects)

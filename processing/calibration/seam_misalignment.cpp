@@ -42,29 +42,39 @@ std::vector<SeamLine> seamLines(const Rig& rig, const PanoramaSettings& settings
 std::optional<SeamMisalignmentProbe> SeamMisalignmentProbe::make(const Rig& rig,
                                                                  const PanoramaSettings& settings,
                                                                  const SeamLine& seam) {
-  const int side = static_cast<int>(kPatchM / kPatchPixelM);
   // The nearest ground under the seam that both cameras see past the vehicle's body.
   for (const double elevationDeg : {25.0, 18.0, 12.0, 8.0, 5.0}) {
     const double distance = settings.geometry.centre[2] / std::tan(elevationDeg * kDegree);
     const cv::Point2d centre(distance * std::cos(seam.azimuthRad),
                              distance * std::sin(seam.azimuthRad));
-    SeamMisalignmentProbe probe;
-    bool seen = true;
-    for (std::size_t k = 0; k < 2 && seen; ++k) {
-      // Patch rows run along -x of the vehicle, columns along -y: a top view, front up.
-      auto sampling = groundSampling(rig.cameras[k == 0 ? seam.left : seam.right],
-                                     {centre, kPatchPixelM, {side, side}});
-      seen = sampling.seen >= kMinimumSeen * side * side;
-      probe.mapX_[k] = std::move(sampling.mapX);
-      probe.mapY_[k] = std::move(sampling.mapY);
+    if (auto probe =
+            at(rig, seam, centre, static_cast<int>(kPatchM / kPatchPixelM), kPatchPixelM)) {
+      return probe;
     }
-    if (!seen) continue;
-    probe.seam_ = seam;
-    probe.distanceM_ = distance;
-    cv::createHanningWindow(probe.window_, {side, side}, CV_32F);
-    return probe;
   }
   return std::nullopt;
+}
+
+std::optional<SeamMisalignmentProbe> SeamMisalignmentProbe::at(const Rig& rig, const SeamLine& seam,
+                                                               const cv::Point2d& centre, int side,
+                                                               double pixelM) {
+  SeamMisalignmentProbe probe;
+  for (std::size_t k = 0; k < 2; ++k) {
+    // Patch rows run along -x of the vehicle, columns along -y: a top view, front up.
+    auto sampling = groundSampling(rig.cameras[k == 0 ? seam.left : seam.right],
+                                   {centre, pixelM, {side, side}});
+    if (sampling.seen < kMinimumSeen * side * side) return std::nullopt;
+    probe.seen_[k] = sampling.mapX >= 0;
+    probe.unseen_[k] = sampling.mapX < 0;
+    probe.mapX_[k] = std::move(sampling.mapX);
+    probe.mapY_[k] = std::move(sampling.mapY);
+  }
+  probe.seam_ = seam;
+  probe.distanceM_ = std::hypot(centre.x, centre.y);
+  probe.centre_ = centre;
+  probe.pixelM_ = pixelM;
+  cv::createHanningWindow(probe.window_, {side, side}, CV_32F);
+  return probe;
 }
 
 SeamMisalignment SeamMisalignmentProbe::measure(const cv::Mat& left, const cv::Mat& right) {
@@ -74,11 +84,17 @@ SeamMisalignment SeamMisalignmentProbe::measure(const cv::Mat& left, const cv::M
               cv::BORDER_CONSTANT, cv::Scalar::all(0));
     cv::cvtColor(colour_[k], grey_[k], cv::COLOR_BGR2GRAY);
     grey_[k].convertTo(patch_[k], CV_32F);
+    // Around its mean, and at it where the camera does not see: the window would otherwise
+    // make two plain patches alike at no shift, and a patch's edge would be a feature.
+    patch_[k] -= cv::mean(patch_[k], seen_[k]);
+    patch_[k].setTo(0, unseen_[k]);
   }
   SeamMisalignment result;
   result.distanceM = distanceM_;
   const cv::Point2d shift = cv::phaseCorrelate(patch_[0], patch_[1], window_, &result.response);
-  result.shiftCm = std::hypot(shift.x, shift.y) * kPatchPixelM * 100;
+  result.shiftCm = std::hypot(shift.x, shift.y) * pixelM_ * 100;
+  // Columns run along -y, rows along -x (GroundGrid).
+  result.shiftM = {-shift.y * pixelM_, -shift.x * pixelM_};
   return result;
 }
 

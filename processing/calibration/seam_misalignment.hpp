@@ -36,6 +36,9 @@ std::vector<SeamLine> seamLines(const Rig& rig, const PanoramaSettings& settings
 struct SeamMisalignment {
   double distanceM = 0;  // of the patch from the vehicle's centre
   double shiftCm = 0;
+  // Where the right camera puts the ground the left one puts at the patch's centre, from there:
+  // vehicle frame, metres.
+  cv::Vec2d shiftM;
   double response = 0;  // phase correlation peak, 0..1: under ~0.05 the shift means little
 };
 
@@ -46,17 +49,27 @@ class SeamMisalignmentProbe {
   // None where either camera sees under 80 % of every patch (body, image edge).
   static std::optional<SeamMisalignmentProbe> make(const Rig& rig, const PanoramaSettings& settings,
                                                    const SeamLine& seam);
+  // The patch centred on `centre` (ground, vehicle frame), `side` pixels of `pixelM` metres; none
+  // where either camera sees under 80 % of it.
+  static std::optional<SeamMisalignmentProbe> at(const Rig& rig, const SeamLine& seam,
+                                                 const cv::Point2d& centre, int side,
+                                                 double pixelM);
 
   // `left` and `right`: the seam's cameras' pictures, 8-bit BGR of their lenses' sizes.
   SeamMisalignment measure(const cv::Mat& left, const cv::Mat& right);
 
   const SeamLine& seam() const { return seam_; }
   double distanceM() const { return distanceM_; }
+  const cv::Point2d& centre() const { return centre_; }
+  double sideM() const { return window_.cols * pixelM_; }
 
  private:
   SeamLine seam_;
   double distanceM_ = 0;
-  std::array<cv::Mat, 2> mapX_, mapY_;  // per side: ground patch -> the camera's picture
+  cv::Point2d centre_;
+  double pixelM_ = 0;
+  std::array<cv::Mat, 2> mapX_, mapY_;    // per side: ground patch -> the camera's picture
+  std::array<cv::Mat, 2> seen_, unseen_;  // per side: where it sees the patch, and not
   std::array<cv::Mat, 2> colour_, grey_, patch_;
   cv::Mat window_;
 };
