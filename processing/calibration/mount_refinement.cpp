@@ -11,24 +11,12 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "processing/calibration/ground_top_view.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/calibration/overlap_patches.hpp"
 
 namespace surroundd::processing {
 namespace {
 
 constexpr double kDegree = std::numbers::pi / 180;
-// Patches are laid where both cameras of a seam see the ground (past the body, within
-// kFarthestM of both), nearest the cameras first, kMaxPatches a seam, as large as the overlap
-// allows up to kLargestPatchM, sampled as finely as the coarser camera sees there.
-constexpr double kCellM = 0.1;
-constexpr double kReachM = 15;
-constexpr double kFarthestM = 12;
-constexpr double kLargestPatchM = 1.6;
-constexpr double kSmallestPatchM = 0.6;
-constexpr int kMaxPatches = 24;
-constexpr int kPatchSides[] = {64, 96, 128};
-
 constexpr std::size_t kPerCamera = 4;  // three angles, the height
 constexpr double kMatchSigmaM = 0.01;  // a patch's shift is good to about a pixel
 constexpr double kHuberM = 0.03;       // past this a match weighs less
@@ -106,96 +94,6 @@ Rig MountRefinementResult::corrected(const Rig& rig) const {
   }
   return out;
 }
-
-namespace {
-
-// How many metres of ground one pixel of `camera` spans at `ground`, along the direction it spans
-// most; infinite where the camera does not see it.
-double groundPerPixel(const CameraModel& model, const Pose& pose, const cv::Vec3d& ground) {
-  const auto at = model.project(pose.toCamera(ground));
-  if (!at) return std::numeric_limits<double>::infinity();
-  double coarsest = 0;
-  for (const cv::Vec3d& step : {cv::Vec3d(0.01, 0, 0), cv::Vec3d(0, 0.01, 0)}) {
-    const auto next = model.project(pose.toCamera(ground + step));
-    if (!next) return std::numeric_limits<double>::infinity();
-    coarsest = std::max(coarsest, 0.01 / std::max(1e-9, cv::norm(*next - *at)));
-  }
-  return coarsest;
-}
-
-// The ground both cameras of `seam` see, on a kCellM grid (GroundGrid's layout), 255 where seen.
-cv::Mat overlapMask(const Rig& rig, const SeamLine& seam, const GroundGrid& grid) {
-  cv::Mat both(grid.size, CV_8U, cv::Scalar(255));
-  for (const std::size_t c : {seam.left, seam.right}) {
-    const CameraCalibration& camera = rig.cameras[c];
-    const GroundSampling sampling = groundSampling(camera, grid);
-    both &= sampling.mapX >= 0;
-    for (int row = 0; row < grid.size.height; ++row) {
-      for (int column = 0; column < grid.size.width; ++column) {
-        const cv::Vec3d ground = grid.groundAt(row, column);
-        const cv::Vec3d away = ground - camera.pose.position;
-        if (std::hypot(away[0], away[1]) > kFarthestM) both.at<std::uint8_t>(row, column) = 0;
-      }
-    }
-  }
-  return both;
-}
-
-// Patches under `seam`: where the overlap is widest around a point, a square patch fits;
-// nearest the two cameras first, apart by half a patch at least.
-std::vector<SeamMisalignmentProbe> overlapPatches(const Rig& rig, const SeamLine& seam) {
-  const int cells = static_cast<int>(2 * kReachM / kCellM);
-  const GroundGrid grid{{0, 0}, kCellM, {cells, cells}};
-  const cv::Mat both = overlapMask(rig, seam, grid);
-  cv::Mat room;  // per cell, how far (in cells) to the nearest ground the two do not both see
-  cv::distanceTransform(both, room, cv::DIST_C, 3);
-  const std::array<CameraModel, 2> models{CameraModel(rig.cameras[seam.left].intrinsics),
-                                          CameraModel(rig.cameras[seam.right].intrinsics)};
-  struct Candidate {
-    cv::Vec3d ground;
-    double sideM = 0;
-    double nearness = 0;  // the distances to the two cameras, summed
-  };
-  std::vector<Candidate> candidates;
-  for (int row = 0; row < cells; ++row) {
-    for (int column = 0; column < cells; ++column) {
-      const double sideM = std::min(kLargestPatchM, 2 * room.at<float>(row, column) * kCellM);
-      if (sideM < kSmallestPatchM) continue;
-      const cv::Vec3d ground = grid.groundAt(row, column);
-      double nearness = 0;
-      for (const std::size_t c : {seam.left, seam.right}) {
-        nearness += cv::norm(ground - rig.cameras[c].pose.position);
-      }
-      candidates.push_back({ground, sideM, nearness});
-    }
-  }
-  std::ranges::sort(candidates, {}, &Candidate::nearness);
-  std::vector<SeamMisalignmentProbe> patches;
-  std::vector<Candidate> placed;
-  for (const Candidate& candidate : candidates) {
-    if (std::cmp_greater_equal(patches.size(), kMaxPatches)) break;
-    const bool crowded = std::ranges::any_of(placed, [&](const Candidate& other) {
-      return cv::norm(candidate.ground - other.ground) < (candidate.sideM + other.sideM) / 4;
-    });
-    if (crowded) continue;
-    // Sampled as finely as the coarser camera sees that ground, no finer than 1 cm.
-    const double perPixel =
-        std::max({0.01, groundPerPixel(models[0], rig.cameras[seam.left].pose, candidate.ground),
-                  groundPerPixel(models[1], rig.cameras[seam.right].pose, candidate.ground)});
-    int side = kPatchSides[0];  // finer than the cameras where the overlap is narrow
-    for (const int allowed : kPatchSides) {
-      if (allowed * perPixel <= candidate.sideM) side = allowed;
-    }
-    auto patch = SeamMisalignmentProbe::at(rig, seam, {candidate.ground[0], candidate.ground[1]},
-                                           side, candidate.sideM / side);
-    if (!patch) continue;
-    patches.push_back(std::move(*patch));
-    placed.push_back(candidate);
-  }
-  return patches;
-}
-
-}  // namespace
 
 MountRefinement::MountRefinement(const Rig& rig, const PanoramaSettings& settings,
                                  std::size_t capacity)

@@ -1,16 +1,17 @@
 #pragma once
 // Small corrections to the cameras' mounts, found from the road: where two neighbouring cameras
 // see the same ground, each puts it where its calibration says; a mount that is off puts it
-// elsewhere. Ground patches spread along every overlap (seam_misalignment.hpp's probe, at five
-// distances and five bearings around each seam) are compared by phase correlation, set after set
-// while the car moves; each comparison that means something (a clear correlation peak: ground
-// with texture that both views show alike) becomes one match, the two rays that see the same
-// ground point. A least-squares fit then turns each camera about its centre (three angles) and
-// moves it up or down, so that every match's two rays meet the ground at one point.
+// elsewhere. Ground patches laid over every overlap (overlap_patches.hpp) are compared by phase
+// correlation (seam_misalignment.hpp's probe), set after set while the car moves; each
+// comparison that means something (a clear correlation peak: ground with texture that both views
+// show alike) becomes one match, the two rays that see the same ground point. A least-squares
+// fit then turns each camera about its centre (three angles) and moves it up or down, so that
+// every match's two rays meet the ground at one point.
 //
 // The reference: seams tie cameras only to each other, so one camera is held. Cameras are knocked
-// one at a time, so the fit is made holding each camera in turn and the one that needs the least
-// turning of the others wins: a knocked front camera is corrected, not the three that agree. (The
+// one at a time, so the fit is made holding each camera in turn: holding a knocked camera leaves
+// the seams apart, and of the fits that bring them together alike the one that turns the others
+// least wins: a knocked front camera is corrected, not the three that agree. (The
 // rig's mean would spread one knocked camera's error over all four.)
 //
 // Robustness: a patch whose views differ by more than a shift (a passing car, a kerb, anything
