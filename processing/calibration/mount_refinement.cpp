@@ -19,7 +19,7 @@ namespace {
 constexpr double kDegree = std::numbers::pi / 180;
 constexpr std::size_t kPerCamera = 4;  // three angles, the height
 constexpr double kMatchSigmaM = 0.01;  // a patch's shift is good to about a pixel
-constexpr double kHuberM = 0.03;       // past this a match weighs less
+constexpr double kHuber = 3;           // past this many of its spreads a match weighs less
 constexpr double kAnglePriorRad = 5 * kDegree;
 constexpr double kHeightPriorM = 0.02;
 constexpr double kStep = 1e-6;  // numerical derivatives
@@ -76,6 +76,10 @@ bool MountCorrection::conclusive() const {
   return largest <= kConclusiveSigmaDeg * kDegree;
 }
 
+bool MountCorrection::worthApplying() const {
+  return conclusive() && angleDeg() >= kSmallestTurnDeg;
+}
+
 Pose MountCorrection::applied(const Pose& pose) const {
   return {turn(rotationRad) * pose.rotation, pose.position + cv::Vec3d(0, 0, heightM)};
 }
@@ -109,9 +113,11 @@ void MountRefinement::layPatches(const Rig& through) {
   patches_.clear();
   patchSeam_.clear();
   for (std::size_t s = 0; s < seams_.size(); ++s) {
-    for (auto& patch : overlapPatches(patchRig_, seams_[s])) {
-      patches_.push_back(std::move(patch));
-      patchSeam_.push_back(s);
+    for (const PatchSizes& sizes : {kCoarsePatches, kFinePatches}) {
+      for (auto& patch : overlapPatches(patchRig_, seams_[s], sizes)) {
+        patches_.push_back(std::move(patch));
+        patchSeam_.push_back(s);
+      }
     }
   }
 }
@@ -120,6 +126,7 @@ void MountRefinement::follow(const MountRefinementResult& result) {
   layPatches(result.corrected(rig_));
   matches_.clear();
   oldest_ = 0;
+  sets_ = 0;
 }
 
 std::size_t MountRefinement::add(std::span<const cv::Mat* const> pictures) {
@@ -142,7 +149,8 @@ std::size_t MountRefinement::add(std::span<const cv::Mat* const> pictures) {
     const cv::Vec3d ground(patch.centre().x, patch.centre().y, 0);
     const cv::Vec3d shifted = ground + cv::Vec3d(measured.shiftM[0], measured.shiftM[1], 0);
     Match match{patchSeam_[p], cv::normalize(patchRig_.cameras[seam.left].pose.toCamera(ground)),
-                cv::normalize(patchRig_.cameras[seam.right].pose.toCamera(shifted))};
+                cv::normalize(patchRig_.cameras[seam.right].pose.toCamera(shifted)),
+                std::max(kMatchSigmaM, patch.pixelM())};
     if (matches_.size() < capacity_) {
       matches_.push_back(match);
     } else {
@@ -206,9 +214,9 @@ MountRefinement::Fit MountRefinement::fit(std::size_t reference, std::vector<dou
     double total = 0;
     for (std::size_t m = 0; m < misses.size(); ++m) {
       if (!result.used[m]) continue;
-      const double miss = std::isfinite(misses[m]) ? misses[m] : 1.0;
-      total += (miss <= kHuberM ? miss * miss : kHuberM * (2 * miss - kHuberM)) /
-               (kMatchSigmaM * kMatchSigmaM);
+      // In the match's own spread: coarse patches' matches count for less.
+      const double u = (std::isfinite(misses[m]) ? misses[m] : 1.0) / matches_[m].sigmaM;
+      total += u <= kHuber ? u * u : kHuber * (2 * u - kHuber);
     }
     for (std::size_t index = 0; index < column.size(); ++index) {
       const double p = prior(index % kPerCamera);
@@ -238,9 +246,8 @@ MountRefinement::Fit MountRefinement::fit(std::size_t reference, std::vector<dou
         const cv::Vec2d r =
             poses[seam.left].hit(match.rayLeft) - poses[seam.right].hit(match.rayRight);
         if (!std::isfinite(r[0]) || !std::isfinite(r[1])) continue;
-        const double size = cv::norm(r);
-        const double weight =
-            (size <= kHuberM ? 1.0 : kHuberM / size) / (kMatchSigmaM * kMatchSigmaM);
+        const double u = cv::norm(r) / match.sigmaM;
+        const double weight = (u <= kHuber ? 1.0 : kHuber / u) / (match.sigmaM * match.sigmaM);
         // The residual's derivatives by the eight parameters of its two cameras.
         std::array<cv::Vec2d, 2 * kPerCamera> jacobian;
         std::array<int, 2 * kPerCamera> columns{};
@@ -317,7 +324,7 @@ MountRefinement::Fit MountRefinement::fit(std::size_t reference, std::vector<dou
   std::size_t count = 0;
   for (std::size_t m = 0; m < misses.size(); ++m) {
     if (!result.used[m] || !std::isfinite(misses[m])) continue;
-    squares += misses[m] * misses[m] / (kMatchSigmaM * kMatchSigmaM);
+    squares += misses[m] * misses[m] / (matches_[m].sigmaM * matches_[m].sigmaM);
     ++count;
   }
   const double dof = std::max(1.0, 2.0 * static_cast<double>(count) - unknowns);
@@ -385,12 +392,18 @@ std::optional<MountRefinementResult> MountRefinement::solve() {
   const std::vector<double> before = residuals(std::vector<double>(warm_.size(), 0.0));
   const std::vector<double> after = residuals(best->parameters);
   for (std::size_t s = 0; s < seams_.size(); ++s) {
+    // Told by the fine patches' matches where there are any: the coarse ones are a few
+    // centimetres off by themselves.
     std::vector<double> was;
     std::vector<double> is;
-    for (std::size_t m = 0; m < matches_.size(); ++m) {
-      if (matches_[m].seam != s || !best->used[m]) continue;
-      was.push_back(before[m]);
-      is.push_back(after[m]);
+    for (const bool coarseToo : {false, true}) {
+      for (std::size_t m = 0; m < matches_.size(); ++m) {
+        const bool fine = matches_[m].sigmaM < kCoarsePatches.finestM;
+        if (matches_[m].seam != s || !best->used[m] || (!fine && !coarseToo)) continue;
+        was.push_back(before[m]);
+        is.push_back(after[m]);
+      }
+      if (!is.empty()) break;
     }
     result.seams.push_back({seams_[s].name, is.size(), 100 * median(was), 100 * median(is)});
   }

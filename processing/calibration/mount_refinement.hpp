@@ -50,14 +50,19 @@ struct MountCorrection {
   // camera's is.
   bool conclusive() const;
   static constexpr double kConclusiveSigmaDeg = 0.1;
+  // Conclusive, and turning the camera by kSmallestTurnDeg or more: less moves the ground 1.5 cm
+  // at 4 m, under what a seam shows, and is as likely the lens's or the fit's own error (an exact
+  // simulator's rig fits 0.1-0.2 degrees off).
+  bool worthApplying() const;
+  static constexpr double kSmallestTurnDeg = 0.2;
   Pose applied(const Pose& pose) const;
 };
 
 // The mount angles' change between two poses of one camera, degrees (yaw wrapped to +-180).
 MountAngles mountAngleChange(const Pose& before, const Pose& after);
 
-// How far apart the seam's two cameras put the same ground (median over its matches), before and
-// after the corrections.
+// How far apart the seam's two cameras put the same ground (median over its fine patches'
+// matches, else all of its matches), before and after the corrections.
 struct SeamFit {
   std::string name;
   std::size_t matches = 0;
@@ -71,7 +76,7 @@ struct MountRefinementResult {
   std::vector<SeamFit> seams;
   std::size_t matches = 0;   // used
   std::size_t rejected = 0;  // left out as disagreeing with the fit
-  std::size_t sets = 0;      // frame sets they came from
+  std::size_t sets = 0;      // frame sets they came from (since the last follow())
 
   Rig corrected(const Rig& rig) const;
 };
@@ -106,6 +111,7 @@ class MountRefinement {
   struct Match {
     std::size_t seam = 0;
     cv::Vec3d rayLeft, rayRight;  // camera frames, unit: the same ground seen by each camera
+    double sigmaM = 0;            // how far off it may be: about a pixel of its patch
   };
   struct Fit;
   Fit fit(std::size_t reference, std::vector<double> start, bool trim) const;

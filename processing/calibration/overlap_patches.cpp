@@ -14,14 +14,9 @@
 namespace surroundd::processing {
 namespace {
 
-// Patches are laid where both cameras of a seam see the ground (past the body, within
-// kFarthestM of both), nearest the cameras first, kMaxPatches a seam, as large as the overlap
-// allows up to kLargestPatchM, sampled as finely as the coarser camera sees there.
 constexpr double kCellM = 0.1;
 constexpr double kReachM = 15;
 constexpr double kFarthestM = 12;
-constexpr double kLargestPatchM = 1.6;
-constexpr double kSmallestPatchM = 0.6;
 constexpr int kMaxPatches = 24;
 constexpr int kPatchSides[] = {64, 96, 128};
 
@@ -59,7 +54,8 @@ cv::Mat overlapMask(const Rig& rig, const SeamLine& seam, const GroundGrid& grid
 
 }  // namespace
 
-std::vector<SeamMisalignmentProbe> overlapPatches(const Rig& rig, const SeamLine& seam) {
+std::vector<SeamMisalignmentProbe> overlapPatches(const Rig& rig, const SeamLine& seam,
+                                                  const PatchSizes& sizes) {
   const int cells = static_cast<int>(2 * kReachM / kCellM);
   const GroundGrid grid{{0, 0}, kCellM, {cells, cells}};
   const cv::Mat both = overlapMask(rig, seam, grid);
@@ -70,19 +66,19 @@ std::vector<SeamMisalignmentProbe> overlapPatches(const Rig& rig, const SeamLine
   struct Candidate {
     cv::Vec3d ground;
     double sideM = 0;
-    double nearness = 0;  // the distances to the two cameras, summed
+    double nearness = 0;  // the distances to the two cameras, summed, per metre of patch
   };
   std::vector<Candidate> candidates;
   for (int row = 0; row < cells; ++row) {
     for (int column = 0; column < cells; ++column) {
-      const double sideM = std::min(kLargestPatchM, 2 * room.at<float>(row, column) * kCellM);
-      if (sideM < kSmallestPatchM) continue;
+      const double sideM = std::min(sizes.largestM, 2 * room.at<float>(row, column) * kCellM);
+      if (sideM < sizes.smallestM) continue;
       const cv::Vec3d ground = grid.groundAt(row, column);
       double nearness = 0;
       for (const std::size_t c : {seam.left, seam.right}) {
         nearness += cv::norm(ground - rig.cameras[c].pose.position);
       }
-      candidates.push_back({ground, sideM, nearness});
+      candidates.push_back({ground, sideM, nearness / sideM});
     }
   }
   std::ranges::sort(candidates, {}, &Candidate::nearness);
@@ -95,9 +91,9 @@ std::vector<SeamMisalignmentProbe> overlapPatches(const Rig& rig, const SeamLine
     });
     if (crowded) continue;
     // Sampled as finely as the coarser camera sees that ground, no finer than 1 cm.
-    const double perPixel =
-        std::max({0.01, groundPerPixel(models[0], rig.cameras[seam.left].pose, candidate.ground),
-                  groundPerPixel(models[1], rig.cameras[seam.right].pose, candidate.ground)});
+    const double perPixel = std::max(
+        {sizes.finestM, groundPerPixel(models[0], rig.cameras[seam.left].pose, candidate.ground),
+         groundPerPixel(models[1], rig.cameras[seam.right].pose, candidate.ground)});
     int side = kPatchSides[0];  // finer than the cameras where the overlap is narrow
     for (const int allowed : kPatchSides) {
       if (allowed * perPixel <= candidate.sideM) side = allowed;

@@ -62,6 +62,7 @@ class SeamMisalignmentProbe {
   double distanceM() const { return distanceM_; }
   const cv::Point2d& centre() const { return centre_; }
   double sideM() const { return window_.cols * pixelM_; }
+  double pixelM() const { return pixelM_; }
 
  private:
   SeamLine seam_;

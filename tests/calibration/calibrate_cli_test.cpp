@@ -346,11 +346,11 @@ TEST(CalibrateCli, UsageErrorsNameTheOption) {
   EXPECT_EQ(version.status, 0) << version.output;
   EXPECT_THAT(version.output, AllOf(HasSubstr("surround-calibrate 0."), HasSubstr("built with: ")));
   expectFailure(calibrate(dir, {}), 2,
-                "surround-calibrate: missing the subcommand: intrinsics, guide, extrinsics, import "
-                "or mask (see --help)");
+                "surround-calibrate: missing the subcommand: intrinsics, guide, extrinsics, import, "
+                "mask or refine (see --help)");
   expectFailure(calibrate(dir, {"calibrate"}), 2,
-                "unknown subcommand 'calibrate': expected intrinsics, guide, extrinsics, import or "
-                "mask");
+                "unknown subcommand 'calibrate': expected intrinsics, guide, extrinsics, import, "
+                "mask or refine");
   // The guide without a camera (its other inputs: GuideCamerasThatCannotBeOpenedAreNamed).
   const std::vector<std::string> guide{
       "guide", "--board", "9x6", "--model", "fisheye", "--out", (dir / "lens.yaml").string()};

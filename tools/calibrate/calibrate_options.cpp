@@ -91,6 +91,34 @@ shows no still picture and is only found there).
   --every S                  seconds of the drive between the pictures compared (default 0.5)
 )";
 
+constexpr std::string_view kRefineUsage =
+    R"(usage: surround-calibrate refine (--config FILE | --rig RIG) --out DIR [--images DIR]
+                                 [--every S] [--update-rig]
+
+The cameras' mounts corrected from the road: where two neighbouring cameras see the same ground,
+a mount that is off puts it elsewhere. Patches of the ground both see are compared set after set
+(the car driving over ground with some texture: asphalt grain, lines, kerbs, gravel), and each
+camera is turned (and raised) so that the ground meets under every seam; the camera that needs no
+turning is held. Three passes, each through the last one's corrections. Prints each camera's
+correction in mount angles with its uncertainty, and each seam's misalignment before and after;
+a correction too uncertain to act on (the cameras share too little ground near the car, or it
+has no texture), or under 0.2 degrees, is said and left out. Writes:
+
+  DIR/mounts.yaml        the refined cameras' mount: blocks, to paste into the rig
+  DIR/top-before.png     the ground from above through the mounts given (doubled where off)
+  DIR/top-after.png      the same through the refined mounts
+
+  --config FILE          a surroundd config: its rig file, vehicle and body masks (mask the
+                         body: ground that keeps still under a seam pulls the fit)
+  --rig RIG              or a rig file, or a recording's folder (with rig.yaml)
+  --images DIR           one still picture per camera, named after it (front.png, Back.jpg...);
+                         without it, the cameras' recorded sources, read side by side
+  --every S              seconds of a recording between the sets compared (default 0.5; at most
+                         240 sets)
+  --update-rig           write the refined mounts into the rig file (the file before is kept
+                         beside it as FILE.before-refine)
+)";
+
 constexpr std::string_view kUpdateRigUsage =
     R"(--update-rig edits the rig file's YAML: only the camera's lens: (intrinsics) or mount:
 (extrinsics) block is replaced. Every other key stays as it was (sources with their sequence_fps,
@@ -150,6 +178,25 @@ MaskOptions parseMask(std::span<const std::string_view> arguments) {
         "of a drive: the body found in it)");
   }
   if (o.out.empty()) throw UsageError("--out: missing (the folder to write the pictures to)");
+  return o;
+}
+
+RefineOptions parseRefine(std::span<const std::string_view> arguments) {
+  RefineOptions o;
+  parseOptions(
+      arguments,
+      {{"--config", [&](auto v) { o.config = std::string(v); }},
+       {"--rig", [&](auto v) { o.rig = std::string(v); }},
+       {"--images", [&](auto v) { o.images = std::string(v); }},
+       {"--every", [&](auto v) { o.everyS = parseDouble("--every", v, 0.02, 60, "seconds"); }},
+       {"--out", [&](auto v) { o.out = std::string(v); }}},
+      {{"--update-rig", [&](auto) { o.updateRig = true; }}});
+  if (o.config.empty() == o.rig.empty()) {
+    throw UsageError(
+        "expected either --config (a surroundd config) or --rig (a rig file or a recording's "
+        "folder)");
+  }
+  if (o.out.empty()) throw UsageError("--out: missing (the folder to write mounts.yaml to)");
   return o;
 }
 
@@ -218,7 +265,8 @@ void parseOptions(std::span<const std::string_view> arguments, const Handlers& v
 Command parseArguments(std::span<const std::string_view> arguments) {
   if (arguments.empty()) {
     throw UsageError(
-        "missing the subcommand: intrinsics, guide, extrinsics, import or mask (see --help)");
+        "missing the subcommand: intrinsics, guide, extrinsics, import, mask or refine (see "
+        "--help)");
   }
   const std::string_view subcommand = arguments.front();
   const auto rest = arguments.subspan(1);
@@ -244,6 +292,10 @@ Command parseArguments(std::span<const std::string_view> arguments) {
     if (asksForHelp(rest)) return HelpRequest{std::string(kMaskUsage)};
     return parseMask(rest);
   }
+  if (subcommand == "refine") {
+    if (asksForHelp(rest)) return HelpRequest{std::string(kRefineUsage)};
+    return parseRefine(rest);
+  }
   if (subcommand == "guide") {
     if (asksForHelp(rest)) {
       return HelpRequest{fmt::format("{}\n{}\n{}", kGuideUsage, kMatGuideUsage, kUpdateRigUsage)};
@@ -252,18 +304,18 @@ Command parseArguments(std::span<const std::string_view> arguments) {
     return parseGuide(rest);
   }
   throw UsageError(
-      fmt::format("unknown subcommand '{}': expected intrinsics, guide, extrinsics, import or mask "
-                  "(see --help)",
+      fmt::format("unknown subcommand '{}': expected intrinsics, guide, extrinsics, import, mask "
+                  "or refine (see --help)",
                   subcommand));
 }
 
 std::string usage() {
   return fmt::format(
-      "surround-calibrate: camera calibration for surroundd.\n\n{}\n{}\n{}\n{}\n{}\n{}\n{}\n"
+      "surround-calibrate: camera calibration for surroundd.\n\n{}\n{}\n{}\n{}\n{}\n{}\n{}\n{}\n"
       "exit status: 0 done, 1 calibration failed (too little in the images), 2 bad arguments or "
       "input files\n",
       kIntrinsicsUsage, kGuideUsage, kMatGuideUsage, kExtrinsicsUsage, kUpdateRigUsage,
-      kImportUsage, kMaskUsage);
+      kImportUsage, kMaskUsage, kRefineUsage);
 }
 
 cv::Size imageSizeFrom(double width, double height, std::string_view where) {

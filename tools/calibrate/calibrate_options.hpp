@@ -58,12 +58,22 @@ struct MaskOptions {
   double everyS = 0.5;        // --every: seconds of the drive between the pictures looked at
 };
 
+struct RefineOptions {
+  std::filesystem::path config;  // a surroundd config: its rig file, vehicle and body masks
+  std::filesystem::path rig;     // or a rig file, or a recording's folder (with rig.yaml)
+  // One still picture per camera, named after it; none: the cameras' recorded sources.
+  std::optional<std::filesystem::path> images;
+  double everyS = 0.5;        // --every: seconds of a recording between the sets looked at
+  std::filesystem::path out;  // folder for mounts.yaml and the pictures
+  bool updateRig = false;     // write the refined mounts into the rig file
+};
+
 struct HelpRequest {
   std::string text;
 };
 
 using Command = std::variant<IntrinsicsOptions, GuideOptions, MatGuideOptions, ExtrinsicsOptions,
-                             ImportOptions, MaskOptions, HelpRequest>;
+                             ImportOptions, MaskOptions, RefineOptions, HelpRequest>;
 
 // An image size read from a calibration file: each side 1 to 65536 pixels, checked before the
 // cast (1e300 pixels fits no int); UsageError naming `where` otherwise.

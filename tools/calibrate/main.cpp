@@ -1,6 +1,6 @@
 // surround-calibrate: camera intrinsics from checkerboard images, extrinsics from ground markers,
-// other tools' calibrations imported into a rig file, and the body masks drawn for checking (see
-// --help).
+// other tools' calibrations imported into a rig file, the body masks drawn for checking, and the
+// mounts refined from the road (see --help).
 
 #include <cstdio>
 #include <cstdlib>
@@ -17,6 +17,7 @@
 #include "tools/calibrate/intrinsics_command.hpp"
 #include "tools/calibrate/mask_command.hpp"
 #include "tools/calibrate/mat_guide_command.hpp"
+#include "tools/calibrate/refine_command.hpp"
 
 namespace {
 
@@ -25,7 +26,7 @@ int run(const std::vector<std::string_view>& arguments) {
   std::string_view subcommand = arguments.empty() ? "" : arguments.front();
   const std::string prefix = subcommand == "intrinsics" || subcommand == "extrinsics" ||
                                      subcommand == "import" || subcommand == "mask" ||
-                                     subcommand == "guide"
+                                     subcommand == "refine" || subcommand == "guide"
                                  ? "surround-calibrate " + std::string(subcommand) + ": "
                                  : std::string("surround-calibrate: ");
   try {
@@ -42,6 +43,8 @@ int run(const std::vector<std::string_view>& arguments) {
       runImport(*import, std::cout);
     } else if (const auto* mask = std::get_if<MaskOptions>(&command)) {
       runMask(*mask, std::cout);
+    } else if (const auto* refine = std::get_if<RefineOptions>(&command)) {
+      runRefine(*refine, std::cout);
     } else {
       runExtrinsics(std::get<ExtrinsicsOptions>(command), std::cout);
     }
