@@ -385,6 +385,17 @@ const ConfigKeys<CalibrationWatchConfig>& calibrationWatchKeys() {
                   {0.5, 100.0, false, "centimetres"},
                   "a seam whose cameras put the ground further apart is misaligned; a camera "
                   "whose every measured seam is, is calibration drifting"),
+      Key::choice("correct", &CalibrationWatchConfig::correct,
+                  {{"off", CalibrationWatchConfig::Correct::kOff},
+                   {"suggest", CalibrationWatchConfig::Correct::kSuggest}},
+                  "suggest: also work out, from the ground two cameras share while the car "
+                  "drives, how each camera's mount would have to turn to bring its seams "
+                  "together, and say it (status, metrics, log); surround-calibrate refine "
+                  "--update-rig writes it"),
+      Key::number("compare_every_s", &CalibrationWatchConfig::compareEveryS,
+                  {0.1, 3600.0, false, "seconds"},
+                  "with correct: suggest, how often (stream time) a set's ground is compared; "
+                  "each comparison costs tens of milliseconds on a thread of its own"),
   };
   return kKeys;
 }

@@ -148,21 +148,39 @@ std::string statusText(const PipelineReport& report) {
                    viewSwitchWithLimits(*report.viewSwitch));
   }
   for (const auto& seam : report.seams) {
-    fmt::format_to(std::back_inserter(out), "seam {}: {}\n", seam.name,
+    fmt::format_to(std::back_inserter(out), "seam {}: {}{}\n", seam.name,
                    seam.shiftCm ? fmt::format("ground {:.1f} cm apart at {:.1f} m (response "
                                               "{:.2f}){}",
                                               *seam.shiftCm, seam.distanceM, seam.response,
                                               seam.misaligned ? ", misaligned" : "")
-                                : std::string("not measured yet"));
+                                : std::string("not measured yet"),
+                   seam.suggestedCm
+                       ? fmt::format("; {:.1f} cm with the mounts suggested", *seam.suggestedCm)
+                       : std::string());
+  }
+  if (report.mountWatch) {
+    fmt::format_to(std::back_inserter(out),
+                   "mount refinement: {} sets compared, {} comparisons in the last solution, "
+                   "{:.1f} s of CPU\n",
+                   report.mountWatch->setsCompared, report.mountWatch->comparisons,
+                   report.mountWatch->cpuSeconds);
   }
   for (std::size_t c = 0; c < report.cameras.size(); ++c) {
     const auto& camera = report.cameras[c];
     fmt::format_to(std::back_inserter(out),
-                   "camera {}: {}{}, {} frames, {} faults, {} queued, {} dropped by sync, {} sets "
-                   "without it\n",
+                   "camera {}: {}{}{}, {} frames, {} faults, {} queued, {} dropped by sync, {} "
+                   "sets without it\n",
                    camera.name, capture::toString(camera.health),
-                   camera.calibrationDrifting ? ", calibration drifting" : "", camera.stats.frames,
-                   camera.stats.faults, camera.queued,
+                   camera.calibrationDrifting ? ", calibration drifting" : "",
+                   camera.mountSuggestion
+                       ? fmt::format(", mount would turn yaw {:+.1f}°, pitch {:+.1f}°, roll "
+                                     "{:+.1f}° (±{:.2f}°)",
+                                     camera.mountSuggestion->changeDeg.yawDeg,
+                                     camera.mountSuggestion->changeDeg.pitchDeg,
+                                     camera.mountSuggestion->changeDeg.rollDeg,
+                                     camera.mountSuggestion->sigmaDeg)
+                       : std::string(),
+                   camera.stats.frames, camera.stats.faults, camera.queued,
                    report.sync.unmatchedDropped[c] + report.sync.outOfOrderDropped[c],
                    report.sync.lateMissing[c]);
   }
@@ -285,6 +303,27 @@ std::string prometheusText(const PipelineReport& report) {
                      "surroundd_seam_misalignment_cm{{seam=\"{}\"}} {:.2f}\n", seam.name,
                      *seam.shiftCm);
     }
+  }
+  if (report.mountWatch) {
+    family(out, "camera_mount_correction_deg", "gauge",
+           "The mount angle change the calibration watch suggests for the camera "
+           "(calibration_watch.correct: suggest); absent where none is worth applying.");
+    for (const auto& camera : report.cameras) {
+      if (!camera.mountSuggestion) continue;
+      const auto& change = camera.mountSuggestion->changeDeg;
+      for (const auto& [axis, value] :
+           {std::pair{"yaw", change.yawDeg}, std::pair{"pitch", change.pitchDeg},
+            std::pair{"roll", change.rollDeg}}) {
+        fmt::format_to(std::back_inserter(out),
+                       "surroundd_camera_mount_correction_deg{{camera=\"{}\",axis=\"{}\"}} "
+                       "{:.3f}\n",
+                       camera.name, axis, value);
+      }
+    }
+    family(out, "mount_refinement_cpu_seconds_total", "counter",
+           "CPU time of the calibration watch's mount refinement thread.");
+    fmt::format_to(std::back_inserter(out), "surroundd_mount_refinement_cpu_seconds_total {:.3f}\n",
+                   report.mountWatch->cpuSeconds);
   }
   family(out, "sync_skew_seconds", "gauge", "Mean newest-minus-oldest timestamp within a set.");
   fmt::format_to(std::back_inserter(out), "surroundd_sync_skew_seconds {:.6f}\n",

@@ -14,6 +14,7 @@
 #include "capture/camera_stream.hpp"
 #include "capture/synchronizer.hpp"
 #include "daemon/duration_histogram.hpp"
+#include "processing/rig.hpp"
 #include "render/gpu_timer.hpp"
 
 namespace surroundd::daemon {
@@ -45,6 +46,23 @@ struct SeamReport {
   double distanceM = 0;           // of the compared ground from the vehicle's centre
   double response = 0;
   bool misaligned = false;
+  // With calibration_watch.correct: suggest, where the suggested mounts would put it, over the
+  // ground compared since start.
+  std::optional<double> suggestedCm{};
+};
+
+// What the calibration watch would turn a camera's mount by (calibration_watch.correct).
+struct MountSuggestion {
+  processing::MountAngles changeDeg;
+  double heightCm = 0;
+  double sigmaDeg = 0;  // the largest of the angles' uncertainties
+};
+
+// The mount refinement behind the suggestions: how much ground it has compared, at what cost.
+struct MountWatchReport {
+  std::size_t setsCompared = 0;
+  std::size_t comparisons = 0;  // of ground patches, kept in the last solution
+  double cpuSeconds = 0;        // of its own thread
 };
 
 struct CameraReport {
@@ -53,6 +71,7 @@ struct CameraReport {
   capture::CameraStreamStats stats;
   std::size_t queued = 0;  // frames waiting between its capture thread and the synchronizer
   bool calibrationDrifting = false;  // the drift watch's verdict
+  std::optional<MountSuggestion> mountSuggestion{};
 };
 
 // The last switch of view (Pipeline::setView, or an output's page): from its request to the first
@@ -75,6 +94,7 @@ struct PipelineReport {
   capture::SyncStats sync;
   std::vector<CameraReport> cameras;
   std::vector<SeamReport> seams;                      // the drift watch's; empty when it is off
+  std::optional<MountWatchReport> mountWatch;         // with calibration_watch.correct: suggest
   std::array<DurationHistogram, kStageCount> stages;  // per frame set that went through the stage
   DurationHistogram latency;  // a frame's capture to its picture handed to an output
   // From the run's start to its first picture handed to an output; empty before.

@@ -1,6 +1,9 @@
 #include "daemon/stages/calibration_watch_stage.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -14,10 +17,17 @@ CalibrationWatchStage::CalibrationWatchStage(const Config& config, const process
     : interval_(std::chrono::duration_cast<std::chrono::nanoseconds>(
           std::chrono::duration<double>(config.calibrationWatch.intervalS))),
       thresholdCm_(config.calibrationWatch.thresholdCm),
-      drifting_(rig.cameras.size(), false) {
+      drifting_(rig.cameras.size(), false),
+      rig_(rig),
+      compareEvery_(std::chrono::duration_cast<std::chrono::nanoseconds>(
+          std::chrono::duration<double>(config.calibrationWatch.compareEveryS))),
+      suggested_(rig.cameras.size()) {
   for (const auto& camera : rig.cameras) cameraNames_.push_back(camera.name);
   if (config.calibrationWatch.intervalS <= 0) return;
   const processing::PanoramaSettings settings = panoramaSettings(config);
+  if (config.calibrationWatch.correct == CalibrationWatchConfig::Correct::kSuggest) {
+    refinement_ = std::make_unique<MountCorrectionWorker>(rig, settings);
+  }
   std::vector<std::string> unseen;
   for (const auto& line : processing::seamLines(rig, settings)) {
     if (auto probe = processing::SeamMisalignmentProbe::make(rig, settings, line)) {
@@ -35,7 +45,8 @@ CalibrationWatchStage::CalibrationWatchStage(const Config& config, const process
 }
 
 void CalibrationWatchStage::process(FrameWork& work, StageTimes& times) {
-  if (seams_.empty()) return;
+  if (refinement_) offerToRefinement(work);
+  if (seams_.empty() && !refinement_) return;
   if (next_ && work.streamTime < *next_) return;
   next_ = work.streamTime + interval_;
   for (Seam& seam : seams_) {
@@ -51,7 +62,64 @@ void CalibrationWatchStage::process(FrameWork& work, StageTimes& times) {
     if (measured.response >= kMinResponse) seam.last = measured;
   }
   judge();
+  if (refinement_) readSuggestions();
   times.lap(Stage::kWatch);
+}
+
+void CalibrationWatchStage::offerToRefinement(FrameWork& work) {
+  if (nextCompare_ && work.streamTime < *nextCompare_) return;
+  std::array<const cv::Mat*, kMaxCameras> pictures{};
+  for (std::size_t c = 0; c < rig_.cameras.size() && c < kMaxCameras; ++c) {
+    // A faulty camera's picture (black, frozen) is no view of the ground.
+    pictures[c] = work.faults[c] == nullptr ? work.bgr(c) : nullptr;
+  }
+  // Skipped while the worker is busy: the next set is offered instead.
+  if (refinement_->offer({pictures.data(), rig_.cameras.size()})) {
+    nextCompare_ = work.streamTime + compareEvery_;
+  }
+}
+
+void CalibrationWatchStage::readSuggestions() {
+  latest_ = refinement_->latest();
+  if (!latest_.result) return;
+  const processing::MountRefinementResult& result = *latest_.result;
+  for (std::size_t c = 0; c < suggested_.size(); ++c) {
+    const processing::MountCorrection& correction = result.cameras[c];
+    std::optional<MountSuggestion> now;
+    if (c != result.reference && correction.worthApplying()) {
+      const cv::Vec3d sigma = correction.rotationSigmaRad * (180 / std::numbers::pi);
+      const processing::Pose& pose = rig_.cameras[c].pose;
+      now = MountSuggestion{processing::mountAngleChange(pose, correction.applied(pose)),
+                            100 * correction.heightM, std::max({sigma[0], sigma[1], sigma[2]})};
+    }
+    const auto turned = [](const std::optional<MountSuggestion>& s) {
+      return s ? std::abs(s->changeDeg.yawDeg) + std::abs(s->changeDeg.pitchDeg) +
+                     std::abs(s->changeDeg.rollDeg)
+               : 0.0;
+    };
+    // Logged when a suggestion appears, goes, or moves by a tenth of a degree or more.
+    const bool changed = now.has_value() != suggested_[c].has_value() ||
+                         (now && std::abs(turned(now) - turned(suggested_[c])) >= 0.1);
+    if (!changed) continue;
+    suggested_[c] = now;
+    if (!now) {
+      spdlog::info("calibration watch: camera '{}' needs no correction now", cameraNames_[c]);
+      continue;
+    }
+    std::vector<std::string> before;
+    std::vector<std::string> after;
+    for (const processing::SeamFit& seam : result.seams) {
+      if (seam.name.find(cameraNames_[c]) == std::string::npos) continue;
+      before.push_back(fmt::format("{:.1f}", seam.beforeCm));
+      after.push_back(fmt::format("{:.1f}", seam.afterCm));
+    }
+    spdlog::warn(
+        "calibration watch: camera '{}': yaw {:+.1f}°, pitch {:+.1f}°, roll {:+.1f}° "
+        "(±{:.2f}°) would bring its seams from {} to {} cm (from {} sets); surround-calibrate "
+        "refine --update-rig writes it",
+        cameraNames_[c], now->changeDeg.yawDeg, now->changeDeg.pitchDeg, now->changeDeg.rollDeg,
+        now->sigmaDeg, fmt::join(before, " / "), fmt::join(after, " / "), result.sets);
+  }
 }
 
 std::vector<bool> driftingCameras(std::size_t cameras, std::span<const SeamShift> seams,
@@ -112,6 +180,18 @@ void CalibrationWatchStage::report(PipelineReport& report) const {
   }
   for (std::size_t c = 0; c < report.cameras.size() && c < drifting_.size(); ++c) {
     report.cameras[c].calibrationDrifting = drifting_[c];
+    report.cameras[c].mountSuggestion = suggested_[c];
+  }
+  if (!refinement_) return;
+  // The counts as they are now; the suggestions and seams as last judged.
+  const MountCorrectionState now = refinement_->latest();
+  report.mountWatch =
+      MountWatchReport{now.setsCompared, now.result ? now.result->matches : 0, now.cpuSeconds};
+  if (!latest_.result) return;
+  for (SeamReport& seam : report.seams) {
+    for (const processing::SeamFit& fit : latest_.result->seams) {
+      if (fit.name == seam.name && fit.matches > 0) seam.suggestedCm = fit.afterCm;
+    }
   }
 }
 

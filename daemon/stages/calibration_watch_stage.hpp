@@ -10,8 +10,15 @@
 //
 // Its probes (where each camera sees each seam's ground patch) are made once at start-up; a
 // measurement resamples only the patches (two of 160 x 160 pixels per seam) and correlates them.
+//
+// With calibration_watch.correct: suggest, every compare_every_s the set's pictures also go to the
+// mount refinement on its own thread (mount_correction_worker.hpp); at each measurement the
+// latest solution is read, and a camera whose correction is worth applying (conclusive, 0.2
+// degrees or more) is reported and logged with what it would do to its seams. Nothing is changed:
+// surround-calibrate refine --update-rig writes a correction into the rig.
 
 #include <chrono>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -19,6 +26,7 @@
 #include "daemon/config.hpp"
 #include "daemon/pipeline_report.hpp"
 #include "daemon/pipeline_stage.hpp"
+#include "daemon/stages/mount_correction_worker.hpp"
 #include "processing/calibration/seam_misalignment.hpp"
 #include "processing/rig.hpp"
 
@@ -51,6 +59,8 @@ class CalibrationWatchStage final : public PipelineStage {
     std::optional<processing::SeamMisalignment> last;  // with a response of kMinResponse or more
   };
   void judge();
+  void offerToRefinement(FrameWork& work);
+  void readSuggestions();
 
   std::vector<std::string> cameraNames_;
   std::vector<Seam> seams_;
@@ -58,6 +68,14 @@ class CalibrationWatchStage final : public PipelineStage {
   std::optional<std::chrono::nanoseconds> next_;  // stream time of the next measurement
   double thresholdCm_;
   std::vector<bool> drifting_;  // per camera
+
+  // correct: suggest
+  std::unique_ptr<MountCorrectionWorker> refinement_;
+  processing::Rig rig_;  // the mounts the suggestions turn
+  std::chrono::nanoseconds compareEvery_{};
+  std::optional<std::chrono::nanoseconds> nextCompare_;
+  MountCorrectionState latest_;
+  std::vector<std::optional<MountSuggestion>> suggested_;  // per camera, as last logged
 };
 
 }  // namespace surroundd::daemon

@@ -137,6 +137,22 @@ RecordingPlan planRecording(const SynthOptions& options) {
     it->fault = fault.kind;
     it->faultFrame = static_cast<int>(std::lround(fault.fromS * options.fps));
   }
+  for (const auto& turn : options.turns) {
+    const auto it = std::find_if(plan.cameras.begin(), plan.cameras.end(), [&](const auto& c) {
+      return c.camera.calibration.name == turn.camera;
+    });
+    if (it == plan.cameras.end()) {
+      throw UsageError(fmt::format("--turn: the rig has no camera named '{}'", turn.camera));
+    }
+    const processing::Pose& pose = it->camera.calibration.pose;
+    const processing::MountAngles before = processing::mountAnglesFromRotation(pose.rotation);
+    it->turnedPose =
+        processing::Pose{processing::rotationFromMountAngles({before.yawDeg + turn.byDeg.yawDeg,
+                                                              before.pitchDeg + turn.byDeg.pitchDeg,
+                                                              before.rollDeg + turn.byDeg.rollDeg}),
+                         pose.position};
+    it->turnFrame = static_cast<int>(std::lround(turn.atS * options.fps));
+  }
   for (const auto& [name, n] : options.dropEvery) {
     const std::string& wanted = name;  // clang-tidy (clang 14) cannot capture the binding
     const auto it = std::find_if(plan.cameras.begin(), plan.cameras.end(), [&](const auto& c) {

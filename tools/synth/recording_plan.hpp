@@ -26,6 +26,9 @@ struct CameraPlan {
   int dropEvery = 0;        // 0: none; N: frames N-1, 2N-1, ... are not recorded
   std::optional<SynthOptions::Fault::Kind> fault;  // from faultFrame on
   int faultFrame = 0;
+  // The mount from turnFrame on, where the camera is knocked.
+  std::optional<processing::Pose> turnedPose;
+  int turnFrame = 0;
   bool faulty(int frame, SynthOptions::Fault::Kind kind) const {
     return fault == kind && frame >= faultFrame;
   }

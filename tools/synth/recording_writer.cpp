@@ -99,11 +99,22 @@ RecordingResult writeRecording(const SynthOptions& options, std::ostream& log) {
   std::optional<EgoBody> body;
   if (plan.vehicle) body.emplace(*plan.vehicle);
   std::vector<std::unique_ptr<CameraRays>> rays;
+  std::vector<std::unique_ptr<CameraRays>> turnedRays;  // per camera; null: not knocked
   std::vector<std::unique_ptr<PhotometricCamera>> sensors, neutral;
   for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
     const auto& calibration = plan.cameras[c].camera.calibration;
     rays.push_back(std::make_unique<CameraRays>(calibration, body ? &*body : nullptr));
     if (body) writePng(folder.path() / bodyMaskName(calibration.name), rays.back()->bodyMask());
+    turnedRays.emplace_back();
+    if (const auto& turned = plan.cameras[c].turnedPose) {
+      processing::CameraCalibration knocked = calibration;
+      knocked.pose = *turned;
+      turnedRays.back() = std::make_unique<CameraRays>(knocked, body ? &*body : nullptr);
+      if (body) {
+        writePng(folder.path() / turnedBodyMaskName(calibration.name),
+                 turnedRays.back()->bodyMask());
+      }
+    }
     sensors.push_back(std::make_unique<PhotometricCamera>(
         plan.cameras[c].photometrics, options.seed, static_cast<int>(c),
         rays.back()->offAxisAngle(), rays.back()->fisheye()));
@@ -140,6 +151,10 @@ RecordingResult writeRecording(const SynthOptions& options, std::ostream& log) {
   std::vector<int> framesWritten(plan.cameras.size(), 0);
   std::vector<cv::Mat> frozen(plan.cameras.size());  // the picture a frozen camera repeats
   auto nextTruth = plan.groundTruthFrames.begin();
+  // The rays a camera sees through at frame k: as knocked from its turn on.
+  const auto raysAt = [&](std::size_t c, int k) {
+    return turnedRays[c] && k >= plan.cameras[c].turnFrame ? turnedRays[c].get() : rays[c].get();
+  };
   for (int k = 0; k < plan.frames; ++k) {
     const double t = plan.frameTime(k);
     const VehiclePose pose = VehiclePath::poseAt(t);
@@ -154,7 +169,7 @@ RecordingResult writeRecording(const SynthOptions& options, std::ostream& log) {
       } else if (camera.faulty(k, SynthOptions::Fault::Kind::kFreeze) && k > camera.faultFrame) {
         frozen[c].copyTo(slot);
       } else {
-        jobs.push_back({rays[c].get(), sensors[c].get(), sensors[c]->frame(k, t), &slot});
+        jobs.push_back({raysAt(c, k), sensors[c].get(), sensors[c]->frame(k, t), &slot});
       }
     }
     renderer.render(pose, jobs);
@@ -171,7 +186,7 @@ RecordingResult writeRecording(const SynthOptions& options, std::ostream& log) {
       const auto truthStart = Clock::now();
       jobs.clear();
       for (std::size_t c = 0; c < plan.cameras.size(); ++c) {
-        jobs.push_back({rays[c].get(), neutral[c].get(), neutral[c]->frame(k, t), &truth[c]});
+        jobs.push_back({raysAt(c, k), neutral[c].get(), neutral[c]->frame(k, t), &truth[c]});
       }
       renderer.render(pose, jobs);
       for (std::size_t c = 0; c < plan.cameras.size(); ++c) {

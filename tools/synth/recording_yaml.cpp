@@ -34,6 +34,9 @@ std::string cameraImageName(const std::string& camera, int frame) {
 std::string bodyMaskName(const std::string& camera) {
   return fmt::format("ground_truth/body_mask_{}.png", camera);
 }
+std::string turnedBodyMaskName(const std::string& camera) {
+  return fmt::format("ground_truth/body_mask_{}_turned.png", camera);
+}
 
 void writeGroundTruthYaml(const std::filesystem::path& file, const RecordingPlan& plan,
                           const std::vector<int>& framesWritten) {
@@ -101,6 +104,21 @@ void writeGroundTruthYaml(const std::filesystem::path& file, const RecordingPlan
     out << YAML::Key << "start_offset_ms" << YAML::Value << camera.startOffsetS * 1e3;
     out << YAML::Key << "jitter_ms" << YAML::Value << RecordingPlan::kJitterS * 1e3;
     out << YAML::Key << "drop_every" << YAML::Value << camera.dropEvery;
+    if (camera.turnedPose) {
+      // The mount before is the rig's; from turned_at_s on the camera sits as knocked.
+      const auto angles = processing::mountAnglesFromRotation(camera.turnedPose->rotation);
+      const cv::Vec3d& at = camera.turnedPose->position;
+      out << YAML::Key << "turned_at_s" << YAML::Value << plan.frameTime(camera.turnFrame);
+      out << YAML::Key << "mount_after_turn" << YAML::Value << YAML::Flow << YAML::BeginMap
+          << YAML::Key << "x_m" << YAML::Value << at[0] << YAML::Key << "y_m" << YAML::Value
+          << at[1] << YAML::Key << "z_m" << YAML::Value << at[2] << YAML::Key << "yaw_deg"
+          << YAML::Value << angles.yawDeg << YAML::Key << "pitch_deg" << YAML::Value
+          << angles.pitchDeg << YAML::Key << "roll_deg" << YAML::Value << angles.rollDeg
+          << YAML::EndMap;
+      if (plan.vehicle) {
+        out << YAML::Key << "body_mask_after_turn" << YAML::Value << turnedBodyMaskName(name);
+      }
+    }
     out << YAML::Key << "frames_written" << YAML::Value << framesWritten[c];
     out << YAML::Key << "timestamps_us" << YAML::Value << YAML::Flow << YAML::BeginSeq;
     for (int k = 0; k < plan.frames; ++k) {

@@ -25,5 +25,7 @@ std::string panoramaName(int frame);
 std::string cameraImageName(const std::string& camera, int frame);
 // The true body mask of a camera (recordings of a rig with a `vehicle:` only).
 std::string bodyMaskName(const std::string& camera);
+// A knocked camera's body mask from its turn on (--turn).
+std::string turnedBodyMaskName(const std::string& camera);
 
 }  // namespace surroundd::synth

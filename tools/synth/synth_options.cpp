@@ -116,6 +116,13 @@ std::string SynthOptions::canonical() const {
       s << f.camera << ":" << static_cast<int>(f.kind) << "@" << fmt::format("{}", f.fromS) << ";";
     }
   }
+  if (!turns.empty()) {  // likewise
+    s << " turns=";
+    for (const auto& t : turns) {
+      s << fmt::format("{}:{},{},{}@{};", t.camera, t.byDeg.yawDeg, t.byDeg.pitchDeg,
+                       t.byDeg.rollDeg, t.atS);
+    }
+  }
   return s.str();
 }
 
@@ -190,6 +197,29 @@ SynthOptions parseSynthArguments(std::span<const std::string_view> arguments) {
                                             : SynthOptions::Fault::Kind::kStop,
                           parseNumber<double>(option, v.substr(at + 1), 0.0, 3600.0,
                                               "CAMERA:KIND@SECONDS with 0 <= SECONDS <= 3600")});
+    } else if (option == "--turn") {
+      const auto v = value();
+      const auto colon = v.find(':');
+      const auto at = v.find('@');
+      const char* expected = "CAMERA:YAW,PITCH,ROLL@SECONDS in degrees (e.g. back:0,2,0@5)";
+      if (colon == 0 || colon == std::string_view::npos || at == std::string_view::npos ||
+          at < colon) {
+        throw UsageError(fmt::format("{}: expected {}, got '{}'", option, expected, v));
+      }
+      const auto angles = v.substr(colon + 1, at - colon - 1);
+      const auto comma1 = angles.find(',');
+      const auto comma2 = comma1 == std::string_view::npos ? comma1 : angles.find(',', comma1 + 1);
+      if (comma2 == std::string_view::npos) {
+        throw UsageError(fmt::format("{}: expected {}, got '{}'", option, expected, v));
+      }
+      const auto angle = [&](std::string_view text) {
+        return parseNumber<double>(option, text, -30.0, 30.0, expected);
+      };
+      o.turns.push_back(
+          {std::string(v.substr(0, colon)),
+           {angle(angles.substr(0, comma1)), angle(angles.substr(comma1 + 1, comma2 - comma1 - 1)),
+            angle(angles.substr(comma2 + 1))},
+           parseNumber<double>(option, v.substr(at + 1), 0.0, 3600.0, expected)});
     } else if (option == "--no-body") {
       o.body = false;
     } else if (option == "--scene") {
@@ -261,6 +291,9 @@ usage: surround-synth --rig FILE --out DIR [options]
   --drop-every NAME:N        omit every Nth frame of camera NAME (repeatable)
   --fault NAME:KIND@S        from S seconds on, camera NAME freezes (repeats one picture), goes
                              black, or stops (its video ends); KIND freeze|black|stop (repeatable)
+  --turn NAME:Y,P,R@S        from S seconds on, camera NAME is knocked: its mount's yaw, pitch
+                             and roll change by Y, P, R degrees (up to 30; repeatable); the rig
+                             written keeps the mount before, ground_truth.yaml has both
   --ground-truth-frames LIST frames with ground truth images (default: first, middle, last)
   --no-body                  leave the rig's vehicle body out (what the cameras would see
                              without it; the recording's rig then has no `vehicle:`)

@@ -15,6 +15,7 @@
 #include <opencv2/core.hpp>
 
 #include "processing/calibration/calibration_targets.hpp"
+#include "processing/rig.hpp"
 #include "tools/synth/scene.hpp"
 
 namespace surroundd::synth {
@@ -47,6 +48,14 @@ struct SynthOptions {
     double fromS = 0;
   };
   std::vector<Fault> faults;
+  // A camera knocked from a time on: its mount angles change by these degrees (a mirror folded,
+  // a tailgate slammed); the recording's rig keeps the mount before.
+  struct Turn {
+    std::string camera;
+    processing::MountAngles byDeg;
+    double atS = 0;
+  };
+  std::vector<Turn> turns;
   std::optional<std::vector<int>> groundTruthFrames;  // default: first, middle, last
   SceneLayout scene = SceneLayout::kDefault;
   bool body =
