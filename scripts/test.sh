@@ -115,7 +115,8 @@ if [ "$sanitizers" = yes ]; then
     http_stream_sink_test replay_test preload_replay_test
     processing_backend_test fault_replay_test fault_isolation_test output_retry_test
     output_files_test recording_test still_rig_test pipeline_report_test control_server_test
-    service_notifier_test service_test end_to_end_test window_output_test"
+    service_notifier_test service_test end_to_end_test window_output_test
+    calibration_watch_stage_test"
   begin "tsan build"
   # Only these tests and the programs they run are built; their recordings are made by the ci
   # build's generator too, so it need not be built a third time.

@@ -49,5 +49,8 @@ surroundd_fixture(synth_drive_paper --rig ${paper_body} ${drive} --seed 3)
 surroundd_fixture(synth_drive_fisheye --rig ${fisheye_body} ${drive} --seed 3 --scene near-objects)
 # The same drive at 1280x720, where a picture's pixel spans about a centimetre of the overlaps'
 # ground: for the mounts corrected from the road.
+# The fisheye rig's back camera knocked, 3 degrees of pitch from 2 s on (surround-synth --turn).
+surroundd_fixture(synth_turn --rig ${fisheye_body} --size 1280x720 --panorama-size 256x128
+                  --seconds 4 --fps 1 --seed 3 --photometrics identity --turn back:0,3,0@2)
 surroundd_fixture(synth_drive_fisheye_hd --rig ${fisheye_body} --size 1280x720 --panorama-size 256x128
                   --seconds 10 --fps 2 --seed 3 --scene near-objects)
