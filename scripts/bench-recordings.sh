@@ -21,3 +21,16 @@ INPUTS
   --panorama-size 1536x768 --seconds 0.2 --seed 5 --photometrics extreme --force
 "$synth" --rig config/rigs/fisheye-body.yaml --out recordings/bench/body-near-objects \
   --size 1280x720 --panorama-size 1536x768 --seconds 0.2 --seed 3 --scene near-objects --force
+# The calibration watch's mount refinement (issue 48; surround-bench mounts): the fisheye rig
+# driving over textured ground, a camera knocked 5 s in (yaw, pitch, roll), and ten minutes with
+# none knocked (false alarms).
+while read -r name turn; do
+  "$synth" --rig config/rigs/fisheye-body.yaml --out "recordings/bench/$name" --size 1280x720 \
+    --panorama-size 256x128 --seconds 30 --fps 2 --seed 3 --turn "$turn" --force
+done <<TURNS
+turn-yaw2 back:2,0,0@5
+turn-pitch2 front:0,2,0@5
+turn-roll3 left:0,0,3@5
+TURNS
+"$synth" --rig config/rigs/fisheye-body.yaml --out recordings/bench/drive-10min --size 1280x720 \
+  --panorama-size 256x128 --seconds 600 --fps 1 --seed 4 --force

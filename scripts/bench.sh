@@ -2,7 +2,8 @@
 # The benchmarks: installs what is missing, builds (release), makes the benchmark recordings (the
 # paper rig at 4 x 854x480, 1280x720 and 1920x1080, 2 s each, with ground truth; once, then cached
 # in recordings/bench/, replaced when they were made with other arguments) and two with the
-# vehicle's body in view, and runs surround-bench stitch, colour and pipeline on them; colour also
+# vehicle's body in view, and runs surround-bench stitch, colour and pipeline on them (and mounts
+# on drives with a camera knocked, and ten minutes with none); colour also
 # on the shared real rigs (config/real/) when ../shared/data is there. Extra arguments go to each, e.g.
 # --threads 1, --repeats 5; --json (first) prints stitch's and pipeline's JSON only.
 set -eu
@@ -26,3 +27,7 @@ if [ "${1:-}" != "--json" ]; then
   fi
 fi
 build/release/tools/bench/surround-bench pipeline "$@" $inputs
+if [ "${1:-}" != "--json" ]; then
+  build/release/tools/bench/surround-bench mounts recordings/bench/turn-yaw2 \
+    recordings/bench/turn-pitch2 recordings/bench/turn-roll3 recordings/bench/drive-10min
+fi

@@ -45,16 +45,6 @@ bool MountCorrectionWorker::offer(std::span<const cv::Mat* const> pictures) {
   return true;
 }
 
-bool MountCorrectionWorker::movedFar(const processing::MountRefinementResult& solved) const {
-  for (std::size_t c = 0; c < solved.cameras.size(); ++c) {
-    const cv::Vec3d followed = c < followed_.size() ? followed_[c].rotationRad : cv::Vec3d();
-    if (cv::norm(solved.cameras[c].rotationRad - followed) * 180 / CV_PI >= kFollowDeg) {
-      return true;
-    }
-  }
-  return false;
-}
-
 MountCorrectionState MountCorrectionWorker::latest() const {
   const std::lock_guard lock(mutex_);
   return state_;
@@ -62,7 +52,6 @@ MountCorrectionState MountCorrectionWorker::latest() const {
 
 void MountCorrectionWorker::run(const std::stop_token& stop) {
   std::vector<const cv::Mat*> set(pictures_.size());
-  std::size_t sinceSolve = 0;
   while (true) {
     {
       std::unique_lock lock(mutex_);
@@ -72,16 +61,7 @@ void MountCorrectionWorker::run(const std::stop_token& stop) {
     for (std::size_t c = 0; c < set.size(); ++c) set[c] = present_[c] ? &pictures_[c] : nullptr;
     std::optional<processing::MountRefinementResult> solved;
     try {
-      refinement_.add(set);
-      if (++sinceSolve >= solveEvery_) {
-        sinceSolve = 0;
-        solved = refinement_.solve();
-        if (solved && movedFar(*solved)) {
-          // Patches laid through the mounts as solved line up: the next solution is finer.
-          refinement_.follow(*solved);
-          followed_ = solved->cameras;
-        }
-      }
+      solved = refinement_.track(set, solveEvery_);
     } catch (const std::exception& error) {
       // A frame the refinement cannot take (its size changed on a reload) costs this set only.
       spdlog::warn("calibration watch: mount refinement skipped a set: {}", error.what());

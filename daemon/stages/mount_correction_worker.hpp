@@ -3,10 +3,8 @@
 // thread of its own: comparing a set's ground patches takes tens of milliseconds, which the
 // pipeline thread must not wait for. The pipeline offers a set now and then; the worker takes it
 // when it is idle (a set offered while it is busy is skipped: the road goes on), adds its
-// comparisons, and every few sets solves; the latest solution is read back at any time. A
-// solution that turns a camera half a degree or more from the mounts the patches were laid
-// through lays them again through it (MountRefinement::follow): the comparisons start afresh,
-// the shifts small, and the next solution is finer.
+// comparisons, and every few sets solves (MountRefinement::track); the latest solution is read
+// back at any time.
 //
 // Threads: the pipeline thread calls offer() and latest(); the worker thread alone touches the
 // refinement. The pictures offered and the latest solution are handed over under mutex_; the
@@ -49,13 +47,8 @@ class MountCorrectionWorker {
 
  private:
   void run(const std::stop_token& stop);
-  bool movedFar(const processing::MountRefinementResult& solved) const;
-
-  static constexpr double kFollowDeg = 0.5;
 
   processing::MountRefinement refinement_;  // the worker thread's alone
-  std::vector<processing::MountCorrection>
-      followed_;  // likewise: what the patches are laid through
   std::size_t solveEvery_;
   std::vector<cv::Mat> pictures_;  // the set handed over: written by offer() while !busy_
   std::vector<bool> present_;

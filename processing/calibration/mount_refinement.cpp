@@ -99,6 +99,18 @@ Rig MountRefinementResult::corrected(const Rig& rig) const {
   return out;
 }
 
+bool MountRefinementResult::closesSeams(std::size_t camera) const {
+  for (std::size_t s = 0; s < seams.size() && s < seamCameras.size(); ++s) {
+    if (seamCameras[s].first != camera && seamCameras[s].second != camera) continue;
+    const SeamFit& seam = seams[s];
+    if (seam.matches < MountRefinement::kMinMatches || seam.afterCm >= seam.beforeCm ||
+        seam.afterCm > kClosedCm) {
+      return false;
+    }
+  }
+  return true;
+}
+
 MountRefinement::MountRefinement(const Rig& rig, const PanoramaSettings& settings,
                                  std::size_t capacity)
     : rig_(rig),
@@ -113,16 +125,36 @@ void MountRefinement::layPatches(const Rig& through) {
   patches_.clear();
   patchSeam_.clear();
   for (std::size_t s = 0; s < seams_.size(); ++s) {
-    for (const PatchSizes& sizes : {kCoarsePatches, kFinePatches}) {
-      for (auto& patch : overlapPatches(patchRig_, seams_[s], sizes)) {
-        patches_.push_back(std::move(patch));
-        patchSeam_.push_back(s);
-      }
+    constexpr std::array kSizes{kCoarsePatches, kFinePatches};
+    for (auto& patch : overlapPatches(patchRig_, seams_[s], kSizes)) {
+      patches_.push_back(std::move(patch));
+      patchSeam_.push_back(s);
     }
   }
 }
 
+std::optional<MountRefinementResult> MountRefinement::track(
+    std::span<const cv::Mat* const> pictures, std::size_t solveEvery) {
+  add(pictures);
+  if (++sinceSolve_ < std::max<std::size_t>(solveEvery, 1)) return std::nullopt;
+  sinceSolve_ = 0;
+  auto solved = solve();
+  if (!solved) return solved;
+  for (std::size_t c = 0; c < solved->cameras.size(); ++c) {
+    const cv::Vec3d laid = c < followed_.size() ? followed_[c].rotationRad : cv::Vec3d();
+    if (cv::norm(solved->cameras[c].rotationRad - laid) / kDegree >= kFollowDeg) {
+      // Patches laid through the mounts as solved line up: the next solution is finer, and
+      // comes after a few sets, not a full round.
+      follow(*solved);
+      sinceSolve_ = solveEvery - std::min(solveEvery, kSetsAfterFollow);
+      break;
+    }
+  }
+  return solved;
+}
+
 void MountRefinement::follow(const MountRefinementResult& result) {
+  followed_ = result.cameras;
   layPatches(result.corrected(rig_));
   matches_.clear();
   oldest_ = 0;
@@ -406,6 +438,7 @@ std::optional<MountRefinementResult> MountRefinement::solve() {
       if (!is.empty()) break;
     }
     result.seams.push_back({seams_[s].name, is.size(), 100 * median(was), 100 * median(is)});
+    result.seamCameras.emplace_back(seams_[s].left, seams_[s].right);
   }
   result.matches = static_cast<std::size_t>(std::ranges::count(best->used, true));
   result.rejected = matches_.size() - result.matches;

@@ -28,6 +28,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -74,11 +75,18 @@ struct MountRefinementResult {
   std::size_t reference = 0;  // the camera held
   std::vector<MountCorrection> cameras;
   std::vector<SeamFit> seams;
-  std::size_t matches = 0;   // used
+  std::vector<std::pair<std::size_t, std::size_t>> seamCameras;  // per seam: left, right
+  std::size_t matches = 0;                                       // used
   std::size_t rejected = 0;  // left out as disagreeing with the fit
   std::size_t sets = 0;      // frame sets they came from (since the last follow())
 
   Rig corrected(const Rig& rig) const;
+  // Whether the correction of `camera` brings every seam it touches together: each with
+  // kMinMatches comparisons or more, closer than before, and within kClosedCm. A fit that
+  // cannot close them (a camera knocked further than the patches' reach, so that most of its
+  // comparisons fail) is no correction to make.
+  bool closesSeams(std::size_t camera) const;
+  static constexpr double kClosedCm = 2.0;
 };
 
 class MountRefinement {
@@ -92,6 +100,15 @@ class MountRefinement {
   // The corrections that bring the matches together, warm-started from the last; none while
   // a camera has fewer than a few matches on its seams.
   std::optional<MountRefinementResult> solve();
+  // The online cadence (the daemon's watch, the benchmark): add() the set, and every
+  // `solveEvery` sets solve(); a solution that turns a camera kFollowDeg or more from the
+  // mounts the patches were laid through is followed, and the next solve comes
+  // kSetsAfterFollow sets later. Returns the solution when one was made.
+  std::optional<MountRefinementResult> track(std::span<const cv::Mat* const> pictures,
+                                             std::size_t solveEvery = 10);
+  static constexpr double kFollowDeg = 0.2;
+  static constexpr std::size_t kSetsAfterFollow = 3;
+
   // Lays the patches through the rig as `result` corrects it, so that later sets' patches line
   // up (their shifts small, more of them clear, and the correlation's bias at sub-pixel shifts
   // gone); the matches so far, made through mounts now known to be off, are dropped.
@@ -127,7 +144,9 @@ class MountRefinement {
   std::size_t capacity_;
   std::size_t oldest_ = 0;  // where the next match goes once at capacity
   std::size_t sets_ = 0;
-  std::vector<double> warm_;  // the last fit's parameters, four per camera
+  std::vector<double> warm_;               // the last fit's parameters, four per camera
+  std::size_t sinceSolve_ = 0;             // track()'s
+  std::vector<MountCorrection> followed_;  // what the patches are laid through
 };
 
 }  // namespace surroundd::processing

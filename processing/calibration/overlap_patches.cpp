@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <utility>
 
 #include <opencv2/imgproc.hpp>
@@ -55,7 +56,7 @@ cv::Mat overlapMask(const Rig& rig, const SeamLine& seam, const GroundGrid& grid
 }  // namespace
 
 std::vector<SeamMisalignmentProbe> overlapPatches(const Rig& rig, const SeamLine& seam,
-                                                  const PatchSizes& sizes) {
+                                                  std::span<const PatchSizes> sizeRanges) {
   const int cells = static_cast<int>(2 * kReachM / kCellM);
   const GroundGrid grid{{0, 0}, kCellM, {cells, cells}};
   const cv::Mat both = overlapMask(rig, seam, grid);
@@ -63,46 +64,48 @@ std::vector<SeamMisalignmentProbe> overlapPatches(const Rig& rig, const SeamLine
   cv::distanceTransform(both, room, cv::DIST_C, 3);
   const std::array<CameraModel, 2> models{CameraModel(rig.cameras[seam.left].intrinsics),
                                           CameraModel(rig.cameras[seam.right].intrinsics)};
-  struct Candidate {
-    cv::Vec3d ground;
-    double sideM = 0;
-    double nearness = 0;  // the distances to the two cameras, summed, per metre of patch
-  };
-  std::vector<Candidate> candidates;
-  for (int row = 0; row < cells; ++row) {
-    for (int column = 0; column < cells; ++column) {
-      const double sideM = std::min(sizes.largestM, 2 * room.at<float>(row, column) * kCellM);
-      if (sideM < sizes.smallestM) continue;
-      const cv::Vec3d ground = grid.groundAt(row, column);
-      double nearness = 0;
-      for (const std::size_t c : {seam.left, seam.right}) {
-        nearness += cv::norm(ground - rig.cameras[c].pose.position);
-      }
-      candidates.push_back({ground, sideM, nearness / sideM});
-    }
-  }
-  std::ranges::sort(candidates, {}, &Candidate::nearness);
   std::vector<SeamMisalignmentProbe> patches;
-  std::vector<Candidate> placed;
-  for (const Candidate& candidate : candidates) {
-    if (std::cmp_greater_equal(patches.size(), kMaxPatches)) break;
-    const bool crowded = std::ranges::any_of(placed, [&](const Candidate& other) {
-      return cv::norm(candidate.ground - other.ground) < (candidate.sideM + other.sideM) / 4;
-    });
-    if (crowded) continue;
-    // Sampled as finely as the coarser camera sees that ground, no finer than 1 cm.
-    const double perPixel = std::max(
-        {sizes.finestM, groundPerPixel(models[0], rig.cameras[seam.left].pose, candidate.ground),
-         groundPerPixel(models[1], rig.cameras[seam.right].pose, candidate.ground)});
-    int side = kPatchSides[0];  // finer than the cameras where the overlap is narrow
-    for (const int allowed : kPatchSides) {
-      if (allowed * perPixel <= candidate.sideM) side = allowed;
+  for (const PatchSizes& sizes : sizeRanges) {
+    struct Candidate {
+      cv::Vec3d ground;
+      double sideM = 0;
+      double nearness = 0;  // the distances to the two cameras, summed, per metre of patch
+    };
+    std::vector<Candidate> candidates;
+    for (int row = 0; row < cells; ++row) {
+      for (int column = 0; column < cells; ++column) {
+        const double sideM = std::min(sizes.largestM, 2 * room.at<float>(row, column) * kCellM);
+        if (sideM < sizes.smallestM) continue;
+        const cv::Vec3d ground = grid.groundAt(row, column);
+        double nearness = 0;
+        for (const std::size_t c : {seam.left, seam.right}) {
+          nearness += cv::norm(ground - rig.cameras[c].pose.position);
+        }
+        candidates.push_back({ground, sideM, nearness / sideM});
+      }
     }
-    auto patch = SeamMisalignmentProbe::at(rig, seam, {candidate.ground[0], candidate.ground[1]},
-                                           side, candidate.sideM / side);
-    if (!patch) continue;
-    patches.push_back(std::move(*patch));
-    placed.push_back(candidate);
+    std::ranges::sort(candidates, {}, &Candidate::nearness);
+    std::vector<Candidate> placed;
+    for (const Candidate& candidate : candidates) {
+      if (std::cmp_greater_equal(placed.size(), kMaxPatches)) break;
+      const bool crowded = std::ranges::any_of(placed, [&](const Candidate& other) {
+        return cv::norm(candidate.ground - other.ground) < (candidate.sideM + other.sideM) / 4;
+      });
+      if (crowded) continue;
+      // Sampled as finely as the coarser camera sees that ground, no finer than 1 cm.
+      const double perPixel = std::max(
+          {sizes.finestM, groundPerPixel(models[0], rig.cameras[seam.left].pose, candidate.ground),
+           groundPerPixel(models[1], rig.cameras[seam.right].pose, candidate.ground)});
+      int side = kPatchSides[0];  // finer than the cameras where the overlap is narrow
+      for (const int allowed : kPatchSides) {
+        if (allowed * perPixel <= candidate.sideM) side = allowed;
+      }
+      auto patch = SeamMisalignmentProbe::at(rig, seam, {candidate.ground[0], candidate.ground[1]},
+                                             side, candidate.sideM / side);
+      if (!patch) continue;
+      patches.push_back(std::move(*patch));
+      placed.push_back(candidate);
+    }
   }
   return patches;
 }

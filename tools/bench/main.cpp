@@ -8,6 +8,7 @@
 //                           [--backend B] [--output O] RECORDING...
 //   surround-bench receive [--transport udp|tcp] [--seconds N] [--save PICTURE] URL
 //   surround-bench gpu-kit KIT RECORDING...
+//   surround-bench mounts RECORDING...
 //
 // Exit codes: 0 done, 1 failed while measuring, 2 bad command line.
 
@@ -24,6 +25,7 @@
 #include "common/work_pool.hpp"
 #include "tools/bench/colour_benchmark.hpp"
 #include "tools/bench/gpu_kit.hpp"
+#include "tools/bench/mount_benchmark.hpp"
 #include "tools/bench/pipeline_benchmark.hpp"
 #include "tools/bench/receive_benchmark.hpp"
 #include "tools/bench/rig_colour_report.hpp"
@@ -39,6 +41,7 @@ constexpr std::string_view kUsage =
                                [--raw-format F] [--backend B] [--output O] RECORDING...
        surround-bench receive [--transport T] [--seconds N] [--save PICTURE] URL
        surround-bench gpu-kit KIT RECORDING...
+       surround-bench mounts RECORDING...
   stitch        LUT build, stitch against cv::remap, accuracy against the ground truth
   colour        Poisson colour correction: solvers, per-frame cost, seam colour error; for a
                 CONFIG (a surroundd .yaml: any rig, the shared real ones, your own car): per
@@ -53,6 +56,9 @@ constexpr std::string_view kUsage =
   gpu-kit       writes into the folder KIT, per recording, its panorama LUT and first frame set
                 as raw YUYV: what surround-gpu-check measures on a machine with a GPU
                 (scripts/gpu-check.sh)
+  mounts        the calibration watch's mount refinement at the daemon's cadence over drives
+                (surround-synth --turn knocks a camera): how long after the turn a correction
+                came, how close to the mount after it, false alarms, CPU per compared set
   RECORDING     a surround-synth recording folder (with ground truth); scripts/bench.sh makes
                 4x480p, 720p and 1080p ones
   --threads N   worker threads (default 2); stitch measures 1 thread too
@@ -173,8 +179,12 @@ int main(int argc, char** argv) {
   const std::string_view command = argc >= 2 ? argv[1] : "";
   if (command == "receive") return receive(argc, argv);
   if (command == "gpu-kit") return gpuKit(argc, argv);
+  if (command == "mounts") {
+    if (argc < 3) return usageError("mounts: no recording given");
+    return bench::runMountBenchmark({argv + 2, argv + argc});
+  }
   if (command != "stitch" && command != "colour" && command != "pipeline") {
-    return usageError("expected 'stitch', 'colour', 'pipeline', 'receive' or 'gpu-kit'");
+    return usageError("expected 'stitch', 'colour', 'pipeline', 'receive', 'gpu-kit' or 'mounts'");
   }
   bench::StitchBenchmarkOptions options;
   bench::PipelineBenchmarkOptions pipeline;

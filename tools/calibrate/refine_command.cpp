@@ -208,6 +208,13 @@ void runRefine(const RefineOptions& options, std::ostream& log) {
                          describe(correction, camera.pose));
       continue;
     }
+    if (correction.worthApplying() && !result->closesSeams(c)) {
+      log << fmt::format(
+          "{}: left as it is: {} leaves its seams apart (the patches cannot reach "
+          "that far: check its mount)\n",
+          camera.name, describe(correction, camera.pose));
+      continue;
+    }
     if (!correction.worthApplying()) {
       log << fmt::format("{}: left as it is: {} turns it less than {:g} deg\n", camera.name,
                          describe(correction, camera.pose),
