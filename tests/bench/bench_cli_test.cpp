@@ -160,7 +160,7 @@ TEST(BenchCli, BadCommandLinesAreUsageErrors) {
   for (const auto& [arguments, message] :
        {std::pair{std::vector<std::string>{"stitch"}, "no recording given"},
         std::pair{std::vector<std::string>{"stich", kRecording},
-                  "expected 'stitch', 'colour', 'pipeline', 'receive' or 'gpu-kit'"},
+                  "expected 'stitch', 'colour', 'pipeline', 'receive', 'gpu-kit' or 'mounts'"},
         std::pair{std::vector<std::string>{"gpu-kit", "kit"},
                   "gpu-kit needs a folder and at least one recording"},
         std::pair{std::vector<std::string>{"receive"}, "no URL given"},
@@ -184,7 +184,8 @@ TEST(BenchCli, BadCommandLinesAreUsageErrors) {
         std::pair{std::vector<std::string>{"stitch", "--threads", "0", kRecording},
                   "--threads needs a number from 1 to 256"},
         std::pair{std::vector<std::string>{"stitch", "--fast", kRecording},
-                  "unknown option '--fast'"}}) {
+                  "unknown option '--fast'"},
+        std::pair{std::vector<std::string>{"mounts"}, "mounts: no recording given"}}) {
     std::vector<std::string> argv{SURROUND_BENCH};
     argv.insert(argv.end(), arguments.begin(), arguments.end());
     testing::ChildProcess bench(argv, dir / "out.txt");
@@ -195,6 +196,10 @@ TEST(BenchCli, BadCommandLinesAreUsageErrors) {
                                 dir / "out.txt");
   EXPECT_EQ(missing.wait(), 1);
   EXPECT_THAT(missing.output(), HasSubstr("rig.yaml"));
+  testing::ChildProcess noMounts({SURROUND_BENCH, "mounts", (dir / "nothing").string()},
+                                 dir / "out.txt");
+  EXPECT_EQ(noMounts.wait(), 1);
+  EXPECT_THAT(noMounts.output(), HasSubstr("surround-bench mounts: "));
   testing::ChildProcess http({SURROUND_BENCH, "receive", "http://127.0.0.1:9/"}, dir / "out.txt");
   EXPECT_EQ(http.wait(), 1);
   EXPECT_THAT(
