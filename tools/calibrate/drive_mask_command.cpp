@@ -15,6 +15,7 @@
 #include "processing/calibration/body_from_motion.hpp"
 #include "tools/calibrate/calibration_output.hpp"
 #include "tools/calibrate/mask_overlay.hpp"
+#include "tools/calibrate/recorded_camera.hpp"
 
 namespace surroundd::calibrate {
 namespace {
@@ -28,10 +29,6 @@ constexpr double kMinMovingShare = 0.3;
 // Polygons within a pixel of the mask's outline.
 constexpr double kOutlineTolerancePx = 1.0;
 
-std::filesystem::path rigFileOf(const std::filesystem::path& from) {
-  return std::filesystem::is_directory(from) ? from / "rig.yaml" : from;
-}
-
 struct FoundBody {
   cv::Mat mask;
   cv::Mat lastPicture;
@@ -43,33 +40,18 @@ struct FoundBody {
 FoundBody findBody(const daemon::RigCamera& camera, const std::filesystem::path& recording,
                    double everyS) {
   const std::string& name = camera.calibration.name;
-  if (!camera.source) {
-    throw UsageError(
-        fmt::format("{}: camera '{}' is live, not recorded: record a drive first "
-                    "(a recording output), then give its folder",
-                    recording.string(), name));
-  }
-  auto settings = *camera.source;
-  settings.pacing = capture::Pacing::kAsFastAsPossible;
-  settings.loop = false;
+  const auto source = openRecordedCamera(camera, recording);
+  const std::filesystem::path& path = camera.source->path;
+  const cv::Size size = camera.calibration.intrinsics.imageSize;
   FoundBody found;
   try {
-    capture::FileSource source(name, settings);
-    const cv::Size size = camera.calibration.intrinsics.imageSize;
-    if (source.frameSize() != size) {
-      throw UsageError(
-          fmt::format("camera '{}': {} has {}x{} frames but the lens is calibrated "
-                      "for {}x{}",
-                      name, settings.path.string(), source.frameSize().width,
-                      source.frameSize().height, size.width, size.height));
-    }
-    const double periodS = std::chrono::duration<double>(source.nominalPeriod()).count();
+    const double periodS = std::chrono::duration<double>(source->nominalPeriod()).count();
     const int every = std::max(1, static_cast<int>(std::lround(everyS / periodS)));
     processing::BodyFromMotion finder(camera.calibration);
     capture::Frame frame;
     frame.image.create(size, CV_8UC3);
     for (int index = 0; found.pictures < kMostPictures; ++index) {
-      if (source.read(frame) != capture::ReadStatus::kFrame) break;
+      if (source->read(frame) != capture::ReadStatus::kFrame) break;
       if (index % every != 0) continue;
       finder.add(frame.image);
       ++found.pictures;
@@ -79,15 +61,14 @@ FoundBody findBody(const daemon::RigCamera& camera, const std::filesystem::path&
       throw UsageError(fmt::format(
           "camera '{}': {} gives {} pictures {:g} s apart; at least {} are needed (a drive of "
           "{:.2g} s or more, or a smaller --every)",
-          name, settings.path.string(), found.pictures, every * periodS, needed,
-          needed * every * periodS));
+          name, path.string(), found.pictures, every * periodS, needed, needed * every * periodS));
     }
     found.movingShare = finder.movingShare();
     if (found.movingShare < kMinMovingShare) {
       throw UsageError(fmt::format(
           "camera '{}': only {:.0f} % of the ground it sees changed in {}: the car must drive "
           "while it records (a few metres at least, past ground with some texture)",
-          name, 100 * found.movingShare, settings.path.string()));
+          name, 100 * found.movingShare, path.string()));
     }
     found.mask = finder.mask();
     frame.image.copyTo(found.lastPicture);
@@ -114,7 +95,7 @@ std::string addedPolygonsYaml(const std::vector<std::vector<cv::Point>>& polygon
 }  // namespace
 
 void runDriveMask(const MaskOptions& options, std::ostream& log) {
-  const std::filesystem::path rigFile = rigFileOf(options.from);
+  const std::filesystem::path rigFile = recordingRigFile(options.from);
   const daemon::RigFile rig = daemon::loadRig(rigFile);
   // What surroundd would mask (the rig's vehicle and the cameras' own masks), to compare.
   daemon::Config config;

@@ -21,6 +21,7 @@
 #include "processing/calibration/mount_refinement.hpp"
 #include "tools/calibrate/calibration_output.hpp"
 #include "tools/calibrate/camera_pictures.hpp"
+#include "tools/calibrate/recorded_camera.hpp"
 
 namespace surroundd::calibrate {
 namespace {
@@ -37,10 +38,6 @@ struct Setup {
   processing::Rig rig;                           // with the body masks surroundd uses
 };
 
-std::filesystem::path rigFileOf(const std::filesystem::path& given) {
-  return std::filesystem::is_directory(given) ? given / "rig.yaml" : given;
-}
-
 Setup load(const RefineOptions& options) {
   Setup setup;
   if (!options.config.empty()) {
@@ -50,7 +47,7 @@ Setup load(const RefineOptions& options) {
       setup.rigFile = options.config.parent_path() / rig["file"].as<std::string>();
     }
   } else {
-    setup.rigFile = rigFileOf(options.rig);
+    setup.rigFile = recordingRigFile(options.rig);
     daemon::RigFile rig = daemon::loadRig(*setup.rigFile);
     setup.config.file = *setup.rigFile;
     setup.config.cameras = std::move(rig.cameras);
@@ -77,8 +74,9 @@ void visitStills(const Setup& setup, const std::filesystem::path& folder, const 
   for (const processing::CameraCalibration& camera : setup.rig.cameras) {
     const std::filesystem::path file = requirePicture(folder, camera.name);
     cv::Mat picture = cv::imread(file.string(), cv::IMREAD_COLOR);
-    if (picture.empty())
+    if (picture.empty()) {
       throw UsageError(fmt::format("{}: cannot read the picture", file.string()));
+    }
     checkPictureSize(file, picture.size(), camera, setup.rigFile.value_or(setup.config.file));
     set.push_back(std::move(picture));
   }
@@ -91,29 +89,7 @@ void visitRecording(const Setup& setup, double everyS, const SetVisitor& visit) 
   std::vector<std::unique_ptr<capture::FileSource>> sources;
   double periodS = 0;
   for (const daemon::RigCamera& camera : setup.config.cameras) {
-    const std::string& name = camera.calibration.name;
-    if (!camera.source) {
-      throw UsageError(fmt::format(
-          "camera '{}' is live: record a drive first (a recording output), then give its folder "
-          "with --rig, or give one picture per camera with --images",
-          name));
-    }
-    auto settings = *camera.source;
-    settings.pacing = capture::Pacing::kAsFastAsPossible;
-    settings.loop = false;
-    try {
-      sources.push_back(std::make_unique<capture::FileSource>(name, settings));
-    } catch (const capture::CaptureError& error) {
-      throw UsageError(error.what());
-    }
-    const cv::Size size = camera.calibration.intrinsics.imageSize;
-    if (sources.back()->frameSize() != size) {
-      throw UsageError(
-          fmt::format("camera '{}': {} has {}x{} frames but the lens is calibrated "
-                      "for {}x{}",
-                      name, settings.path.string(), sources.back()->frameSize().width,
-                      sources.back()->frameSize().height, size.width, size.height));
-    }
+    sources.push_back(openRecordedCamera(camera, setup.rigFile.value_or(setup.config.file)));
     periodS =
         std::max(periodS, std::chrono::duration<double>(sources.back()->nominalPeriod()).count());
   }
