@@ -26,7 +26,7 @@ INPUTS
 # none knocked (false alarms).
 while read -r name turn; do
   "$synth" --rig config/rigs/fisheye-body.yaml --out "recordings/bench/$name" --size 1280x720 \
-    --panorama-size 256x128 --seconds 30 --fps 2 --seed 3 --turn "$turn" --force
+    --panorama-size 256x128 --seconds 60 --fps 2 --seed 3 --turn "$turn" --force
 done <<TURNS
 turn-yaw2 back:2,0,0@5
 turn-pitch2 front:0,2,0@5
