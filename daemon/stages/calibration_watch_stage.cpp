@@ -109,7 +109,7 @@ void CalibrationWatchStage::readSuggestions() {
     std::vector<std::string> before;
     std::vector<std::string> after;
     for (const processing::SeamFit& seam : result.seams) {
-      if (seam.name.find(cameraNames_[c]) == std::string::npos) continue;
+      if (!seam.touches(c)) continue;
       before.push_back(fmt::format("{:.1f}", seam.beforeCm));
       after.push_back(fmt::format("{:.1f}", seam.afterCm));
     }

@@ -14,8 +14,9 @@
 // With calibration_watch.correct: suggest, every compare_every_s the set's pictures also go to the
 // mount refinement on its own thread (mount_correction_worker.hpp); at each measurement the
 // latest solution is read, and a camera whose correction is worth applying (conclusive, 0.2
-// degrees or more) is reported and logged with what it would do to its seams. Nothing is changed:
-// surround-calibrate refine --update-rig writes a correction into the rig.
+// degrees or more, closing every seam it touches) is reported and logged with what it would do to
+// its seams. Nothing is changed: surround-calibrate refine --update-rig writes a correction into
+// the rig.
 
 #include <chrono>
 #include <memory>

@@ -39,14 +39,15 @@ cv::Vec2d groundHit(const cv::Matx33d& rotation, const cv::Vec3d& position, cons
   return {position[0] + t * d[0], position[1] + t * d[1]};
 }
 
-// A camera's pose turned and raised by its four parameters, and by each parameter nudged either
-// way (for the derivatives): variant 0 is the pose, 1 + 2k and 2 + 2k parameter k +- kStep.
+// A camera's pose turned and raised by its four parameters, and, `nudged`, by each parameter
+// nudged either way (for the derivatives): variant 0 is the pose, 1 + 2k and 2 + 2k parameter k
+// +- kStep.
 struct NudgedPose {
   std::array<cv::Matx33d, 2 * kPerCamera + 1> rotation;
   std::array<cv::Vec3d, 2 * kPerCamera + 1> position;
 
-  NudgedPose(const Pose& pose, const double* p) {
-    for (std::size_t v = 0; v < rotation.size(); ++v) {
+  NudgedPose(const Pose& pose, const double* p, bool nudged) {
+    for (std::size_t v = 0; v < (nudged ? rotation.size() : 1); ++v) {
       std::array<double, kPerCamera> q{p[0], p[1], p[2], p[3]};
       if (v > 0) q[(v - 1) / 2] += (v % 2 == 1 ? kStep : -kStep);
       rotation[v] = turn({q[0], q[1], q[2]}) * pose.rotation;
@@ -98,9 +99,8 @@ Rig MountRefinementResult::corrected(const Rig& rig) const {
 }
 
 bool MountRefinementResult::closesSeams(std::size_t camera) const {
-  for (std::size_t s = 0; s < seams.size() && s < seamCameras.size(); ++s) {
-    if (seamCameras[s].first != camera && seamCameras[s].second != camera) continue;
-    const SeamFit& seam = seams[s];
+  for (const SeamFit& seam : seams) {
+    if (!seam.touches(camera)) continue;
     if (seam.matches < MountRefinement::kMinMatches || seam.afterCm >= seam.beforeCm ||
         seam.afterCm > kClosedCm) {
       return false;
@@ -198,7 +198,7 @@ std::size_t MountRefinement::add(std::span<const cv::Mat* const> pictures) {
 std::vector<double> MountRefinement::residuals(const std::vector<double>& parameters) const {
   std::vector<NudgedPose> poses;
   for (std::size_t c = 0; c < rig_.cameras.size(); ++c) {
-    poses.emplace_back(rig_.cameras[c].pose, &parameters[kPerCamera * c]);
+    poses.emplace_back(rig_.cameras[c].pose, &parameters[kPerCamera * c], false);
   }
   std::vector<double> out;
   out.reserve(matches_.size());
@@ -265,7 +265,7 @@ MountRefinement::Fit MountRefinement::fit(std::size_t reference, std::vector<dou
       const std::vector<double>& x = result.parameters;
       std::vector<NudgedPose> poses;
       for (std::size_t c = 0; c < cameras; ++c) {
-        poses.emplace_back(rig_.cameras[c].pose, &x[kPerCamera * c]);
+        poses.emplace_back(rig_.cameras[c].pose, &x[kPerCamera * c], true);
       }
       for (std::size_t m = 0; m < matches_.size(); ++m) {
         if (!result.used[m]) continue;
@@ -378,9 +378,7 @@ MountRefinement::Fit MountRefinement::fit(std::size_t reference, std::vector<dou
 std::optional<MountRefinementResult> MountRefinement::solve() {
   const std::size_t cameras = rig_.cameras.size();
   std::vector<std::size_t> perCamera(cameras, 0);
-  std::vector<std::size_t> perSeam(seams_.size(), 0);
   for (const Match& match : matches_) {
-    ++perSeam[match.seam];
     ++perCamera[seams_[match.seam].left];
     ++perCamera[seams_[match.seam].right];
   }
@@ -435,8 +433,8 @@ std::optional<MountRefinementResult> MountRefinement::solve() {
       }
       if (!is.empty()) break;
     }
-    result.seams.push_back({seams_[s].name, is.size(), 100 * median(was), 100 * median(is)});
-    result.seamCameras.emplace_back(seams_[s].left, seams_[s].right);
+    result.seams.push_back({seams_[s].name, seams_[s].left, seams_[s].right, is.size(),
+                            100 * median(was), 100 * median(is)});
   }
   result.matches = static_cast<std::size_t>(std::ranges::count(best->used, true));
   result.rejected = matches_.size() - result.matches;

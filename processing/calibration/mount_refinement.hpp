@@ -28,7 +28,6 @@
 #include <optional>
 #include <span>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -66,7 +65,10 @@ MountAngles mountAngleChange(const Pose& before, const Pose& after);
 // matches, else all of its matches), before and after the corrections.
 struct SeamFit {
   std::string name;
+  std::size_t left = 0, right = 0;  // its cameras
   std::size_t matches = 0;
+
+  bool touches(std::size_t camera) const { return left == camera || right == camera; }
   double beforeCm = 0;
   double afterCm = 0;
 };
@@ -75,8 +77,7 @@ struct MountRefinementResult {
   std::size_t reference = 0;  // the camera held
   std::vector<MountCorrection> cameras;
   std::vector<SeamFit> seams;
-  std::vector<std::pair<std::size_t, std::size_t>> seamCameras;  // per seam: left, right
-  std::size_t matches = 0;                                       // used
+  std::size_t matches = 0;   // used
   std::size_t rejected = 0;  // left out as disagreeing with the fit
   std::size_t sets = 0;      // frame sets they came from (since the last follow())
 
