@@ -86,7 +86,7 @@ void CalibrationWatchStage::readSuggestions() {
   for (std::size_t c = 0; c < suggested_.size(); ++c) {
     const processing::MountCorrection& correction = result.cameras[c];
     std::optional<MountSuggestion> now;
-    if (c != result.reference && correction.worthApplying() && result.closesSeams(c)) {
+    if (result.verdict(c) == processing::CorrectionVerdict::kOffered) {
       const cv::Vec3d sigma = correction.rotationSigmaRad * (180 / std::numbers::pi);
       const processing::Pose& pose = rig_.cameras[c].pose;
       now = MountSuggestion{processing::mountAngleChange(pose, correction.applied(pose)),

@@ -75,10 +75,6 @@ bool MountCorrection::conclusive() const {
   return largest <= kConclusiveSigmaDeg * kDegree;
 }
 
-bool MountCorrection::worthApplying() const {
-  return conclusive() && angleDeg() >= kSmallestTurnDeg;
-}
-
 Pose MountCorrection::applied(const Pose& pose) const {
   return {turn(rotationRad) * pose.rotation, pose.position + cv::Vec3d(0, 0, heightM)};
 }
@@ -107,6 +103,15 @@ bool MountRefinementResult::closesSeams(std::size_t camera) const {
     }
   }
   return true;
+}
+
+CorrectionVerdict MountRefinementResult::verdict(std::size_t camera) const {
+  const MountCorrection& correction = cameras[camera];
+  if (camera == reference) return CorrectionVerdict::kHeld;
+  if (!correction.conclusive()) return CorrectionVerdict::kUncertain;
+  if (correction.angleDeg() < kSmallestTurnDeg) return CorrectionVerdict::kTooSmall;
+  if (!closesSeams(camera)) return CorrectionVerdict::kSeamsApart;
+  return CorrectionVerdict::kOffered;
 }
 
 MountRefinement::MountRefinement(const Rig& rig, const PanoramaSettings& settings,

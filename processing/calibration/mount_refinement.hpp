@@ -50,11 +50,6 @@ struct MountCorrection {
   // camera's is.
   bool conclusive() const;
   static constexpr double kConclusiveSigmaDeg = 0.1;
-  // Conclusive, and turning the camera by kSmallestTurnDeg or more: less moves the ground 1.5 cm
-  // at 4 m, under what a seam shows, and is as likely the lens's or the fit's own error (an exact
-  // simulator's rig fits 0.1-0.2 degrees off).
-  bool worthApplying() const;
-  static constexpr double kSmallestTurnDeg = 0.2;
   Pose applied(const Pose& pose) const;
 };
 
@@ -67,10 +62,20 @@ struct SeamFit {
   std::string name;
   std::size_t left = 0, right = 0;  // its cameras
   std::size_t matches = 0;
-
-  bool touches(std::size_t camera) const { return left == camera || right == camera; }
   double beforeCm = 0;
   double afterCm = 0;
+
+  bool touches(std::size_t camera) const { return left == camera || right == camera; }
+};
+
+// What to do with one camera's correction; only kOffered is one to make (refine writes it, the
+// watch suggests it).
+enum class CorrectionVerdict {
+  kHeld,        // the camera the others were fitted around
+  kUncertain,   // not conclusive()
+  kTooSmall,    // under kSmallestTurnDeg
+  kSeamsApart,  // it would not close every seam the camera touches (closesSeams())
+  kOffered,
 };
 
 struct MountRefinementResult {
@@ -88,6 +93,11 @@ struct MountRefinementResult {
   // comparisons fail) is no correction to make.
   bool closesSeams(std::size_t camera) const;
   static constexpr double kClosedCm = 2.0;
+  // A turn under kSmallestTurnDeg moves the ground 1.5 cm at 4 m, under what a seam shows, and
+  // is as likely the lens's or the fit's own error (an exact simulator's rig fits 0.1-0.2
+  // degrees off).
+  CorrectionVerdict verdict(std::size_t camera) const;
+  static constexpr double kSmallestTurnDeg = 0.2;
 };
 
 class MountRefinement {

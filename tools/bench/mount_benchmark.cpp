@@ -109,9 +109,7 @@ void report(const std::filesystem::path& folder) {
     last = solved;
     for (std::size_t c = 0; c < solved->cameras.size(); ++c) {
       const auto& correction = solved->cameras[c];
-      if (c == solved->reference || !correction.worthApplying() || !solved->closesSeams(c)) {
-        continue;
-      }
+      if (solved->verdict(c) != processing::CorrectionVerdict::kOffered) continue;
       const bool knocked = knock && c == knock->camera && t >= knock->atS;
       if (!knocked) {
         ++falseAlarms;

@@ -128,6 +128,22 @@ std::string describe(const processing::MountCorrection& correction,
       100 * correction.heightM, 100 * correction.heightSigmaM);
 }
 
+std::string whyLeft(processing::CorrectionVerdict verdict) {
+  switch (verdict) {
+    case processing::CorrectionVerdict::kUncertain:
+      return "is too uncertain to act on";
+    case processing::CorrectionVerdict::kTooSmall:
+      return fmt::format("turns it less than {:g} deg",
+                         processing::MountRefinementResult::kSmallestTurnDeg);
+    case processing::CorrectionVerdict::kSeamsApart:
+      return "leaves its seams apart (the patches cannot reach that far: check its mount)";
+    case processing::CorrectionVerdict::kHeld:
+    case processing::CorrectionVerdict::kOffered:
+      break;
+  }
+  return "";
+}
+
 cv::Mat topView(const processing::Rig& rig, const std::vector<cv::Mat>& set) {
   const int side = static_cast<int>(2 * kTopReachM / kTopMetresPerPx);
   return processing::stitchedTopView(rig.cameras, set, {{0, 0}, kTopMetresPerPx, {side, side}});
@@ -175,26 +191,15 @@ void runRefine(const RefineOptions& options, std::ostream& log) {
   for (std::size_t c = 0; c < setup.rig.cameras.size(); ++c) {
     const processing::CameraCalibration& camera = setup.rig.cameras[c];
     const processing::MountCorrection& correction = result->cameras[c];
-    if (c == result->reference) {
+    using processing::CorrectionVerdict;
+    const CorrectionVerdict verdict = result->verdict(c);
+    if (verdict == CorrectionVerdict::kHeld) {
       log << fmt::format("{}: held (the others turn least around it)\n", camera.name);
       continue;
     }
-    if (!correction.conclusive()) {
-      log << fmt::format("{}: left as it is: {} is too uncertain to act on\n", camera.name,
-                         describe(correction, camera.pose));
-      continue;
-    }
-    if (correction.worthApplying() && !result->closesSeams(c)) {
-      log << fmt::format(
-          "{}: left as it is: {} leaves its seams apart (the patches cannot reach "
-          "that far: check its mount)\n",
-          camera.name, describe(correction, camera.pose));
-      continue;
-    }
-    if (!correction.worthApplying()) {
-      log << fmt::format("{}: left as it is: {} turns it less than {:g} deg\n", camera.name,
-                         describe(correction, camera.pose),
-                         processing::MountCorrection::kSmallestTurnDeg);
+    if (verdict != CorrectionVerdict::kOffered) {
+      log << fmt::format("{}: left as it is: {} {}\n", camera.name,
+                         describe(correction, camera.pose), whyLeft(verdict));
       continue;
     }
     log << fmt::format("{}: {}\n", camera.name, describe(correction, camera.pose));
