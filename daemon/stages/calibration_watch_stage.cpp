@@ -67,13 +67,14 @@ void CalibrationWatchStage::process(FrameWork& work, StageTimes& times) {
 }
 
 void CalibrationWatchStage::offerToRefinement(FrameWork& work) {
-  if (nextCompare_ && work.streamTime < *nextCompare_) return;
+  // While the worker is busy no set's pictures are converted for it: the next one is offered.
+  if ((nextCompare_ && work.streamTime < *nextCompare_) || !refinement_->idle()) return;
   std::array<const cv::Mat*, kMaxCameras> pictures{};
   for (std::size_t c = 0; c < rig_.cameras.size() && c < kMaxCameras; ++c) {
     // A faulty camera's picture (black, frozen) is no view of the ground.
     pictures[c] = work.faults[c] == nullptr ? work.bgr(c) : nullptr;
   }
-  // Skipped while the worker is busy: the next set is offered instead.
+  // Only this thread offers, so the worker found idle above takes it.
   if (refinement_->offer({pictures.data(), rig_.cameras.size()})) {
     nextCompare_ = work.streamTime + compareEvery_;
   }

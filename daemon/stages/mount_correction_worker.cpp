@@ -45,6 +45,11 @@ bool MountCorrectionWorker::offer(std::span<const cv::Mat* const> pictures) {
   return true;
 }
 
+bool MountCorrectionWorker::idle() const {
+  const std::lock_guard lock(mutex_);
+  return !busy_;
+}
+
 MountCorrectionState MountCorrectionWorker::latest() const {
   const std::lock_guard lock(mutex_);
   return state_;

@@ -43,6 +43,8 @@ class MountCorrectionWorker {
   // One picture per camera (8-bit BGR; null where missing or faulty). Copied when the worker is
   // idle (returns true), else skipped.
   bool offer(std::span<const cv::Mat* const> pictures);
+  // Whether an offer now would be taken: the pipeline asks before it converts a set's pictures.
+  bool idle() const;
   MountCorrectionState latest() const;
 
  private:
