@@ -60,7 +60,7 @@ using BufferPtr = std::unique_ptr<AVBufferRef, BufferDeleter>;
 
 // While one lives, FFmpeg's messages from this thread are about failures its caller expects and
 // reports in its own words (a hardware encoder tried where there is none): the daemon's log takes
-// them at debug level instead of as errors (daemon/logging.hpp routes FFmpeg's log).
+// them at debug level instead of as errors (daemon/config/logging.hpp routes FFmpeg's log).
 class ExpectedFailures {
  public:
   ExpectedFailures() { ++depth(); }

@@ -29,8 +29,8 @@
 #include <utility>
 #include <vector>
 
-#include "daemon/control_protocol.hpp"
-#include "daemon/unix_socket.hpp"
+#include "daemon/control/control_protocol.hpp"
+#include "daemon/control/unix_socket.hpp"
 
 namespace surroundd::daemon {
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 
 namespace surroundd::daemon {
 

@@ -16,11 +16,12 @@
 #include <spdlog/spdlog.h>
 
 #include "common/build_info.hpp"
-#include "daemon/config.hpp"
+#include "daemon/config/config.hpp"
+#include "daemon/config/logging.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "daemon/live_cameras.hpp"
-#include "daemon/logging.hpp"
+#include "daemon/outputs/built_in_outputs.hpp"
 #include "daemon/process_start.hpp"
-#include "daemon/rig_yaml.hpp"
 #include "daemon/service.hpp"
 
 namespace {
@@ -168,6 +169,7 @@ int main(int argc, char** argv) {
   const auto arguments = parseArguments(argc, argv, help);
   if (!arguments) return help ? 0 : 2;
 
+  daemon::registerBuiltInOutputTypes();
   daemon::Config config;
   try {
     config = daemon::loadConfig(arguments->configFile);

@@ -5,7 +5,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "daemon/output_type.hpp"
+#include "daemon/config/output_type.hpp"
 #include "daemon/pipeline_ends.hpp"
 #include "daemon/stages/calibration_watch_stage.hpp"
 #include "daemon/stages/camera_health_stage.hpp"

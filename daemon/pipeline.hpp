@@ -35,7 +35,7 @@
 #include "capture/camera_stream.hpp"
 #include "capture/synchronizer.hpp"
 #include "common/work_pool.hpp"
-#include "daemon/config.hpp"
+#include "daemon/config/config.hpp"
 #include "daemon/pipeline_outputs.hpp"
 #include "daemon/pipeline_report.hpp"
 #include "daemon/pipeline_stage.hpp"

@@ -12,7 +12,7 @@
 
 #include "capture/camera_health.hpp"
 #include "capture/camera_stream.hpp"
-#include "daemon/config.hpp"
+#include "daemon/config/config.hpp"
 
 namespace surroundd::daemon {
 

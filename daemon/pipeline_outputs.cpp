@@ -5,8 +5,8 @@
 
 #include <spdlog/spdlog.h>
 
-#include "daemon/output_files.hpp"
-#include "daemon/output_type.hpp"
+#include "daemon/config/output_files.hpp"
+#include "daemon/config/output_type.hpp"
 
 namespace surroundd::daemon {
 namespace {

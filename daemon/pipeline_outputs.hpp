@@ -24,8 +24,8 @@
 #include <opencv2/core.hpp>
 
 #include "capture/frame_set.hpp"
-#include "daemon/camera_frames_sink.hpp"
-#include "daemon/config.hpp"
+#include "daemon/config/camera_frames_sink.hpp"
+#include "daemon/config/config.hpp"
 #include "daemon/duration_histogram.hpp"
 #include "daemon/pipeline_report.hpp"
 #include "render/egl_context.hpp"

@@ -7,7 +7,7 @@
 #include <malloc.h>
 #include <spdlog/spdlog.h>
 
-#include "daemon/view_rules.hpp"
+#include "daemon/config/view_rules.hpp"
 #include "render/outputs/image_file.hpp"
 #include "render/view_camera.hpp"
 

@@ -7,7 +7,7 @@
 // A bad one is rejected with its messages and the running pipeline goes on untouched. A good one
 // ends the run (every output finalized) and a pipeline for it starts; if that cannot start (a
 // camera or output cannot be opened), the previous config is started again; its outputs take
-// new names where the files hold the last run's data (daemon/output_files.hpp). The control
+// new names where the files hold the last run's data (daemon/config/output_files.hpp). The control
 // socket stays where it was.
 //
 // The vehicle's signals (`surroundctl signal`, and the CAN bus of vehicle_signals.can, read on
@@ -25,7 +25,7 @@
 #include <optional>
 #include <string>
 
-#include "daemon/config.hpp"
+#include "daemon/config/config.hpp"
 #include "daemon/control_server.hpp"
 #include "daemon/pipeline.hpp"
 #include "daemon/service_notifier.hpp"

@@ -1,8 +1,8 @@
 #pragma once
-// The ego vehicle's measurements, as one `vehicle:` block gives them (daemon/vehicle_yaml.hpp):
-// one type for every part that needs them — the body the cameras see (body()), the car model and
-// the guidelines drawn in its box (box(), render/), the views' default sizes and the generator's
-// ego car. Vehicle frame: x forward, y left, metres.
+// The ego vehicle's measurements, as one `vehicle:` block gives them
+// (daemon/config/vehicle_yaml.hpp): one type for every part that needs them — the body the cameras
+// see (body()), the car model and the guidelines drawn in its box (box(), render/), the views'
+// default sizes and the generator's ego car. Vehicle frame: x forward, y left, metres.
 
 #include <array>
 #include <filesystem>

@@ -9,7 +9,7 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
-#include "daemon/panorama_setup.hpp"
+#include "daemon/config/panorama_setup.hpp"
 
 namespace surroundd::daemon {
 

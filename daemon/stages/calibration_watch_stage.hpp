@@ -24,7 +24,7 @@
 #include <span>
 #include <vector>
 
-#include "daemon/config.hpp"
+#include "daemon/config/config.hpp"
 #include "daemon/pipeline_report.hpp"
 #include "daemon/pipeline_stage.hpp"
 #include "daemon/stages/mount_correction_worker.hpp"

@@ -10,7 +10,7 @@
 #include "capture/camera_health.hpp"
 #include "capture/camera_stream.hpp"
 #include "capture/synchronizer.hpp"
-#include "daemon/config.hpp"
+#include "daemon/config/config.hpp"
 #include "daemon/pipeline_stage.hpp"
 
 namespace surroundd::daemon {

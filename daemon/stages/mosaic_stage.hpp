@@ -4,7 +4,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "daemon/config.hpp"
+#include "daemon/config/config.hpp"
 #include "daemon/pipeline_stage.hpp"
 #include "render/mosaic.hpp"
 

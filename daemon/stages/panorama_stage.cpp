@@ -6,7 +6,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "daemon/panorama_setup.hpp"
+#include "daemon/config/panorama_setup.hpp"
 #include "daemon/pipeline_ends.hpp"
 #include "processing/stitch/i420_picture.hpp"
 #include "processing/stitch/view_lut.hpp"

@@ -18,7 +18,7 @@
 
 #include "common/dmabuf_planes.hpp"
 #include "common/work_pool.hpp"
-#include "daemon/config.hpp"
+#include "daemon/config/config.hpp"
 #include "daemon/pipeline_stage.hpp"
 #include "processing/colour/gain_compensation.hpp"
 #include "processing/colour/poisson_correction.hpp"

@@ -9,8 +9,8 @@
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
-#include "daemon/output_type.hpp"
-#include "daemon/panorama_setup.hpp"
+#include "daemon/config/output_type.hpp"
+#include "daemon/config/panorama_setup.hpp"
 #include "daemon/pipeline_ends.hpp"
 #include "processing/stitch/i420_picture.hpp"
 #include "render/dmabuf_import.hpp"

@@ -40,7 +40,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "daemon/config.hpp"
+#include "daemon/config/config.hpp"
 #include "daemon/duration_histogram.hpp"
 #include "daemon/pipeline_stage.hpp"
 #include "daemon/stages/panorama_stage.hpp"

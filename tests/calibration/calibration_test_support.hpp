@@ -11,7 +11,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "processing/calibration/calibration_error.hpp"
 #include "processing/calibration/calibration_targets.hpp"
 #include "processing/rig.hpp"

@@ -18,7 +18,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sys/stat.h>
 
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "processing/camera_model.hpp"
 #include "tests/calibration/import_test_support.hpp"
 #include "tests/support/temp_dir.hpp"

@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "processing/rig.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 #include "tools/calibrate/import_command.hpp"

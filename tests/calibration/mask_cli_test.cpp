@@ -14,8 +14,8 @@
 
 #include "capture/file_source.hpp"
 #include "common/work_pool.hpp"
-#include "daemon/config.hpp"
-#include "daemon/panorama_setup.hpp"
+#include "daemon/config/config.hpp"
+#include "daemon/config/panorama_setup.hpp"
 #include "tests/calibration/calibrate_run.hpp"
 #include "tests/support/child_process.hpp"
 #include "tests/support/temp_dir.hpp"

@@ -17,7 +17,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "processing/calibration/calibration_error.hpp"
 #include "tests/calibration/mat_calibration_support.hpp"
 #include "tests/support/temp_dir.hpp"

@@ -11,7 +11,7 @@
 #include <opencv2/calib3d.hpp>
 #include <yaml-cpp/yaml.h>
 
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 #include "tools/calibrate/refine_command.hpp"

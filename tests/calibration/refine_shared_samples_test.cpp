@@ -21,7 +21,7 @@
 #include <opencv2/calib3d.hpp>
 #include <yaml-cpp/yaml.h>
 
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "processing/calibration/seam_misalignment.hpp"
 #include "tests/calibration/import_test_support.hpp"
 #include "tests/support/temp_dir.hpp"

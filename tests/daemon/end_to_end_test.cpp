@@ -10,8 +10,8 @@
 
 #include "capture/file_source.hpp"
 #include "common/work_pool.hpp"
-#include "daemon/panorama_setup.hpp"
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/panorama_setup.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "processing/colour/poisson_correction.hpp"
 #include "processing/stitch/stitcher.hpp"
 #include "render/egl_context.hpp"

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "daemon/panorama_setup.hpp"
+#include "daemon/config/panorama_setup.hpp"
 #include "daemon/pipeline.hpp"
 #include "processing/stitch/panorama_ownership.hpp"
 #include "tests/daemon/replay_config.hpp"

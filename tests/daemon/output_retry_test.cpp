@@ -12,7 +12,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "daemon/output_type.hpp"
+#include "daemon/config/output_type.hpp"
 #include "daemon/pipeline.hpp"
 #include "daemon/pipeline_outputs.hpp"
 #include "tests/daemon/replay_config.hpp"

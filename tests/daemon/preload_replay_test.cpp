@@ -8,7 +8,7 @@
 
 #include "daemon/pipeline.hpp"
 #include "daemon/pipeline_ends.hpp"
-#include "tests/daemon/config_test_support.hpp"
+#include "tests/daemon/config/config_test_support.hpp"
 #include "tests/daemon/replay_config.hpp"
 
 namespace surroundd::daemon {

@@ -19,7 +19,7 @@
 
 #include "daemon/pipeline.hpp"
 #include "daemon/pipeline_report.hpp"
-#include "tests/daemon/config_test_support.hpp"
+#include "tests/daemon/config/config_test_support.hpp"
 #include "tests/daemon/replay_config.hpp"
 #include "tests/support/log_capture.hpp"
 #include "tests/support/temp_dir.hpp"

@@ -6,8 +6,8 @@
 #include <string_view>
 #include <vector>
 
-#include "daemon/config.hpp"
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/config.hpp"
+#include "daemon/config/rig_yaml.hpp"
 
 namespace surroundd::daemon {
 

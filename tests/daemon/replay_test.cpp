@@ -11,8 +11,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "capture/file_source.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "daemon/pipeline.hpp"
-#include "daemon/rig_yaml.hpp"
 #include "tests/support/temp_dir.hpp"
 
 namespace surroundd::daemon {

@@ -16,8 +16,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "daemon/control_protocol.hpp"
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
+#include "daemon/control/control_protocol.hpp"
 #include "tests/support/child_process.hpp"
 #include "tests/support/http_client.hpp"
 #include "tests/support/notify_socket.hpp"

@@ -15,8 +15,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include "capture/file_source.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "daemon/pipeline.hpp"
-#include "daemon/rig_yaml.hpp"
 #include "tests/daemon/replay_config.hpp"
 #include "tests/support/temp_dir.hpp"
 

@@ -8,13 +8,15 @@
 #include <cstdint>
 #include <string>
 
-#include "daemon/config.hpp"
-#include "daemon/yaml_reader.hpp"
+#include "daemon/config/config.hpp"
+#include "daemon/config/yaml_reader.hpp"
+#include "daemon/outputs/built_in_outputs.hpp"
 #include "tests/fuzz/fuzz_support.hpp"
 #include "tests/fuzz/rig_invariants.hpp"
 
 extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
   surroundd::fuzz::quietLogs();
+  surroundd::daemon::registerBuiltInOutputTypes();
   return 0;
 }
 

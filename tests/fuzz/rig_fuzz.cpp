@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "tests/fuzz/fuzz_support.hpp"
 #include "tests/fuzz/rig_invariants.hpp"
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <span>
 
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "tests/fuzz/fuzz_support.hpp"
 
 namespace surroundd::fuzz {

@@ -2,7 +2,8 @@
 # includes_test.sh checked: in trees of its own, a clean one passes and each planted fault fails
 # with the file and line named — a wrong include in a folder's first file, one behind a file with
 # no project include (the check once stopped reading a folder there, and passed while reading 19
-# of 205 files), one in daemon/ and in tools/, and a folder of code with no rule.
+# of 205 files), one in daemon/ and in tools/, the config including an output kind, and a folder
+# of code with no rule.
 #
 # Usage: includes_self_test.sh PATH/TO/includes_test.sh
 set -eu
@@ -62,6 +63,14 @@ expect "a wrong include behind a file with none" "render/view.cpp:3: includes da
 clean
 printf '#include "tools/synth/y.hpp"\n' >"$work/tree/daemon/main.cpp"
 expect "the daemon including a tool" "daemon/main.cpp:1: includes tools/synth/y.hpp"
+
+clean
+# The config library does not link the output kinds: they are registered into it.
+mkdir -p "$work/tree/daemon/config" "$work/tree/daemon/outputs"
+printf '#include "render/first.hpp"\n' >"$work/tree/daemon/outputs/video_output.cpp"
+printf '#include "daemon/outputs/built_in_outputs.hpp"\n' >"$work/tree/daemon/config/loader.cpp"
+expect "the config including an output kind" \
+  "daemon/config/loader.cpp:1: includes daemon/outputs/built_in_outputs.hpp"
 
 clean
 mkdir -p "$work/tree/tools/calibrate"

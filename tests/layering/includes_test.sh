@@ -12,8 +12,9 @@ root="$1"
 cd "$root"
 
 # shellcheck disable=SC2116 # echo joins the lines into one list of words
-libraries=$(echo common capture vehicle processing processing/stitch processing/colour \
-  processing/calibration render render/outputs daemon daemon/stages)
+below_daemon=$(echo common capture vehicle processing processing/stitch processing/colour \
+  processing/calibration render render/outputs)
+libraries="$below_daemon daemon/control daemon/config daemon/outputs daemon daemon/stages"
 
 # folder: the folders its headers and sources may include from (besides its own).
 allowed() {
@@ -24,7 +25,12 @@ allowed() {
     processing/colour | processing/calibration) echo "common processing processing/stitch" ;;
     render) echo "common processing processing/stitch" ;;
     render/outputs) echo "common render" ;;
-    # The daemon wires every part together; its stages and the rest of it are one part.
+    # The daemon: its control protocol stands alone; its config reads into every part's
+    # settings; the output kinds are registered into the config's registry; the runtime (its
+    # stages and the rest of it, one part) wires every part together.
+    daemon/control) echo "common" ;;
+    daemon/config) echo "$below_daemon" ;;
+    daemon/outputs) echo "$below_daemon daemon/config" ;;
     daemon | daemon/stages) echo "$libraries" ;;
     # The tools use the libraries, never one another, but the benchmark measures on the
     # generator's recordings.

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "common/work_pool.hpp"
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "processing/camera_model.hpp"
 #include "processing/vehicle_body.hpp"
 #include "tests/synth/synth_test_support.hpp"

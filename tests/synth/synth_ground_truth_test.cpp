@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "processing/camera_model.hpp"
 #include "tests/synth/synth_test_support.hpp"
 #include "tools/synth/scene.hpp"

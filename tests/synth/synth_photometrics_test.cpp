@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "tests/synth/synth_test_support.hpp"
 #include "tools/synth/photometrics.hpp"
 #include "tools/synth/scene_renderer.hpp"

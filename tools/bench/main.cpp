@@ -23,6 +23,7 @@
 
 #include "common/build_info.hpp"
 #include "common/work_pool.hpp"
+#include "daemon/outputs/built_in_outputs.hpp"
 #include "tools/bench/colour_benchmark.hpp"
 #include "tools/bench/gpu_kit.hpp"
 #include "tools/bench/mount_benchmark.hpp"
@@ -168,6 +169,7 @@ int main(int argc, char** argv) {
   using surroundd::processing::PanoramaProjection;
   using surroundd::processing::PoissonSolverKind;
   using surroundd::render::ViewKind;
+  surroundd::daemon::registerBuiltInOutputTypes();  // the pipeline's benchmarks read configs
   if (argc >= 2 && (std::string_view(argv[1]) == "--help" || std::string_view(argv[1]) == "-h")) {
     fmt::print("{}", kUsage);
     return 0;

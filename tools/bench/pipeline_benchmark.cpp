@@ -14,9 +14,9 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include "daemon/logging.hpp"
+#include "daemon/config/logging.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "daemon/pipeline.hpp"
-#include "daemon/rig_yaml.hpp"
 #include "render/gpu_timer.hpp"
 #include "tools/bench/recording_truth.hpp"
 

@@ -19,7 +19,7 @@
 #include <opencv2/core.hpp>
 
 #include "capture/pixel_conversion.hpp"
-#include "daemon/config.hpp"
+#include "daemon/config/config.hpp"
 #include "processing/colour/poisson_solver.hpp"
 #include "processing/stitch/panorama_lut.hpp"
 #include "render/view_camera.hpp"

@@ -7,7 +7,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "common/work_pool.hpp"
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 
 namespace surroundd::bench {
 namespace {

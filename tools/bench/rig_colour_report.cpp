@@ -5,8 +5,8 @@
 
 #include "capture/file_source.hpp"
 #include "common/work_pool.hpp"
-#include "daemon/config.hpp"
-#include "daemon/panorama_setup.hpp"
+#include "daemon/config/config.hpp"
+#include "daemon/config/panorama_setup.hpp"
 #include "processing/colour/gain_compensation.hpp"
 #include "processing/colour/poisson_correction.hpp"
 #include "processing/stitch/stitcher.hpp"

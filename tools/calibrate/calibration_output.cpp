@@ -13,7 +13,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "common/regular_file.hpp"
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 #include "tools/calibrate/rig_text_edit.hpp"
 

@@ -1,8 +1,8 @@
 #pragma once
 // What surround-calibrate writes: the camera's lens: or mount: block in the rig schema
-// (daemon/rig_yaml.hpp), ready to paste under the camera, and optionally the same values written
-// into a rig file; the mask pictures. Every file is written beside and renamed, so a reader never
-// sees half of one.
+// (daemon/config/rig_yaml.hpp), ready to paste under the camera, and optionally the same values
+// written into a rig file; the mask pictures. Every file is written beside and renamed, so a reader
+// never sees half of one.
 
 #include <filesystem>
 #include <span>

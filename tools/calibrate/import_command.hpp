@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "tools/calibrate/import_options.hpp"
 
 namespace surroundd::calibrate {

@@ -15,7 +15,7 @@ const std::string_view kImportUsage =
     R"(usage: surround-calibrate import (--camera NAME=FILE[,FILE...]... | --pjlab DIR | --pjlab-yaml FILE)
                               --out RIG [frame options] [lens options] [--images DIR]
 
-Writes a rig file (daemon/rig_yaml.hpp) from a calibration made by another tool, in the project's
+Writes a rig file (daemon/config/rig_yaml.hpp) from a calibration made by another tool, in the project's
 vehicle frame: origin on the ground under the vehicle centre, x forward, y left, z up, metres;
 camera frame OpenCV (x right, y down, z forward); mount angles as in processing/rig.hpp.
 

@@ -16,7 +16,7 @@ const std::string_view kIntrinsicsUsage =
 Intrinsics of one camera from a folder of pictures of a board (at many angles and all over the
 image, its edges and corners too). Prints each picture's detection, a table of the views used
 (corners, RMS, pose), every parameter with its standard deviation, the field of view and a
-verdict; writes the camera's lens: block in the rig schema (daemon/rig_yaml.hpp) only when the
+verdict; writes the camera's lens: block in the rig schema (daemon/config/rig_yaml.hpp) only when the
 verdict is a pass. A failed solve writes nothing and exits 1, naming the views to drop.
 
 Boards: any chessboard, square (7x7, 8x8) or not, and ChArUco boards. For intrinsics a board's

@@ -8,7 +8,8 @@
 #include <string_view>
 #include <vector>
 
-#include "daemon/yaml_reader.hpp"
+#include "daemon/config/yaml_reader.hpp"
+#include "daemon/outputs/built_in_outputs.hpp"
 #include "processing/calibration/calibration_error.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 #include "tools/calibrate/extrinsics_command.hpp"
@@ -67,6 +68,8 @@ int run(const std::vector<std::string_view>& arguments) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // `mask` and `refine` read the daemon's config, its outputs too.
+  surroundd::daemon::registerBuiltInOutputTypes();
   const int status = run({argv + 1, argv + argc});
   // The intrinsics' board search may have left a detection thread running past its time bound
   // (processing/calibration/picture_search.hpp): static destructors must not run under it, so the

@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "daemon/yaml_reader.hpp"
+#include "daemon/config/yaml_reader.hpp"
 
 namespace surroundd::calibrate {
 namespace {

@@ -11,8 +11,8 @@
 
 #include "capture/file_source.hpp"
 #include "common/work_pool.hpp"
-#include "daemon/config.hpp"
-#include "daemon/panorama_setup.hpp"
+#include "daemon/config/config.hpp"
+#include "daemon/config/panorama_setup.hpp"
 #include "tools/calibrate/calibration_output.hpp"
 #include "tools/calibrate/drive_mask_command.hpp"
 #include "tools/calibrate/mask_overlay.hpp"

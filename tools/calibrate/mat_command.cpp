@@ -6,7 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "processing/calibration/calibration_error.hpp"
 #include "tools/calibrate/calibration_output.hpp"
 #include "tools/calibrate/camera_pictures.hpp"

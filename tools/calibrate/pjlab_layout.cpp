@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
-#include "daemon/yaml_reader.hpp"
+#include "daemon/config/yaml_reader.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 
 namespace surroundd::calibrate {

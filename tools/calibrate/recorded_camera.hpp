@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "capture/file_source.hpp"
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 
 namespace surroundd::calibrate {
 

@@ -15,8 +15,8 @@
 
 #include "capture/file_source.hpp"
 #include "common/work_pool.hpp"
-#include "daemon/config.hpp"
-#include "daemon/panorama_setup.hpp"
+#include "daemon/config/config.hpp"
+#include "daemon/config/panorama_setup.hpp"
 #include "processing/calibration/ground_top_view.hpp"
 #include "processing/calibration/mount_refinement.hpp"
 #include "tools/calibrate/calibration_output.hpp"

@@ -1,5 +1,5 @@
 // surroundctl: asks a running surroundd for its status or metrics, switches its view, takes a
-// snapshot or makes it reload its config (protocol: daemon/control_protocol.hpp).
+// snapshot or makes it reload its config (protocol: daemon/control/control_protocol.hpp).
 //
 // Exit codes: 0 done, 1 surroundd answered with an error or could not be reached, 2 bad usage.
 
@@ -12,7 +12,7 @@
 #include <fmt/format.h>
 
 #include "common/build_info.hpp"
-#include "daemon/control_protocol.hpp"
+#include "daemon/control/control_protocol.hpp"
 
 namespace {
 

@@ -8,7 +8,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "tools/synth/calibration_scenes.hpp"
 #include "tools/synth/photometrics.hpp"
 #include "tools/synth/recording_plan.hpp"

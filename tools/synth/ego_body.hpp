@@ -17,7 +17,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "daemon/vehicle_yaml.hpp"
+#include "daemon/config/vehicle_yaml.hpp"
 
 namespace surroundd::synth {
 

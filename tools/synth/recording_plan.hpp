@@ -10,7 +10,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "daemon/rig_yaml.hpp"
+#include "daemon/config/rig_yaml.hpp"
 #include "tools/synth/photometrics.hpp"
 #include "tools/synth/synth_options.hpp"
 

@@ -18,8 +18,8 @@
 #include "capture/frame.hpp"
 #include "capture/frame_set.hpp"
 #include "common/work_pool.hpp"
-#include "daemon/config.hpp"
-#include "daemon/panorama_setup.hpp"
+#include "daemon/config/config.hpp"
+#include "daemon/config/panorama_setup.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace surroundd::daemon {

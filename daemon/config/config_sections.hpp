@@ -1,0 +1,40 @@
+#pragma once
+// The key tables (config_keys.hpp) of the config's sections, read by config_loader.cpp. Each
+// output type's own keys are in its registration (output_type.hpp); the vehicle's in
+// vehicle_yaml.hpp, shared with rig files. The rig's cameras (rig_yaml.hpp) have no table yet.
+
+#include <string_view>
+#include <vector>
+
+#include "daemon/config/config.hpp"
+#include "daemon/config/config_keys.hpp"
+
+namespace surroundd::daemon {
+
+const ConfigKeys<Config>& loggingKeys();  // logging: the level, in Config itself
+const ConfigKeys<CaptureConfig>& captureKeys();
+const ConfigKeys<PipelineConfig>& pipelineKeys();
+const ConfigKeys<ProcessingConfig>& processingKeys();
+const ConfigKeys<PanoramaConfig>& panoramaKeys();
+const ConfigKeys<ColourCorrectionConfig>& colourKeys();
+const ConfigKeys<MeshConfig>& meshKeys();
+const ConfigKeys<RenderConfig>& renderKeys();
+const ConfigKeys<ControlConfig>& controlKeys();
+const ConfigKeys<CalibrationWatchConfig>& calibrationWatchKeys();
+// The keys every entry of `outputs:` has besides `type` (which picks the type's own keys).
+const ConfigKeys<OutputConfig>& outputKeys();
+
+// The bowl's rim when the config leaves it out: the wall rises over as much again as the floor's
+// radius (far enough for a gentle slope), to a height in proportion.
+double bowlRimRadiusM(const MeshConfig& mesh);
+double bowlRimHeightM(const MeshConfig& mesh);
+
+// Every section's table by its name in the file (the vehicle's too), for the reference config's
+// test.
+struct SectionDocs {
+  std::string_view name;
+  std::vector<KeyDoc> keys;
+};
+std::vector<SectionDocs> sectionDocs();
+
+}  // namespace surroundd::daemon
