@@ -82,8 +82,6 @@ Pipeline::Pipeline(const Config& config, RunStart start)
     surround_ = stage.get();
     outputs_.setRenderer(&surround_->context());
     stages_.push_back(std::move(stage));
-    panorama->setWanted(
-        [surround = surround_](FrameWork& work) { return surround->needsPanorama(work); });
     if (surround_->stitchesOnGpu()) lendCameraBuffers(config);
   }
   if (surround_ == nullptr && config.processing.backend == ProcessingBackend::kGpu) {
@@ -305,7 +303,10 @@ void Pipeline::process(const capture::FrameSet& set) {
                  .streamTime = lastStreamTime_,
                  .origin = captureTimeOf(set),
                  .outputs = outputs_};
-  for (const auto& stage : stages_) stage->process(work, times_);
+  for (std::size_t s = 0; s < stages_.size(); ++s) {
+    work.later = std::span(stages_).subspan(s + 1);
+    stages_[s]->process(work, times_);
+  }
   times_.endSet();
 }
 
@@ -337,6 +338,10 @@ void Pipeline::finish(RunSummary& summary) {
     summary.cameraNames.push_back(camera->name());
     summary.cameras.push_back(camera->stats());
   }
+}
+
+bool FrameWork::needed(Need what) const {
+  return std::ranges::any_of(later, [&](const auto& stage) { return stage->needs(what, *this); });
 }
 
 const cv::Mat* FrameWork::bgr(std::size_t camera) {

@@ -3,7 +3,8 @@
 // stages (Pipeline's constructor lists them, in order): each is set up once from the config — all
 // that is heavy happens then — and is then given every frame set in turn. A stage owns its state
 // and says where its time goes (StageTimes); what it makes for later stages it hands them at
-// set-up (a picture they read) or in the set's FrameWork.
+// set-up (a picture they read) or in the set's FrameWork, where a stage that makes something
+// costly asks the later ones whether this set needs it (needs()), not naming them.
 //
 // Error policy: set-up throws, naming what could not be set up. An exception from process() drops
 // the set (Pipeline counts it, and rebuilds after Pipeline::kRebuildAfterFailures in a row).
@@ -11,6 +12,8 @@
 
 #include <array>
 #include <chrono>
+#include <memory>
+#include <span>
 
 #include <opencv2/core.hpp>
 
@@ -21,6 +24,14 @@
 #include "daemon/stage_times.hpp"
 
 namespace surroundd::daemon {
+
+class PipelineStage;
+
+// What a stage may ask the stages before it to make for a set (PipelineStage::needs()), where
+// making it costs and not every set needs it.
+enum class Need {
+  kPanorama,  // the CPU's panorama picture of the set (FrameWork::panorama)
+};
 
 // One frame set on its way through the stages.
 struct FrameWork {
@@ -41,6 +52,14 @@ struct FrameWork {
   // the stitch samples the frames as they are.
   const cv::Mat* bgr(std::size_t camera);
   std::array<const cv::Mat*, kMaxCameras> converted{};  // bgr()'s answers so far, for this set
+
+  // Whether a stage after the one running needs `what` made for this set (asked now: what the
+  // stages before have found, a faulty camera say, counts).
+  bool needed(Need what) const;
+  std::span<const std::unique_ptr<PipelineStage>> later{};  // set by the pipeline for each stage
+
+  // The CPU's panorama of this set, where a stage made it (Need::kPanorama); else null.
+  const cv::Mat* panorama = nullptr;
 };
 
 class PipelineStage {
@@ -51,6 +70,9 @@ class PipelineStage {
   PipelineStage& operator=(const PipelineStage&) = delete;
 
   virtual void process(FrameWork& work, StageTimes& times) = 0;
+  // Whether this set needs `what` made by a stage before this one (FrameWork::needed()). Asked
+  // of the later stages by the stage that would make it; it changes nothing.
+  virtual bool needs(Need /*what*/, const FrameWork& /*work*/) const { return false; }
   // No set is waiting: hand over what has finished meanwhile rather than with the next set.
   virtual void idle(PipelineOutputs& /*outputs*/, StageTimes& /*times*/) {}
   // Adds what the stage knows to the pipeline's report, whose cameras are listed already (in the

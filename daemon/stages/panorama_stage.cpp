@@ -22,7 +22,8 @@ PanoramaStage::PanoramaStage(const Config& config, WorkPool& pool)
       corrected_(config.cameras.size()),
       stitched_(config.cameras.size()),
       dmabufs_(config.cameras.size()),
-      panorama_(lut_.size, CV_8UC3) {
+      // Black until a set needs it stitched: an output may be handed it before (at the run's end).
+      panorama_(lut_.size, CV_8UC3, cv::Scalar::all(0)) {
   setUpColourCorrection(config, pool);
 }
 
@@ -78,7 +79,7 @@ PixelFormat PanoramaStage::gatherFrames(FrameWork& work) {
 
 void PanoramaStage::process(FrameWork& work, StageTimes& times) {
   format_ = gatherFrames(work);
-  const bool wanted = !wanted_ || wanted_(work);
+  const bool wanted = work.needed(Need::kPanorama);
   if (wanted) stitcher_.stitch(stitched_, format_, panorama_);
   times.lap(Stage::kStitch);
   if (poisson_) {
@@ -97,6 +98,7 @@ void PanoramaStage::process(FrameWork& work, StageTimes& times) {
   for (std::size_t c = 0; c < work.set.cameraCount && wanted; ++c) {
     if (work.faults[c] != nullptr) ownership_.markFaulty(panorama_, c);
   }
+  if (wanted) work.panorama = &panorama_;
   times.lap(Stage::kCorrect);
 }
 

@@ -35,11 +35,10 @@ class PanoramaStage final : public PipelineStage {
   // panorama.
   PanoramaStage(const Config& config, WorkPool& pool);
 
-  // Whether the panorama itself is wanted for a set: by an output of it, or a view drawn from
-  // it. When not, process() only updates the colour correction (it follows the pictures over
-  // time; views gathered through their own LUTs apply it). Unset: always.
-  void setWanted(std::function<bool(FrameWork&)> wanted) { wanted_ = std::move(wanted); }
-
+  // Stitches the panorama where a later stage needs it this set (Need::kPanorama: an output of
+  // it, a view drawn from it), and hands it on in FrameWork::panorama; else only updates the
+  // colour correction (it follows the pictures over time; views gathered through their own LUTs
+  // apply it).
   void process(FrameWork& work, StageTimes& times) override;
 
   // The corrected panorama of the last set, reused for every set; of lut().size.
@@ -116,7 +115,6 @@ class PanoramaStage final : public PipelineStage {
   PixelFormat format_ = PixelFormat::kBgr;                       // the one both hold this set
   std::array<std::vector<cv::Mat>, kPixelFormats> blackFrames_;  // per PixelFormat, per camera
   cv::Mat panorama_;
-  std::function<bool(FrameWork&)> wanted_;
   // buildView()'s threads; last, so that they are joined before what they read goes.
   std::vector<std::jthread> viewBuilds_;
 };

@@ -15,6 +15,11 @@ class StreamOutputStage final : public PipelineStage {
     }
     times.lap(Stage::kOutput);
   }
+  // An output of the panorama takes it whether or not it wants this set: the run's end hands it
+  // the last one.
+  bool needs(Need what, const FrameWork& work) const override {
+    return what == Need::kPanorama && work.outputs.shows(OutputStream::kPanorama);
+  }
 };
 
 }  // namespace surroundd::daemon

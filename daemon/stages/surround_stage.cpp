@@ -196,6 +196,14 @@ SurroundStage::FixedView* SurroundStage::fixedViewFor(PipelineOutputs::PictureOu
   return output.sink->presentsViews() ? nullptr : fixedView(*output.view);
 }
 
+const SurroundStage::FixedView* SurroundStage::shownFixedView(
+    const PipelineOutputs::PictureOutput& output) const {
+  const render::SurroundView& view = *output.view;
+  if (output.sink->presentsViews() || !viewLut_ || gpu_ || view.moves()) return nullptr;
+  const auto known = fixedViews_.find({&view, view.view()});
+  return known != fixedViews_.end() && known->second.view ? &known->second : nullptr;
+}
+
 void SurroundStage::startFixedView(render::SurroundView& view, FixedView& fixed) {
   // The map here, on the context's thread (a tenth of a second on llvmpipe the first time); the
   // composition on a thread of its own, while OpenGL draws the view (and the switch to it); the
@@ -294,19 +302,15 @@ void SurroundStage::collectGpuTimes() {
   }
 }
 
-bool SurroundStage::needsPanorama(const FrameWork& work) {
-  panoramaSkipped_ = false;
-  const bool gpuSet = gpuStitches(work);
-  for (auto& output : work.outputs.pictures()) {
-    // An output of the panorama takes it whether or not it wants this set: the run's end hands
-    // it the last one.
-    if (output.picture == &panorama_ && output.sink) return true;
-    if (!output.view || !output.sink || gpuSet) continue;
-    // A view with a read-back pending is mapped after it is collected, in process().
-    if (output.view->pending() || fixedViewFor(output) == nullptr) return true;
-  }
-  panoramaSkipped_ = true;
-  return false;
+bool SurroundStage::needs(Need what, const FrameWork& work) const {
+  if (what != Need::kPanorama || gpuStitches(work)) return false;
+  return std::ranges::any_of(work.outputs.pictures(), [&](const auto& output) {
+    // A view with a read-back pending is drawn (or its table started) after it is collected;
+    // a fixed view whose table has just been made is taken into use in process(), so this set
+    // still has the panorama.
+    return output.view && output.sink &&
+           (output.view->pending() || shownFixedView(output) == nullptr);
+  });
 }
 
 void SurroundStage::setVehicleSignals(const vehicle::VehicleSignals& signals) {
@@ -363,7 +367,7 @@ void SurroundStage::process(FrameWork& work, StageTimes& times) {
       if (FixedView* fixed = fixedViewFor(output)) {
         // Without a panorama this set, also when not wanted: the run's end hands over the last
         // set's picture, and there is no panorama to draw it from.
-        if (!wanted && !panoramaSkipped_) return;
+        if (!wanted && work.panorama != nullptr) return;
         times.lap(Stage::kRender);  // the views drawn before this one
         // The car, the background and the split view's camera go where the view shows no
         // panorama, before the correction, which leaves those pixels as they are; the guidelines

@@ -95,12 +95,12 @@ class SurroundStage final : public PipelineStage {
   // started once it has gone out: the first picture sooner.
   void prepare(PipelineOutputs& outputs, bool waitForTables);
 
-  // Whether this set needs the CPU's panorama: an output shows it, or a view drawn from it (on
-  // the CPU backend, in a set the GPU does not stitch, or while its table is made). Each output's
-  // view that does not move starts being mapped here the first time it is shown (a view switched
-  // to, as the switch begins). For PanoramaStage::setWanted().
-  bool needsPanorama(const FrameWork& work);
-
+  // Whether this set needs the CPU's panorama (Need::kPanorama): a view drawn from it (on the
+  // CPU backend, or in a set the GPU does not stitch) that is not yet gathered through its own
+  // table.
+  bool needs(Need what, const FrameWork& work) const override;
+  // Each output's view that does not move starts being mapped here the first time it is shown (a
+  // view switched to, as the switch begins), and is gathered through its table once made.
   void process(FrameWork& work, StageTimes& times) override;
   void finish(PipelineOutputs& outputs) override;
   // Whether a working output's view has a picture drawn and not yet handed over.
@@ -164,6 +164,9 @@ class SurroundStage final : public PipelineStage {
   FixedView* fixedView(render::SurroundView& view);
   // The output's fixed view, as fixedView(); none for a sink that shows the view on the GPU.
   FixedView* fixedViewFor(PipelineOutputs::PictureOutput& output);
+  // The fixed view the output shows now, as fixedViewFor() gives it once taken into use; with
+  // nothing started or taken.
+  const FixedView* shownFixedView(const PipelineOutputs::PictureOutput& output) const;
   // Maps the view onto the panorama (OpenGL, here), then has the panorama stage build its table.
   void startFixedView(render::SurroundView& view, FixedView& fixed);
   // Whether the GPU stitches this set: the GPU backend, and no camera faulty.
@@ -201,7 +204,6 @@ class SurroundStage final : public PipelineStage {
   // What the guidelines show now (travel, steering in tenths of a degree); none: not shown.
   std::optional<std::pair<render::Travel, long>> guidesShown_;
   int guidesVersion_ = 0;
-  bool panoramaSkipped_ = false;          // this set: needsPanorama() said no
   bool tablesAfterFirstPicture_ = false;  // prepare() without waiting: no table started yet
   // Per output's view (its address; each lives as long as the pipeline) and the kind it shows.
   std::map<std::pair<const render::SurroundView*, ViewKind>, FixedView> fixedViews_;

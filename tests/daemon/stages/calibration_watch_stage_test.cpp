@@ -20,50 +20,23 @@
 #include "common/work_pool.hpp"
 #include "daemon/config/config.hpp"
 #include "daemon/config/panorama_setup.hpp"
+#include "tests/daemon/stages/seams_frame_set.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace surroundd::daemon {
 namespace {
 
-const std::filesystem::path kSeams = std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_seams";
-const std::array<std::string, 4> kCameras{"front", "right", "back", "left"};
+using testing::kSeamsCameras;
 
-// synth_seams' rig with its recordings where the config finds them; `yaw` the front camera's.
+// synth_seams' rig, `frontYaw` the front camera's.
 Config seamsConfig(const testing::TempDir& dir, const std::string& frontYaw) {
-  std::string rig = testing::fileBytes(kSeams / "rig.yaml");
-  for (const std::string& name : kCameras) {
-    const std::string source = "file: " + name + ".mkv";
-    rig.replace(rig.find(source), source.size(), "file: " + (kSeams / (name + ".mkv")).string());
-  }
-  const std::string yaw = "yaw_deg: 0,";  // the front camera's, the first
-  rig.replace(rig.find(yaw), yaw.size(), "yaw_deg: " + frontYaw + ",");
-  dir.write("rig.yaml", rig);
-  return loadConfig(dir.write("config.yaml", R"(rig: {file: rig.yaml}
+  return testing::seamsConfig(dir, frontYaw, R"(rig: {file: rig.yaml}
 panorama: {width_px: 1024, height_px: 512, cache_dir: lut-cache}
 calibration_watch: {interval_s: 0.2, threshold_cm: 5}
 outputs:
   - {type: snapshot, stream: panorama, path: panorama.png}
-)"));
+)");
 }
-
-// Each camera's first frame, in pooled frames as a camera stream hands them over.
-class FirstFrames {
- public:
-  FirstFrames() {
-    for (std::size_t c = 0; c < kCameras.size(); ++c) {
-      const cv::Mat picture =
-          testing::decodeAll(kSeams / (kCameras[c] + ".mkv"), false, 1).images.at(0);
-      pools_[c].emplace(1, picture.size());
-      set.frames[c] = pools_[c]->tryAcquire();
-      picture.copyTo(set.frames[c]->image);
-    }
-    set.cameraCount = kCameras.size();
-  }
-  capture::FrameSet set;
-
- private:
-  std::array<std::optional<capture::FramePool>, kMaxCameras> pools_;
-};
 
 struct Watched {
   PipelineReport report;
@@ -74,7 +47,7 @@ struct Watched {
 Watched watch(const Config& config) {
   WorkPool pool(1);
   CalibrationWatchStage stage(config, rigOf(config, pool));
-  const FirstFrames frames;
+  const testing::SeamsFirstFrames frames;
   std::array<cv::Mat, kMaxCameras> bgrBuffers;
   PipelineOutputs outputs(30, false);
   StageTimes times;
@@ -88,7 +61,7 @@ Watched watch(const Config& config) {
     times.endSet();
   }
   Watched watched;
-  for (const std::string& name : kCameras) watched.report.cameras.emplace_back().name = name;
+  for (const std::string& name : kSeamsCameras) watched.report.cameras.emplace_back().name = name;
   stage.report(watched.report);
   watched.measuredSets = times.histograms()[static_cast<std::size_t>(Stage::kWatch)].count();
   return watched;
