@@ -7,13 +7,7 @@
 
 #include "daemon/config/output_type.hpp"
 #include "daemon/pipeline_ends.hpp"
-#include "daemon/stages/calibration_watch_stage.hpp"
-#include "daemon/stages/camera_health_stage.hpp"
-#include "daemon/stages/mosaic_stage.hpp"
-#include "daemon/stages/panorama_stage.hpp"
-#include "daemon/stages/recording_stage.hpp"
-#include "daemon/stages/stream_output_stage.hpp"
-#include "daemon/stages/surround_stage.hpp"
+#include "daemon/stage_list.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -26,20 +20,6 @@ constexpr std::chrono::milliseconds kLiveCameraWait{2};
 constexpr std::chrono::seconds kProgressInterval{10};
 constexpr std::chrono::seconds kPageStatusInterval{1};
 
-bool configured(const Config& config, OutputStream stream) {
-  return std::ranges::any_of(config.outputs, [&](const auto& o) { return o.stream == stream; });
-}
-
-// The format the panorama samples the cameras' frames in: theirs when they all hold one
-// (PanoramaStage), else BGR.
-PixelFormat cameraFormatOf(const std::vector<std::unique_ptr<capture::CameraStream>>& cameras) {
-  if (cameras.empty()) return PixelFormat::kBgr;
-  const PixelFormat first = cameras.front()->pixelFormat();
-  return std::ranges::all_of(cameras, [&](const auto& c) { return c->pixelFormat() == first; })
-             ? first
-             : PixelFormat::kBgr;
-}
-
 double nominalFpsOf(const std::vector<std::unique_ptr<capture::CameraStream>>& cameras) {
   return 1e9 / static_cast<double>(cameras.front()->nominalPeriod().count());
 }
@@ -48,8 +28,8 @@ double nominalFpsOf(const std::vector<std::unique_ptr<capture::CameraStream>>& c
 
 Pipeline::Pipeline(const Config& config, RunStart start)
     : runStart_(start),
-      renderer_(configured(config, OutputStream::kSurround) ? openSurroundRenderer(config)
-                                                            : decltype(renderer_)()),
+      renderer_(config.shows(OutputStream::kSurround) ? openSurroundRenderer(config)
+                                                      : decltype(renderer_)()),
       cameras_(openCameras(config)),
       synchronizer_(cameras_.size(),
                     std::chrono::duration_cast<capture::Timestamp>(
@@ -61,61 +41,28 @@ Pipeline::Pipeline(const Config& config, RunStart start)
           std::chrono::duration<double, std::milli>(config.capture.lateAfterMs))),
       pool_(config.pipeline.threads),
       outputs_(nominalFpsOf(cameras_), latestWins_) {
-  // The stages, in order. A new stage is one more line here.
-  auto health = std::make_unique<CameraHealthStage>(config, cameras_, synchronizer_);
-  health_ = health.get();
-  stages_.push_back(std::move(health));
-  stages_.push_back(std::make_unique<RecordingStage>());
-  auto mosaic = std::make_unique<MosaicStage>(config);
-  const MosaicStage& mosaicStage = *mosaic;
-  stages_.push_back(std::move(mosaic));
-  PanoramaStage* panorama = nullptr;
-  if (configured(config, OutputStream::kPanorama) || configured(config, OutputStream::kSurround)) {
-    auto stage = std::make_unique<PanoramaStage>(config, pool_);
-    panorama = stage.get();
-    stages_.push_back(std::move(stage));
-    stages_.push_back(std::make_unique<CalibrationWatchStage>(config, panorama->rig()));
-  }
-  if (configured(config, OutputStream::kSurround)) {
-    auto stage = std::make_unique<SurroundStage>(config, std::move(*renderer_.get()), *panorama,
-                                                 cameraFormatOf(cameras_));
-    surround_ = stage.get();
-    outputs_.setRenderer(&surround_->context());
-    stages_.push_back(std::move(stage));
-    if (surround_->stitchesOnGpu()) lendCameraBuffers(config);
-  }
-  if (surround_ == nullptr && config.processing.backend == ProcessingBackend::kGpu) {
-    spdlog::info("processing: cpu (no surround output: the GPU stitch is for the surround views)");
-  }
-  stages_.push_back(std::make_unique<StreamOutputStage>());
-  openOutputs(config, mosaicStage, panorama);
-  if (surround_ != nullptr) {
-    surround_->prepare(outputs_, config.capture.pacing == capture::Pacing::kAsFastAsPossible);
+  StageList list = buildStages(
+      config,
+      {.cameras = cameras_, .synchronizer = synchronizer_, .pool = pool_, .renderer = renderer_});
+  stages_ = std::move(list.stages);
+  views_ = list.views;
+  if (views_ != nullptr) outputs_.setRenderer(&views_->context());
+  openOutputs(config);
+  if (views_ != nullptr) {
+    views_->prepare(outputs_, config.capture.pacing == capture::Pacing::kAsFastAsPossible);
   }
 }
 
-void Pipeline::lendCameraBuffers(const Config& config) {
-  // Only for a GPU that imports them: a CPU stitch would gather its pixels from the driver's
-  // buffers in place, which on many embedded capture drivers are not cached. The GPU path reads
-  // a lent frame once, in order, where the driver will not import it after all (its upload's
-  // copy, in place of capture's); colour correction reads only its seam samples.
-  const std::string& refusal = surround_->dmabufImportRefusal();
-  for (std::size_t c = 0; c < cameras_.size(); ++c) {
-    if (!config.cameras[c].device) continue;
-    const std::string& name = cameras_[c]->name();
-    const char* why = refusal.empty() ? cameras_[c]->lendBuffers() : refusal.c_str();
-    if (why == nullptr) {
-      spdlog::info("capture: camera '{}': frames lent the driver's buffers, for the GPU to import",
-                   name);
-    } else {
-      spdlog::info("capture: camera '{}': frames copied out of the driver's buffers: {}", name,
-                   why);
-    }
+std::optional<StreamPicture> Pipeline::streamPicture(OutputStream stream) const {
+  for (const auto& stage : stages_) {
+    if (auto picture = stage->streamPicture(stream)) return picture;
   }
+  return std::nullopt;
 }
 
-void Pipeline::openOutputs(const Config& config, const MosaicStage& mosaic,
-                           const PanoramaStage* panorama) {
+void Pipeline::openOutputs(const Config& config) {
+  // The surround views are drawn at the size the mosaic is composed at: the config's.
+  const cv::Size viewSize = streamPicture(OutputStream::kMosaic).value().size;
   for (OutputConfig output : config.outputs) {
     if (outputTypeOf(output).input == OutputInput::kCameraFrames) {
       outputs_.addRecording(output, config.cameras);
@@ -123,17 +70,11 @@ void Pipeline::openOutputs(const Config& config, const MosaicStage& mosaic,
     }
     const ViewKind view = output.view.value_or(config.render.view);
     output.view = view;
-    switch (output.stream) {
-      case OutputStream::kMosaic:
-        outputs_.addPicture(output, mosaic.size(), &mosaic.picture(), nullptr);
-        break;
-      case OutputStream::kPanorama:
-        outputs_.addPicture(output, panorama->lut().size, &panorama->picture(), nullptr);
-        break;
-      case OutputStream::kSurround:
-        outputs_.addPicture(output, mosaic.size(), nullptr,
-                            surround_->makeView(mosaic.size(), view));
-        break;
+    if (output.stream == OutputStream::kSurround) {
+      outputs_.addPicture(output, viewSize, nullptr, views_->makeView(viewSize, view));
+    } else {
+      const StreamPicture picture = streamPicture(output.stream).value();
+      outputs_.addPicture(output, picture.size, picture.picture, nullptr);
     }
   }
 }
@@ -141,7 +82,7 @@ void Pipeline::openOutputs(const Config& config, const MosaicStage& mosaic,
 Pipeline::~Pipeline() = default;
 
 void Pipeline::setVehicleSignals(const vehicle::VehicleSignals& signals) {
-  if (surround_ != nullptr) surround_->setVehicleSignals(signals);
+  if (views_ != nullptr) views_->setVehicleSignals(signals);
 }
 
 PipelineReport Pipeline::report() const {
@@ -278,7 +219,7 @@ void Pipeline::fillNeeds(const std::atomic<bool>& stop) {
     if (!synchronizer_.needs(c)) continue;
     capture::FrameRef frame;
     // While a picture is being drawn, the waits are short too: it goes out once finished.
-    const bool briefly = live_ || (surround_ != nullptr && SurroundStage::drawing(outputs_));
+    const bool briefly = live_ || outputs_.drawing();
     switch (cameras_[c]->next(frame, briefly ? kLiveCameraWait : kCameraWait)) {
       case capture::CameraStream::Next::kFrame:
         synchronizer_.offer(c, std::move(frame));
@@ -312,7 +253,7 @@ void Pipeline::process(const capture::FrameSet& set) {
 
 cv::Mat Pipeline::latestPicture() {
   return outputs_.latestPicture([&](PipelineOutputs::PictureOutput& output) {
-    return firstTimestamp_ ? surround_->redraw(output) : cv::Mat();
+    return firstTimestamp_ ? views_->redraw(output) : cv::Mat();
   });
 }
 
@@ -325,15 +266,14 @@ void Pipeline::finish(RunSummary& summary) {
       [&](PipelineOutputs::PictureOutput& output) {
         // A view shown on the GPU keeps its last picture: none is read back for it.
         if (!firstTimestamp_ || (output.sink && output.sink->presentsViews())) return cv::Mat();
-        return output.view ? surround_->redraw(output) : *output.picture;
+        return output.view ? views_->redraw(output) : *output.picture;
       },
       summary.outputs);
   summary.failedOutputs = outputs_.failures();
   summary.sync = synchronizer_.stats();
   summary.stageTime = times_.totals();
-  summary.healthChanges = health_->changes();
-  if (surround_ != nullptr) summary.renderer = surround_->description();
   summary.report = report();
+  summary.renderer = summary.report.renderer;
   for (const auto& camera : cameras_) {
     summary.cameraNames.push_back(camera->name());
     summary.cameras.push_back(camera->stats());

@@ -43,11 +43,8 @@
 
 namespace surroundd::daemon {
 
-class CameraHealthStage;
-class MosaicStage;
-class PanoramaStage;
-class SurroundStage;
 class SurroundRenderer;
+class SurroundViews;
 
 struct RunSummary {
   std::uint64_t frameSets = 0;
@@ -60,7 +57,6 @@ struct RunSummary {
   std::uint64_t failedSets = 0;  // frame sets a stage failed on: dropped, the run went on
   bool rebuild = false;          // ended because kRebuildAfterFailures sets failed in a row
   std::array<std::chrono::nanoseconds, kStageCount> stageTime{};  // summed over the run
-  std::vector<capture::HealthChange> healthChanges;               // in order; `at` is stream time
   std::string renderer;   // the EGL context's description, when there were surround outputs
   PipelineReport report;  // at the end: per-stage and latency distributions among others
 
@@ -119,9 +115,9 @@ class Pipeline {
  private:
   using Clock = std::chrono::steady_clock;
 
-  void openOutputs(const Config& config, const MosaicStage& mosaic, const PanoramaStage* panorama);
-  // The V4L2 cameras' frames lent their drivers' buffers where the GPU stitch can import them.
-  void lendCameraBuffers(const Config& config);
+  // The picture a stage makes for outputs of `stream`.
+  std::optional<StreamPicture> streamPicture(OutputStream stream) const;
+  void openOutputs(const Config& config);
   void fillNeeds(const std::atomic<bool>& stop);
   // The next complete set; with latestWins_, the newest, the older ones counted as stale.
   std::optional<capture::FrameSet> nextSet(const std::atomic<bool>& stop);
@@ -137,7 +133,7 @@ class Pipeline {
   bool firstPictureLogged_ = false;
   // Opened beside the cameras and the panorama stage, taken by the surround stage; before the
   // cameras, so that a camera that cannot open leaves it to finish and go.
-  // (Held by pointer: the renderer is declared in the surround stage's header, not this one.)
+  // (Held by pointer: the renderer is declared in its own header, not this one.)
   std::future<std::unique_ptr<SurroundRenderer>> renderer_;
   std::vector<std::unique_ptr<capture::CameraStream>> cameras_;
   capture::Synchronizer synchronizer_;
@@ -145,13 +141,12 @@ class Pipeline {
   bool latestWins_;  // stale sets are skipped, encoders drop their oldest picture
   capture::Timestamp lateAfter_;
   WorkPool pool_;
-  // The stages, in their order; before the outputs, whose surround views need the surround
-  // stage's GL context to the end. Each reports itself (PipelineStage::report()); the two named
-  // here are in the list too: the run's summary lists the health changes, and the surround
-  // views' outputs are opened and redrawn through their stage.
+  // The stages (stage_list.hpp), in their order; before the outputs, whose surround views need
+  // the surround stage's GL context to the end. Each reports itself (PipelineStage::report()).
   std::vector<std::unique_ptr<PipelineStage>> stages_;
-  CameraHealthStage* health_ = nullptr;
-  SurroundStage* surround_ = nullptr;  // when an output shows a surround view
+  // The stage that draws the surround views, in the list too: their outputs are opened and
+  // redrawn through it. Null when no output shows one.
+  SurroundViews* views_ = nullptr;
   PipelineOutputs outputs_;
   StageTimes times_;
   std::array<cv::Mat, kMaxCameras> bgrBuffers_;  // FrameWork::bgr()'s, one per camera

@@ -50,6 +50,11 @@ bool PipelineOutputs::shows(OutputStream stream) const {
       pictures_, [&](const PictureOutput& o) { return o.config.stream == stream && o.sink; });
 }
 
+bool PipelineOutputs::drawing() const {
+  return std::ranges::any_of(
+      pictures_, [](const PictureOutput& o) { return o.view && o.sink && o.view->pending(); });
+}
+
 void PipelineOutputs::drop(PictureOutput& output, const std::exception& error) {
   output.sink.reset();
   output.retryDelay =

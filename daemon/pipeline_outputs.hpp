@@ -77,6 +77,8 @@ class PipelineOutputs {
   const std::vector<PictureOutput>& pictures() const { return pictures_; }
   // Whether a working output shows `stream`.
   bool shows(OutputStream stream) const;
+  // Whether a working output's surround view has a picture drawn and not yet handed over.
+  bool drawing() const;
 
   // Runs `step` on the output (if it works); an exception drops the output with a logged error.
   template <typename Step>

@@ -93,8 +93,10 @@ struct PipelineReport {
   std::uint64_t staleDropped = 0;  // live: complete sets skipped because a newer one was ready
   capture::SyncStats sync;
   std::vector<CameraReport> cameras;
-  std::vector<SeamReport> seams;                      // the drift watch's; empty when it is off
-  std::optional<MountWatchReport> mountWatch;         // with calibration_watch.correct: suggest
+  std::vector<capture::HealthChange>
+      healthChanges;                           // every one so far, in order; `at`: stream time
+  std::vector<SeamReport> seams;               // the drift watch's; empty when it is off
+  std::optional<MountWatchReport> mountWatch;  // with calibration_watch.correct: suggest
   std::array<DurationHistogram, kStageCount> stages;  // per frame set that went through the stage
   DurationHistogram latency;  // a frame's capture to its picture handed to an output
   // From the run's start to its first picture handed to an output; empty before.

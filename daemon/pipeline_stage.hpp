@@ -13,6 +13,7 @@
 #include <array>
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <span>
 
 #include <opencv2/core.hpp>
@@ -31,6 +32,13 @@ class PipelineStage;
 // making it costs and not every set needs it.
 enum class Need {
   kPanorama,  // the CPU's panorama picture of the set (FrameWork::panorama)
+};
+
+// A picture a stage makes for the outputs of a stream (the mosaic, the panorama): reused for every
+// set, of `size`.
+struct StreamPicture {
+  const cv::Mat* picture;
+  cv::Size size;
 };
 
 // One frame set on its way through the stages.
@@ -73,6 +81,10 @@ class PipelineStage {
   // Whether this set needs `what` made by a stage before this one (FrameWork::needed()). Asked
   // of the later stages by the stage that would make it; it changes nothing.
   virtual bool needs(Need /*what*/, const FrameWork& /*work*/) const { return false; }
+  // The picture this stage makes for the outputs of `stream`; none for a stream it does not make.
+  virtual std::optional<StreamPicture> streamPicture(OutputStream /*stream*/) const {
+    return std::nullopt;
+  }
   // No set is waiting: hand over what has finished meanwhile rather than with the next set.
   virtual void idle(PipelineOutputs& /*outputs*/, StageTimes& /*times*/) {}
   // Adds what the stage knows to the pipeline's report, whose cameras are listed already (in the

@@ -7,6 +7,7 @@
 // The parts' settings are plain structs with units in their names; they are defined here until the
 // part that consumes them exists (processing/ and render/ never see YAML).
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -313,6 +314,10 @@ struct Config {
 
   // The vehicle drawn and guided: `vehicle`, else the default car.
   processing::VehicleDimensions car() const { return vehicle.value_or(VehicleConfig{}); }
+  // Whether an output shows `stream`.
+  bool shows(OutputStream stream) const {
+    return std::ranges::any_of(outputs, [&](const OutputConfig& o) { return o.stream == stream; });
+  }
 };
 
 // Default sizes that follow the vehicle: a small robot in a room wants a closer look than a bus.

@@ -37,6 +37,7 @@ void CameraHealthStage::report(PipelineReport& report) const {
   for (std::size_t c = 0; c < report.cameras.size(); ++c) {
     report.cameras[c].health = monitor_.health(c);
   }
+  report.healthChanges = changes_;
 }
 
 }  // namespace surroundd::daemon

@@ -26,9 +26,6 @@ class CameraHealthStage final : public PipelineStage {
   // Each camera's health.
   void report(PipelineReport& report) const override;
 
-  // Every change so far, in order; `at` is stream time.
-  const std::vector<capture::HealthChange>& changes() const { return changes_; }
-
  private:
   const std::vector<std::unique_ptr<capture::CameraStream>>& cameras_;
   const capture::Synchronizer& synchronizer_;

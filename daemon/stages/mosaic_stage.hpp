@@ -2,6 +2,8 @@
 // The mosaic: every camera's picture side by side, labelled, faulty ones marked (render/mosaic.hpp)
 // — composed for each set while a working output shows it.
 
+#include <optional>
+
 #include <opencv2/core.hpp>
 
 #include "daemon/config/config.hpp"
@@ -16,9 +18,11 @@ class MosaicStage final : public PipelineStage {
 
   void process(FrameWork& work, StageTimes& times) override;
 
-  // The composed mosaic, reused for every set (black before the first); of size().
-  const cv::Mat& picture() const { return canvas_; }
-  cv::Size size() const { return mosaic_.outputSize(); }
+  // The composed mosaic, reused for every set (black before the first).
+  std::optional<StreamPicture> streamPicture(OutputStream stream) const override {
+    if (stream != OutputStream::kMosaic) return std::nullopt;
+    return StreamPicture{&canvas_, mosaic_.outputSize()};
+  }
 
  private:
   render::Mosaic mosaic_;

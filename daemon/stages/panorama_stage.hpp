@@ -41,8 +41,12 @@ class PanoramaStage final : public PipelineStage {
   // apply it).
   void process(FrameWork& work, StageTimes& times) override;
 
-  // The corrected panorama of the last set, reused for every set; of lut().size.
+  // The corrected panorama of the last set that needed it, reused for every set; of lut().size.
   const cv::Mat& picture() const { return panorama_; }
+  std::optional<StreamPicture> streamPicture(OutputStream stream) const override {
+    if (stream != OutputStream::kPanorama) return std::nullopt;
+    return StreamPicture{&panorama_, lut_.size};
+  }
   const processing::PanoramaLut& lut() const { return lut_; }
   // The rig the LUT was built for (body masks included).
   const processing::Rig& rig() const { return rig_; }

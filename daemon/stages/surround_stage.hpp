@@ -44,6 +44,8 @@
 #include "daemon/duration_histogram.hpp"
 #include "daemon/pipeline_stage.hpp"
 #include "daemon/stages/panorama_stage.hpp"
+#include "daemon/stages/surround_renderer.hpp"
+#include "daemon/surround_views.hpp"
 #include "render/egl_context.hpp"
 #include "render/gpu_stitcher.hpp"
 #include "render/gpu_timer.hpp"
@@ -53,31 +55,7 @@
 
 namespace surroundd::daemon {
 
-// What the surround views are drawn with: the EGL context and the scene (mesh, car, shaders).
-// Opening it is most of the start-up's fixed cost on llvmpipe (0.4 s: the driver's start and the
-// shaders' compiling) and needs nothing the cameras or the panorama's table give, so it runs beside
-// them. Its context is current on no thread while it is handed over.
-class SurroundRenderer {
- public:
-  SurroundRenderer(std::unique_ptr<render::EglContext> context,
-                   std::unique_ptr<render::SurroundScene> built);
-  // Never taken by a stage (the start-up failed elsewhere): the scene's GL objects are deleted
-  // with its context current on this thread.
-  ~SurroundRenderer();
-  SurroundRenderer(SurroundRenderer&&) = default;
-  SurroundRenderer& operator=(SurroundRenderer&&) = default;
-
-  // The context first, so that it outlives the GL objects of the scene.
-  std::unique_ptr<render::EglContext> gl;
-  std::unique_ptr<render::SurroundScene> scene;
-};
-
-// Opens the renderer for `config`'s surround views on a thread of its own; `config` must outlive
-// the future's result. Its get() throws RenderError, or std::runtime_error naming the config for
-// a mesh that cannot be built.
-std::future<std::unique_ptr<SurroundRenderer>> openSurroundRenderer(const Config& config);
-
-class SurroundStage final : public PipelineStage {
+class SurroundStage final : public PipelineStage, public SurroundViews {
  public:
   // Draws with `renderer` (openSurroundRenderer(config)), its context made current here;
   // `panorama` must outlive the stage. The GPU stitch, where processing.backend chooses it, is
@@ -86,14 +64,13 @@ class SurroundStage final : public PipelineStage {
   SurroundStage(const Config& config, SurroundRenderer renderer, PanoramaStage& panorama,
                 PixelFormat cameraFormat);
 
-  // A view for an output of `size` (even sides), first showing `view`.
-  std::unique_ptr<render::SurroundView> makeView(cv::Size size, ViewKind view);
-
-  // `waitForTables` (a replay as fast as possible, whose pictures are all to come the same way):
-  // maps each output's first view that does not move and waits for its table, ahead of the first
-  // set. Else (a paced or live rig) the renderer draws the first picture, and the tables are
-  // started once it has gone out: the first picture sooner.
-  void prepare(PipelineOutputs& outputs, bool waitForTables);
+  // SurroundViews (daemon/surround_views.hpp).
+  std::unique_ptr<render::SurroundView> makeView(cv::Size size, ViewKind view) override;
+  void prepare(PipelineOutputs& outputs, bool waitForTables) override;
+  cv::Mat redraw(PipelineOutputs::PictureOutput& output) override;
+  render::EglContext& context() override { return *gl_; }
+  // The guidelines are drawn again only when they change by a tenth of a degree or more.
+  void setVehicleSignals(const vehicle::VehicleSignals& signals) override;
 
   // Whether this set needs the CPU's panorama (Need::kPanorama): a view drawn from it (on the
   // CPU backend, or in a set the GPU does not stitch) that is not yet gathered through its own
@@ -103,8 +80,6 @@ class SurroundStage final : public PipelineStage {
   // view switched to, as the switch begins), and is gathered through its table once made.
   void process(FrameWork& work, StageTimes& times) override;
   void finish(PipelineOutputs& outputs) override;
-  // Whether a working output's view has a picture drawn and not yet handed over.
-  static bool drawing(const PipelineOutputs& outputs);
   // Hands over the pictures whose drawing has finished, so that a picture goes out as soon as it
   // is drawn rather than when the next set comes.
   void idle(PipelineOutputs& outputs, StageTimes& times) override {
@@ -112,24 +87,16 @@ class SurroundStage final : public PipelineStage {
   }
   // The renderer, and the GPU's times of its steps.
   void report(PipelineReport& report) const override;
-  // The view of the last set, drawn again for an output that writes it at the end.
-  cv::Mat redraw(PipelineOutputs::PictureOutput& output);
 
   // The renderer, and where the panorama is stitched when that is the GPU.
   std::string description() const {
     return gpu_ ? gl_->description() + "; panorama stitched on the GPU" : gl_->description();
   }
-  // The renderer's context, current on the stage's thread: for outputs that show views on the GPU.
-  render::EglContext& context() { return *gl_; }
   // Whether the GPU stitches the panorama (processing.backend as it came out on this renderer).
   bool stitchesOnGpu() const { return gpu_ != nullptr; }
   // Why the GPU stitch cannot import camera frames from their DMABUFs (render/dmabuf_import.hpp);
   // empty when it can.
   const std::string& dmabufImportRefusal() const { return importRefusal_; }
-
-  // The vehicle's signals as they are now: the guidelines follow its gear and steering (drawn
-  // again only when they change by a tenth of a degree or more).
-  void setVehicleSignals(const vehicle::VehicleSignals& signals);
 
  private:
   enum class Pending { kAll, kFinished };

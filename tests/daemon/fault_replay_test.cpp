@@ -32,7 +32,7 @@ TEST(CameraHealth, FaultsAreDetectedWithin200MsAndMarkedWhileTheOthersGoOn) {
   EXPECT_EQ(summary.frameSets, 30u);  // 'back' ends, the others go on to the end
 
   const auto detected = [&](std::size_t camera, capture::CameraHealth health) {
-    for (const auto& change : summary.healthChanges) {
+    for (const auto& change : summary.report.healthChanges) {
       if (change.camera == camera && change.to == health) {
         return std::chrono::duration<double>(change.at).count();
       }
@@ -50,7 +50,8 @@ TEST(CameraHealth, FaultsAreDetectedWithin200MsAndMarkedWhileTheOthersGoOn) {
     RecordProperty(std::string("detected_") + capture::toString(health) + "_after_ms",
                    std::to_string(std::lround((at - 0.5) * 1000)));
   }
-  for (const auto& change : summary.healthChanges) EXPECT_NE(change.camera, 0u);  // front is fine
+  for (const auto& change : summary.report.healthChanges)
+    EXPECT_NE(change.camera, 0u);  // front is fine
 
   // The lost camera's part of the panorama is greyed and striped; the front's is its picture.
   const cv::Mat shot = cv::imread((dir / "panorama.png").string());

@@ -195,7 +195,7 @@ TEST_F(LiveCameras, FourV4l2CamerasThroughTheKernelMakeTheMosaicAndMatchedSets) 
   // vivid's devices run on timers of their own, not one clock, and the machine's CPU is
   // emulated: a camera may fall out of sync with the others, or behind (lost), for a while, and
   // is reported so, its tile dimmed or grey meanwhile. Nothing else is wrong with them.
-  for (const auto& change : summary.healthChanges) {
+  for (const auto& change : summary.report.healthChanges) {
     EXPECT_THAT(change.to,
                 ::testing::AnyOf(capture::CameraHealth::kOk, capture::CameraHealth::kOutOfSync,
                                  capture::CameraHealth::kLost))

@@ -100,7 +100,7 @@ TEST_F(StillRigTest, StillPicturesRunLiveWithEveryCameraOk) {
   std::vector<capture::CameraHealth> health;
   const RunSummary summary = run(rig, health);
   EXPECT_GE(summary.frameSets, kSets);
-  EXPECT_THAT(summary.healthChanges, ::testing::IsEmpty());
+  EXPECT_THAT(summary.report.healthChanges, ::testing::IsEmpty());
   ASSERT_EQ(health.size(), 4u);
   for (const auto h : health) EXPECT_EQ(h, capture::CameraHealth::kOk) << capture::toString(h);
   for (std::size_t c = 0; c < 4; ++c) EXPECT_EQ(summary.sync.unmatchedDropped[c], 0u) << c;
@@ -113,9 +113,9 @@ TEST_F(StillRigTest, AnAskedForFrozenCheckStillFindsTheStillFrozen) {
   ASSERT_EQ(health.size(), 4u);
   EXPECT_EQ(health[0], capture::CameraHealth::kFrozen);
   for (std::size_t c = 1; c < 4; ++c) EXPECT_EQ(health[c], capture::CameraHealth::kOk) << c;
-  ASSERT_FALSE(summary.healthChanges.empty());
-  EXPECT_EQ(summary.healthChanges[0].camera, 0u);
-  EXPECT_EQ(summary.healthChanges[0].to, capture::CameraHealth::kFrozen);
+  ASSERT_FALSE(summary.report.healthChanges.empty());
+  EXPECT_EQ(summary.report.healthChanges[0].camera, 0u);
+  EXPECT_EQ(summary.report.healthChanges[0].to, capture::CameraHealth::kFrozen);
 }
 
 // Before each set's stages: how many pictures the outputs had been handed by then, and how long
