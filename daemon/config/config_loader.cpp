@@ -206,28 +206,22 @@ void checkCorrectionScale(YamlObject& root, const Config& config) {
   }
 }
 
-// The render's size and views, whose defaults follow the vehicle.
-void readRenderSection(YamlObject& root, Config& config) {
-  const VehicleConfig vehicle = config.vehicle.value_or(VehicleConfig{});
-  const VehicleSizes sizes = vehicleSizes(vehicle);
+// The render's views' defaults follow the vehicle.
+void renderDefaults(Config& config) {
+  const VehicleSizes sizes = vehicleSizes(config.vehicle.value_or(VehicleConfig{}));
   auto& views = config.render.views;
   views.topRangeM = sizes.topRangeM;
   views.topHeightM = sizes.topHeightM;
   views.orbitRadiusM = sizes.orbitRadiusM;
   views.orbitHeightM = sizes.orbitHeightM;
-  readSection(root, "render", [&](YamlObject& s) {
-    readRender(s, config.render);
-    checkSplitCamera(s, config);
-  });
 }
 
 // After the render: the bowl's default floor reaches as far as the top view shows.
-void readMeshSection(YamlObject& root, Config& config) {
+void meshDefaults(Config& config) {
   auto& mesh = config.mesh;
   mesh.bowlFloorRadiusM = topViewReachM(config.render);
   mesh.bowlRadiusM = bowlRimRadiusM(mesh);
   mesh.bowlHeightM = bowlRimHeightM(mesh);
-  readSection(root, "mesh", [&](YamlObject& s) { readMesh(s, mesh); });
 }
 
 void addWarnings(Config& config) {
@@ -271,24 +265,12 @@ Config readConfig(const YAML::Node& document, const std::filesystem::path& file)
   config.file = file;
   YamlObject root(document, "", file, diag);
   readRig(root, config);
-  readSection(root, "logging", [&](YamlObject& s) { loggingKeys().read(s, config); });
-  readSection(root, "capture", [&](YamlObject& s) { readCapture(s, config.capture); });
-  readSection(root, "pipeline", [&](YamlObject& s) { pipelineKeys().read(s, config.pipeline); });
-  readSection(root, "processing",
-              [&](YamlObject& s) { processingKeys().read(s, config.processing); });
-  readSection(root, "panorama", [&](YamlObject& s) { readPanorama(s, config.panorama); });
-  readSection(root, "colour_correction",
-              [&](YamlObject& s) { colourKeys().read(s, config.colour); });
+  for (const ConfigSection& section : configSections()) {
+    if (section.prepare != nullptr) section.prepare(config);
+    readSection(root, section.name, [&](YamlObject& s) { section.read(s, config); });
+  }
   checkCorrectionScale(root, config);
-  if (auto section = root.object("vehicle")) config.vehicle = readVehicle(*section);
-  readRenderSection(root, config);
-  readMeshSection(root, config);
   addWarnings(config);
-  readSection(root, "control", [&](YamlObject& s) { readControl(s, config.control); });
-  readSection(root, "vehicle_signals",
-              [&](YamlObject& s) { vehicleSignalsKeys().read(s, config.vehicleSignals); });
-  readSection(root, "calibration_watch",
-              [&](YamlObject& s) { calibrationWatchKeys().read(s, config.calibrationWatch); });
   readOutputs(root, config);
   root.finish();
   diag.throwIfAny();
@@ -296,6 +278,40 @@ Config readConfig(const YAML::Node& document, const std::filesystem::path& file)
 }
 
 }  // namespace
+
+std::span<const ConfigSection> configSections() {
+  static const std::array<ConfigSection, 12> kSections{{
+      {"logging", [] { return loggingKeys().docs(); }, nullptr,
+       [](YamlObject& s, Config& c) { loggingKeys().read(s, c); }},
+      {"capture", [] { return captureKeys().docs(); }, nullptr,
+       [](YamlObject& s, Config& c) { readCapture(s, c.capture); }},
+      {"pipeline", [] { return pipelineKeys().docs(); }, nullptr,
+       [](YamlObject& s, Config& c) { pipelineKeys().read(s, c.pipeline); }},
+      {"processing", [] { return processingKeys().docs(); }, nullptr,
+       [](YamlObject& s, Config& c) { processingKeys().read(s, c.processing); }},
+      {"panorama", [] { return panoramaKeys().docs(); }, nullptr,
+       [](YamlObject& s, Config& c) { readPanorama(s, c.panorama); }},
+      {"colour_correction", [] { return colourKeys().docs(); }, nullptr,
+       [](YamlObject& s, Config& c) { colourKeys().read(s, c.colour); }},
+      // Over the rig file's vehicle, before what follows it.
+      {"vehicle", [] { return vehicleKeys().docs(); }, nullptr,
+       [](YamlObject& s, Config& c) { c.vehicle = readVehicle(s); }},
+      {"render", [] { return renderKeys().docs(); }, renderDefaults,
+       [](YamlObject& s, Config& c) {
+         readRender(s, c.render);
+         checkSplitCamera(s, c);
+       }},
+      {"mesh", [] { return meshKeys().docs(); }, meshDefaults,
+       [](YamlObject& s, Config& c) { readMesh(s, c.mesh); }},
+      {"control", [] { return controlKeys().docs(); }, nullptr,
+       [](YamlObject& s, Config& c) { readControl(s, c.control); }},
+      {"vehicle_signals", [] { return vehicleSignalsKeys().docs(); }, nullptr,
+       [](YamlObject& s, Config& c) { vehicleSignalsKeys().read(s, c.vehicleSignals); }},
+      {"calibration_watch", [] { return calibrationWatchKeys().docs(); }, nullptr,
+       [](YamlObject& s, Config& c) { calibrationWatchKeys().read(s, c.calibrationWatch); }},
+  }};
+  return kSections;
+}
 
 Config loadConfig(const std::filesystem::path& file) {
   return readConfig(parseYamlFile(file), file);

@@ -400,19 +400,4 @@ const ConfigKeys<CalibrationWatchConfig>& calibrationWatchKeys() {
   return kKeys;
 }
 
-std::vector<SectionDocs> sectionDocs() {
-  return {{"logging", loggingKeys().docs()},
-          {"capture", captureKeys().docs()},
-          {"pipeline", pipelineKeys().docs()},
-          {"processing", processingKeys().docs()},
-          {"panorama", panoramaKeys().docs()},
-          {"colour_correction", colourKeys().docs()},
-          {"mesh", meshKeys().docs()},
-          {"render", renderKeys().docs()},
-          {"control", controlKeys().docs()},
-          {"vehicle", vehicleKeys().docs()},
-          {"vehicle_signals", vehicleSignalsKeys().docs()},
-          {"calibration_watch", calibrationWatchKeys().docs()}};
-}
-
 }  // namespace surroundd::daemon

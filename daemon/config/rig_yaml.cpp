@@ -110,7 +110,10 @@ RigFile readRig(const YAML::Node& document, const std::filesystem::path& file) {
   YamlObject root(document, "", file, diag);
   RigFile rig;
   rig.cameras = readRigCameras(root);
-  if (auto vehicle = root.object("vehicle")) rig.vehicle = readVehicle(*vehicle);
+  if (auto vehicle = root.object("vehicle")) {
+    rig.vehicle = readVehicle(*vehicle);
+    vehicle->finish();
+  }
   root.finish();
   diag.throwIfAny();
   return rig;

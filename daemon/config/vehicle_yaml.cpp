@@ -94,7 +94,6 @@ VehicleConfig readVehicle(YamlObject& v) {
   VehicleConfig c;
   vehicleKeys().read(v, c);
   checkShape(v, c);
-  v.finish();
   return c;
 }
 

@@ -36,7 +36,7 @@ struct BodyMaskConfig {
 
 const ConfigKeys<VehicleConfig>& vehicleKeys();
 // Reads and validates a `vehicle:` mapping (its table, then the rules across keys); errors go to
-// its Diagnostics.
+// its Diagnostics. The caller finishes the mapping (its unknown keys).
 VehicleConfig readVehicle(YamlObject& vehicle);
 // A camera's `body_mask:`; its picture must be of the lens's size.
 BodyMaskConfig readBodyMask(YamlObject& mask, cv::Size lensSize);
