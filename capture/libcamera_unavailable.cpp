@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "capture/libcamera_source.hpp"
+#include "common/build_info.hpp"
 
 namespace surroundd::capture {
 
@@ -15,10 +16,8 @@ std::vector<std::string> libcameraCameras() {
 struct LibcameraSource::Impl {};
 
 LibcameraSource::LibcameraSource(std::string cameraName, LibcameraSettings /*settings*/) {
-  throw CaptureError(
-      fmt::format("camera '{}': this surroundd was built without libcamera (configure with "
-                  "-DSURROUNDD_WITH_LIBCAMERA=ON; needs libcamera-dev)",
-                  cameraName));
+  throw CaptureError(fmt::format("camera '{}': this surroundd was built without libcamera ({})",
+                                 cameraName, howToBuildIn("LIBCAMERA")));
 }
 
 LibcameraSource::~LibcameraSource() = default;

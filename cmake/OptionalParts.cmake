@@ -6,6 +6,7 @@
 # sets SURROUNDD_WITH_<PART> (an option) and, when ON, the imported target PkgConfig::<PART>.
 set(SURROUNDD_PARTS_IN "")
 set(SURROUNDD_PARTS_OUT "")
+set(SURROUNDD_PARTS_PACKAGES "")  # "<PART> <packages>" per part, for howToBuildIn()
 
 macro(surroundd_optional_part part what)
   cmake_parse_arguments(PART_ARG "" "" "PACKAGES;MODULES" ${ARGN})
@@ -18,6 +19,7 @@ macro(surroundd_optional_part part what)
                         "install ${part_packages}, or configure with -DSURROUNDD_WITH_${part}=OFF")
   endif()
   # One list item per part: no semicolons inside.
+  list(APPEND SURROUNDD_PARTS_PACKAGES "${part} ${part_packages}")
   if(SURROUNDD_WITH_${part})
     list(APPEND SURROUNDD_PARTS_IN "${part}: ${what}")
   else()

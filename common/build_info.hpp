@@ -11,4 +11,9 @@ namespace surroundd {
 // "<program> <version>", then a line of the parts built in and one of those left out.
 std::string versionText(std::string_view program);
 
+// How to build in the optional part `part` (OptionalParts.cmake's name: "HTTP", "LIBCAMERA"):
+// "configure with -DSURROUNDD_WITH_HTTP=ON (needs libmicrohttpd-dev libturbojpeg0-dev)", for the
+// message that refuses what a build leaves out. Throws std::logic_error for a part there is not.
+std::string howToBuildIn(std::string_view part);
+
 }  // namespace surroundd

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "capture/sequence_pattern.hpp"
+#include "common/build_info.hpp"
 
 namespace surroundd::daemon {
 namespace {
@@ -122,8 +123,7 @@ capture::LibcameraSettings readLibcameraSource(YamlObject& source) {
   refusePreload(source, "libcamera");
   if (!capture::libcameraAvailable()) {
     source.error("libcamera",
-                 "this surroundd is built without libcamera cameras: configure with "
-                 "-DSURROUNDD_WITH_LIBCAMERA=ON (needs libcamera-dev)");
+                 "this surroundd is built without libcamera cameras: " + howToBuildIn("LIBCAMERA"));
   }
   settings.fps = source.number("fps", settings.fps, {1.0, 1000.0, false, "frames per second"});
   settings.buffers = source.integer("buffers", settings.buffers, 2, 32);

@@ -71,7 +71,7 @@ struct OutputType {
   std::string name;  // the config's `type:`
   OutputInput input = OutputInput::kPicture;
   // Empty when this build has the type; else how to build it in, e.g. "configure with
-  // -DSURROUNDD_WITH_HTTP=ON (needs libmicrohttpd-dev and libturbojpeg0-dev)".
+  // -DSURROUNDD_WITH_HTTP=ON (needs libmicrohttpd-dev libturbojpeg0-dev)" (howToBuildIn()).
   std::string leftOut;
   // The schema: the type's own keys of one `outputs:` entry (`type`, `stream` and `view` are read
   // already), a table (config_keys.hpp) whose defaults are OutputConfig's fields; the reference

@@ -4,6 +4,7 @@
 #include <mutex>
 #include <string>
 
+#include "common/build_info.hpp"
 #include "daemon/outputs/built_in_outputs.hpp"
 
 namespace surroundd::daemon {
@@ -26,27 +27,22 @@ std::vector<OutputType> builtInOutputTypes() {
 #if SURROUNDD_WITH_HTTP
   types.push_back(httpOutputType());
 #else
-  types.push_back(leftOut("http",
-                          "configure with -DSURROUNDD_WITH_HTTP=ON (needs libmicrohttpd-dev and "
-                          "libturbojpeg0-dev)"));
+  types.push_back(leftOut("http", howToBuildIn("HTTP")));
 #endif
 #if SURROUNDD_WITH_RTSP
   types.push_back(rtspOutputType());
 #else
-  types.push_back(
-      leftOut("rtsp", "configure with -DSURROUNDD_WITH_RTSP=ON (needs libgstrtspserver-1.0-dev)"));
+  types.push_back(leftOut("rtsp", howToBuildIn("RTSP")));
 #endif
 #if SURROUNDD_WITH_X11
   types.push_back(windowOutputType());
 #else
-  types.push_back(leftOut(
-      "window", "configure with -DSURROUNDD_WITH_X11=ON (needs libx11-dev and libxext-dev)"));
+  types.push_back(leftOut("window", howToBuildIn("X11")));
 #endif
 #if SURROUNDD_WITH_DRM
   types.push_back(displayOutputType());
 #else
-  types.push_back(leftOut(
-      "display", "configure with -DSURROUNDD_WITH_DRM=ON (needs libdrm-dev and libgbm-dev)"));
+  types.push_back(leftOut("display", howToBuildIn("DRM")));
 #endif
   types.push_back(snapshotOutputType());
   types.push_back(recordingOutputType());

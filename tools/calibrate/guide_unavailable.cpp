@@ -1,6 +1,7 @@
 // Built instead of guide_command.cpp and mat_guide_command.cpp where SURROUNDD_WITH_HTTP is off:
 // the guide's page needs the HTTP server. Asking this build for it is a usage error (status 2),
 // refused before any camera is opened, with how to build it in.
+#include "common/build_info.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
 #include "tools/calibrate/guide_command.hpp"
 #include "tools/calibrate/mat_guide_command.hpp"
@@ -9,9 +10,7 @@ namespace surroundd::calibrate {
 namespace {
 
 [[noreturn]] void refuse() {
-  throw UsageError(
-      "this build has no HTTP server for its page (configure with "
-      "-DSURROUNDD_WITH_HTTP=ON; needs libmicrohttpd-dev and libturbojpeg0-dev)");
+  throw UsageError("this build has no HTTP server for its page (" + howToBuildIn("HTTP") + ")");
 }
 
 }  // namespace
