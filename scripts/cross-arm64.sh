@@ -11,13 +11,12 @@
 set -eu
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh --cross-arm64
+# shellcheck source=scripts/packages.sh
+. scripts/packages.sh
 
 sysroot="$PWD/build/arm64-sysroot"
-packages="libc6-dev,libstdc++-12-dev,libopencv-dev,libyaml-cpp-dev,libtinygltf-dev,libspdlog-dev,libfmt-dev,\
-zlib1g-dev,libavcodec-dev,libavformat-dev,libavutil-dev,libswscale-dev,libsuitesparse-dev,\
-libegl-dev,libgles-dev,libx11-dev,libxext-dev,libdrm-dev,libgbm-dev,libturbojpeg0-dev,\
-libcamera-dev,libsystemd-dev,libgtest-dev,libgmock-dev,libmicrohttpd-dev,libeigen3-dev,libegl-mesa0,\
-libgl1-mesa-dri"
+# shellcheck disable=SC2086 # the lists are meant to split into words
+packages=$(echo libc6-dev libstdc++-12-dev $LIBRARY_PACKAGES $GTEST_PACKAGES $MESA_PACKAGES | tr ' ' ',')
 stamp="$sysroot/.surroundd-packages"
 
 started=$(date +%s)

@@ -11,19 +11,11 @@
 # --device-vm: also QEMU, busybox, kmod and cpio, for scripts/device-vm.sh (the tests' machine with
 #   a KMS screen, V4L2 cameras and a CAN bus).
 set -eu
+# shellcheck source=scripts/packages.sh
+. "$(dirname "$0")/packages.sh"
 
-PACKAGES="
-  build-essential cmake ninja-build pkg-config ccache
-  libopencv-dev libyaml-cpp-dev libspdlog-dev libfmt-dev zlib1g-dev libtinygltf-dev
-  libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
-  libsuitesparse-dev libeigen3-dev
-  libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
-  libx11-dev libxext-dev libdrm-dev libgbm-dev
-  libturbojpeg0-dev libcamera-dev libsystemd-dev
-  libmicrohttpd-dev python3
-  libgstrtspserver-1.0-dev gstreamer1.0-plugins-base gstreamer1.0-plugins-good
-"
-TEST_PACKAGES="libgtest-dev libgmock-dev xvfb opencv-doc help2man lintian chromium"
+PACKAGES="$TOOL_PACKAGES $LIBRARY_PACKAGES $MESA_PACKAGES $RTSP_PACKAGES"
+TEST_PACKAGES="$GTEST_PACKAGES xvfb opencv-doc help2man lintian chromium"
 tests=no
 
 for argument in "$@"; do
