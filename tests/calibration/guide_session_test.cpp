@@ -5,7 +5,7 @@
 // point within 1 px of the truth, and say what is missing before it is there. The views and
 // stream time it took are recorded (docs/calibration.md: "Guided calibration").
 
-#include "tools/calibrate/guide_session.hpp"
+#include "tools/calibrate/guide/guide_session.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -19,7 +19,7 @@
 #include "capture/file_source.hpp"
 #include "tests/calibration/calibration_test_support.hpp"
 #include "tests/support/temp_dir.hpp"
-#include "tools/calibrate/guide_state_json.hpp"
+#include "tools/calibrate/guide/guide_state_json.hpp"
 #include "tools/synth/calibration_session.hpp"
 
 namespace surroundd::calibration::testing {

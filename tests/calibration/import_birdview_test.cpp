@@ -15,7 +15,7 @@
 #include "tests/calibration/import_test_support.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
-#include "tools/calibrate/import_command.hpp"
+#include "tools/calibrate/import/import_command.hpp"
 
 namespace surroundd::calibrate {
 namespace {

@@ -23,8 +23,8 @@
 #include "tests/calibration/import_test_support.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
-#include "tools/calibrate/import_command.hpp"
-#include "tools/calibrate/ocam_results.hpp"
+#include "tools/calibrate/import/import_command.hpp"
+#include "tools/calibrate/import/ocam_results.hpp"
 
 namespace surroundd::calibrate {
 namespace {

@@ -18,7 +18,7 @@
 #include "daemon/config/rig_yaml.hpp"
 #include "processing/rig.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
-#include "tools/calibrate/import_command.hpp"
+#include "tools/calibrate/import/import_command.hpp"
 
 namespace surroundd::calibrate {
 

@@ -6,7 +6,7 @@
 // stated limit, stitch a top view, and write the mounts into the rig; a mat declared at the wrong
 // size, or a camera that sees no board, must fail, say why, and leave the rig untouched.
 
-#include "tools/calibrate/mat_guide_session.hpp"
+#include "tools/calibrate/guide/mat_guide_session.hpp"
 
 #include <algorithm>
 #include <fstream>
@@ -21,9 +21,9 @@
 #include "processing/calibration/calibration_error.hpp"
 #include "tests/calibration/mat_calibration_support.hpp"
 #include "tests/support/temp_dir.hpp"
-#include "tools/calibrate/mat_guide_state_json.hpp"
-#include "tools/calibrate/mat_guide_view.hpp"
-#include "tools/calibrate/mat_mounts_output.hpp"
+#include "tools/calibrate/extrinsics/mat_mounts_output.hpp"
+#include "tools/calibrate/guide/mat_guide_state_json.hpp"
+#include "tools/calibrate/guide/mat_guide_view.hpp"
 
 namespace surroundd::calibration::testing {
 namespace {

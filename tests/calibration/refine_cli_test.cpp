@@ -14,7 +14,7 @@
 #include "daemon/config/rig_yaml.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
-#include "tools/calibrate/refine_command.hpp"
+#include "tools/calibrate/refine/refine_command.hpp"
 
 namespace surroundd::calibrate {
 namespace {

@@ -25,7 +25,7 @@
 #include "processing/calibration/seam_misalignment.hpp"
 #include "tests/calibration/import_test_support.hpp"
 #include "tests/support/temp_dir.hpp"
-#include "tools/calibrate/refine_command.hpp"
+#include "tools/calibrate/refine/refine_command.hpp"
 
 namespace surroundd::calibrate {
 namespace {

@@ -12,7 +12,7 @@
 #include "tests/fuzz/fuzz_support.hpp"
 #include "tests/fuzz/rig_invariants.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
-#include "tools/calibrate/import_command.hpp"
+#include "tools/calibrate/import/import_command.hpp"
 
 namespace {
 

@@ -33,9 +33,12 @@ allowed() {
     daemon/outputs) echo "$below_daemon daemon/config" ;;
     daemon | daemon/stages) echo "$libraries" ;;
     # The tools use the libraries, never one another, but the benchmark measures on the
-    # generator's recordings.
+    # generator's recordings; a tool's own folders (one per command) are one part.
     tools/bench) echo "$libraries tools/synth" ;;
-    tools/*) echo "$libraries" ;;
+    tools/*)
+      # shellcheck disable=SC2046 # each folder a word
+      echo "$libraries" $(find "tools/$(echo "$1" | cut -d/ -f2)" -type d)
+      ;;
     *) return 1 ;;
   esac
 }

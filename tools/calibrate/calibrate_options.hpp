@@ -19,10 +19,10 @@
 #include "processing/calibration/mat_calibration.hpp"
 #include "processing/camera_model.hpp"
 #include "render/outputs/credentials.hpp"
-#include "tools/calibrate/guide_options.hpp"
-#include "tools/calibrate/import_options.hpp"
-#include "tools/calibrate/intrinsics_options.hpp"
-#include "tools/calibrate/mat_guide_options.hpp"
+#include "tools/calibrate/guide/guide_options.hpp"
+#include "tools/calibrate/guide/mat_guide_options.hpp"
+#include "tools/calibrate/import/import_options.hpp"
+#include "tools/calibrate/intrinsics/intrinsics_options.hpp"
 
 namespace surroundd::calibrate {
 

@@ -3,8 +3,8 @@
 // refused before any camera is opened, with how to build it in.
 #include "common/build_info.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
-#include "tools/calibrate/guide_command.hpp"
-#include "tools/calibrate/mat_guide_command.hpp"
+#include "tools/calibrate/guide/guide_command.hpp"
+#include "tools/calibrate/guide/mat_guide_command.hpp"
 
 namespace surroundd::calibrate {
 namespace {

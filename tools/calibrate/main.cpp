@@ -12,13 +12,13 @@
 #include "daemon/outputs/built_in_outputs.hpp"
 #include "processing/calibration/calibration_error.hpp"
 #include "tools/calibrate/calibrate_options.hpp"
-#include "tools/calibrate/extrinsics_command.hpp"
-#include "tools/calibrate/guide_command.hpp"
-#include "tools/calibrate/import_command.hpp"
-#include "tools/calibrate/intrinsics_command.hpp"
-#include "tools/calibrate/mask_command.hpp"
-#include "tools/calibrate/mat_guide_command.hpp"
-#include "tools/calibrate/refine_command.hpp"
+#include "tools/calibrate/extrinsics/extrinsics_command.hpp"
+#include "tools/calibrate/guide/guide_command.hpp"
+#include "tools/calibrate/guide/mat_guide_command.hpp"
+#include "tools/calibrate/import/import_command.hpp"
+#include "tools/calibrate/intrinsics/intrinsics_command.hpp"
+#include "tools/calibrate/mask/mask_command.hpp"
+#include "tools/calibrate/refine/refine_command.hpp"
 
 namespace {
 
