@@ -5,9 +5,21 @@
 #include <fmt/format.h>
 
 #include "daemon/compliance_limits.hpp"
+#include "processing/calibration/mount_refinement.hpp"
 
 namespace surroundd::daemon {
 namespace {
+
+// ", mount would turn yaw +1.8°, pitch -0.4°, roll +0.2° (±0.05°)"; a fault says so.
+std::string mountText(const MountSuggestion& mount) {
+  return fmt::format(
+      "{} yaw {:+.1f}°, pitch {:+.1f}°, roll {:+.1f}° (±{:.2f}°){}",
+      mount.fault ? ", mount has turned" : ", mount would turn", mount.changeDeg.yawDeg,
+      mount.changeDeg.pitchDeg, mount.changeDeg.rollDeg, mount.sigmaDeg,
+      mount.fault ? fmt::format(": past the {:g}° a correction may make, check its mount",
+                                processing::MountRefinementResult::kLargestTurnDeg)
+                  : "");
+}
 
 double milliseconds(std::chrono::nanoseconds duration) {
   return std::chrono::duration<double, std::milli>(duration).count();
@@ -172,14 +184,7 @@ std::string statusText(const PipelineReport& report) {
                    "sets without it\n",
                    camera.name, capture::toString(camera.health),
                    camera.calibrationDrifting ? ", calibration drifting" : "",
-                   camera.mountSuggestion
-                       ? fmt::format(", mount would turn yaw {:+.1f}°, pitch {:+.1f}°, roll "
-                                     "{:+.1f}° (±{:.2f}°)",
-                                     camera.mountSuggestion->changeDeg.yawDeg,
-                                     camera.mountSuggestion->changeDeg.pitchDeg,
-                                     camera.mountSuggestion->changeDeg.rollDeg,
-                                     camera.mountSuggestion->sigmaDeg)
-                       : std::string(),
+                   camera.mountSuggestion ? mountText(*camera.mountSuggestion) : std::string(),
                    camera.stats.frames, camera.stats.faults, camera.queued,
                    report.sync.unmatchedDropped[c] + report.sync.outOfOrderDropped[c],
                    report.sync.lateMissing[c]);
@@ -309,7 +314,7 @@ std::string prometheusText(const PipelineReport& report) {
            "The mount angle change the calibration watch suggests for the camera "
            "(calibration_watch.correct: suggest); absent where none is worth applying.");
     for (const auto& camera : report.cameras) {
-      if (!camera.mountSuggestion) continue;
+      if (!camera.mountSuggestion || camera.mountSuggestion->fault) continue;
       const auto& change = camera.mountSuggestion->changeDeg;
       for (const auto& [axis, value] :
            {std::pair{"yaw", change.yawDeg}, std::pair{"pitch", change.pitchDeg},
@@ -319,6 +324,13 @@ std::string prometheusText(const PipelineReport& report) {
                        "{:.3f}\n",
                        camera.name, axis, value);
       }
+    }
+    family(out, "camera_mount_fault", "gauge",
+           "1 where the calibration watch finds the camera turned past what a mount correction "
+           "may make (check its mount), else 0.");
+    for (const auto& camera : report.cameras) {
+      fmt::format_to(std::back_inserter(out), "surroundd_camera_mount_fault{{camera=\"{}\"}} {}\n",
+                     camera.name, camera.mountSuggestion && camera.mountSuggestion->fault ? 1 : 0);
     }
     family(out, "mount_refinement_cpu_seconds_total", "counter",
            "CPU time of the calibration watch's mount refinement thread.");

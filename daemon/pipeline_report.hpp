@@ -56,6 +56,9 @@ struct MountSuggestion {
   processing::MountAngles changeDeg;
   double heightCm = 0;
   double sigmaDeg = 0;  // the largest of the angles' uncertainties
+  // Past MountRefinementResult::kLargestTurnDeg: the camera has moved too far to be followed (a
+  // fault, reported: check its mount), not a correction to make.
+  bool fault = false;
 };
 
 // The mount refinement behind the suggestions: how much ground it has compared, at what cost.

@@ -87,11 +87,14 @@ void CalibrationWatchStage::readSuggestions() {
   for (std::size_t c = 0; c < suggested_.size(); ++c) {
     const processing::MountCorrection& correction = result.cameras[c];
     std::optional<MountSuggestion> now;
-    if (result.verdict(c) == processing::CorrectionVerdict::kOffered) {
+    const processing::CorrectionVerdict verdict = result.verdict(c);
+    if (verdict == processing::CorrectionVerdict::kOffered ||
+        verdict == processing::CorrectionVerdict::kTooLarge) {
       const cv::Vec3d sigma = correction.rotationSigmaRad * (180 / std::numbers::pi);
       const processing::Pose& pose = rig_.cameras[c].pose;
       now = MountSuggestion{processing::mountAngleChange(pose, correction.applied(pose)),
-                            100 * correction.heightM, std::max({sigma[0], sigma[1], sigma[2]})};
+                            100 * correction.heightM, std::max({sigma[0], sigma[1], sigma[2]}),
+                            verdict == processing::CorrectionVerdict::kTooLarge};
     }
     const auto turned = [](const std::optional<MountSuggestion>& s) {
       return s ? std::abs(s->changeDeg.yawDeg) + std::abs(s->changeDeg.pitchDeg) +
@@ -100,11 +103,20 @@ void CalibrationWatchStage::readSuggestions() {
     };
     // Logged when a suggestion appears, goes, or moves by a tenth of a degree or more.
     const bool changed = now.has_value() != suggested_[c].has_value() ||
-                         (now && std::abs(turned(now) - turned(suggested_[c])) >= 0.1);
+                         (now && (now->fault != suggested_[c]->fault ||
+                                  std::abs(turned(now) - turned(suggested_[c])) >= 0.1));
     if (!changed) continue;
     suggested_[c] = now;
     if (!now) {
       spdlog::info("calibration watch: camera '{}' needs no correction now", cameraNames_[c]);
+      continue;
+    }
+    if (now->fault) {
+      spdlog::error(
+          "calibration watch: camera '{}' has turned yaw {:+.1f}°, pitch {:+.1f}°, roll {:+.1f}° "
+          "(±{:.2f}°): more than the {:g}° a mount correction may make; check its mount",
+          cameraNames_[c], now->changeDeg.yawDeg, now->changeDeg.pitchDeg, now->changeDeg.rollDeg,
+          now->sigmaDeg, processing::MountRefinementResult::kLargestTurnDeg);
       continue;
     }
     std::vector<std::string> before;

@@ -109,6 +109,7 @@ CorrectionVerdict MountRefinementResult::verdict(std::size_t camera) const {
   const MountCorrection& correction = cameras[camera];
   if (camera == reference) return CorrectionVerdict::kHeld;
   if (!correction.conclusive()) return CorrectionVerdict::kUncertain;
+  if (correction.angleDeg() > kLargestTurnDeg) return CorrectionVerdict::kTooLarge;
   if (correction.angleDeg() < kSmallestTurnDeg) return CorrectionVerdict::kTooSmall;
   if (!closesSeams(camera)) return CorrectionVerdict::kSeamsApart;
   return CorrectionVerdict::kOffered;

@@ -73,6 +73,7 @@ struct SeamFit {
 enum class CorrectionVerdict {
   kHeld,        // the camera the others were fitted around
   kUncertain,   // not conclusive()
+  kTooLarge,    // past kLargestTurnDeg: a fault to report, not a correction to make
   kTooSmall,    // under kSmallestTurnDeg
   kSeamsApart,  // it would not close every seam the camera touches (closesSeams())
   kOffered,
@@ -96,8 +97,12 @@ struct MountRefinementResult {
   // A turn under kSmallestTurnDeg moves the ground 1.5 cm at 4 m, under what a seam shows, and
   // is as likely the lens's or the fit's own error (an exact simulator's rig fits 0.1-0.2
   // degrees off).
+  // A turn past kLargestTurnDeg is no drift but a fault (a camera knocked off its mount, a mirror
+  // folded): the patches were laid through the mounts as they were, and a picture that far off
+  // wants the mount looked at, not followed.
   CorrectionVerdict verdict(std::size_t camera) const;
   static constexpr double kSmallestTurnDeg = 0.2;
+  static constexpr double kLargestTurnDeg = 5.0;
 };
 
 class MountRefinement {

@@ -166,6 +166,28 @@ TEST(MountRefinement, DoesNotOfferACorrectionThatLeavesTheSeamsApart) {
   EXPECT_TRUE(error <= 0.3 || !result->closesSeams(left)) << error;
 }
 
+// Past a few degrees a camera has not drifted but been knocked: reported as a fault, however sure
+// the fit; a turn inside the bound that closes its seams is offered; one too small is left.
+TEST(MountRefinementResult, CallsATurnPastTheBoundAFaultNotACorrection) {
+  const auto about = [](double degrees) {
+    MountCorrection correction;
+    correction.rotationRad = cv::Vec3d(0, 0, degrees * std::numbers::pi / 180);
+    correction.rotationSigmaRad = cv::Vec3d::all(0.01 * std::numbers::pi / 180);
+    return correction;
+  };
+  MountRefinementResult result;
+  result.reference = 0;
+  result.cameras = {MountCorrection{}, about(6), about(3), about(0.1), about(-5.5)};
+  EXPECT_EQ(result.verdict(0), CorrectionVerdict::kHeld);
+  EXPECT_EQ(result.verdict(1), CorrectionVerdict::kTooLarge);
+  EXPECT_EQ(result.verdict(2), CorrectionVerdict::kOffered);
+  EXPECT_EQ(result.verdict(3), CorrectionVerdict::kTooSmall);
+  EXPECT_EQ(result.verdict(4), CorrectionVerdict::kTooLarge);
+  // A fault is no more than the fit knows: an uncertain one is uncertain.
+  result.cameras[1].rotationSigmaRad = cv::Vec3d::all(0.5 * std::numbers::pi / 180);
+  EXPECT_EQ(result.verdict(1), CorrectionVerdict::kUncertain);
+}
+
 TEST(MountRefinement, FindsNothingToActOnWhereCamerasShareOnlyFarGround) {
   const Drive drive = loadDrive("synth_drive_paper");
   Rig knocked = drive.truth.rig;

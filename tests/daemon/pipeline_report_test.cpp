@@ -149,6 +149,32 @@ TEST(PipelineReport, TheCalibrationWatchShowsEachSeamAndTheDriftingCamera) {
               ::testing::HasSubstr("surroundd_camera_calibration_drifting{camera=\"back\"} 0\n"));
 }
 
+// A suggested mount correction, and a camera turned past what a correction may make: the status
+// and the metrics tell them apart.
+TEST(PipelineReport, AMountTurnedPastTheBoundIsAFaultNotASuggestion) {
+  PipelineReport report = sampleReport();
+  report.mountWatch = MountWatchReport{.setsCompared = 40, .comparisons = 900, .cpuSeconds = 2.5};
+  report.cameras[1].mountSuggestion = MountSuggestion{{1.5, -0.4, 0.2}, 0.3, 0.05, false};
+  report.cameras[2].mountSuggestion = MountSuggestion{{8.0, 0.1, 0.0}, 0.0, 0.04, true};
+  const std::string text = statusText(report);
+  EXPECT_THAT(text, ::testing::HasSubstr(
+                        "camera right: frozen, mount would turn yaw +1.5°, pitch -0.4°, roll +0.2° "
+                        "(±0.05°), 298 frames"));
+  EXPECT_THAT(text, ::testing::HasSubstr("mount has turned yaw +8.0°, pitch +0.1°, roll +0.0° "
+                                         "(±0.04°): past the 5° a correction may make, check its "
+                                         "mount"));
+  const std::string metrics = prometheusText(report);
+  EXPECT_THAT(metrics, ::testing::HasSubstr(
+                           "surroundd_camera_mount_correction_deg{camera=\"right\",axis=\"yaw\"} "
+                           "1.500\n"));
+  EXPECT_THAT(metrics, ::testing::Not(
+                           ::testing::HasSubstr("surroundd_camera_mount_correction_deg{camera=\"" +
+                                                report.cameras[2].name + "\"")));
+  EXPECT_THAT(metrics, ::testing::HasSubstr("surroundd_camera_mount_fault{camera=\"" +
+                                            report.cameras[2].name + "\"} 1\n"));
+  EXPECT_THAT(metrics, ::testing::HasSubstr("surroundd_camera_mount_fault{camera=\"right\"} 0\n"));
+}
+
 // A switch of view: its first picture, then the new view settled, held to the first picture's
 // 2.0 s and surroundd's 0.5 s target; absent before any switch.
 TEST(PipelineReport, AViewSwitchIsTimedToItsFirstPictureAndToTheNewViewSettled) {

@@ -132,6 +132,11 @@ std::string whyLeft(processing::CorrectionVerdict verdict) {
   switch (verdict) {
     case processing::CorrectionVerdict::kUncertain:
       return "is too uncertain to act on";
+    case processing::CorrectionVerdict::kTooLarge:
+      return fmt::format(
+          "turns it more than {:g} deg: a fault, not a drift (check its mount, or calibrate it "
+          "again: surround-calibrate extrinsics)",
+          processing::MountRefinementResult::kLargestTurnDeg);
     case processing::CorrectionVerdict::kTooSmall:
       return fmt::format("turns it less than {:g} deg",
                          processing::MountRefinementResult::kSmallestTurnDeg);
