@@ -21,6 +21,30 @@ std::string mountText(const MountSuggestion& mount) {
                   : "");
 }
 
+// The drift watch's lines: each seam's figure, and the mount refinement's work.
+std::string watchLines(const PipelineReport& report) {
+  std::string out;
+  for (const auto& seam : report.seams) {
+    fmt::format_to(std::back_inserter(out), "seam {}: {}{}\n", seam.name,
+                   seam.shiftCm ? fmt::format("ground {:.1f} cm apart at {:.1f} m (response "
+                                              "{:.2f}){}",
+                                              *seam.shiftCm, seam.distanceM, seam.response,
+                                              seam.misaligned ? ", misaligned" : "")
+                                : std::string("not measured yet"),
+                   seam.suggestedCm
+                       ? fmt::format("; {:.1f} cm with the mounts suggested", *seam.suggestedCm)
+                       : std::string());
+  }
+  if (report.mountWatch) {
+    fmt::format_to(std::back_inserter(out),
+                   "mount refinement: {} sets compared, {} comparisons in the last solution, "
+                   "{:.1f} s of CPU\n",
+                   report.mountWatch->setsCompared, report.mountWatch->comparisons,
+                   report.mountWatch->cpuSeconds);
+  }
+  return out;
+}
+
 double milliseconds(std::chrono::nanoseconds duration) {
   return std::chrono::duration<double, std::milli>(duration).count();
 }
@@ -159,24 +183,7 @@ std::string statusText(const PipelineReport& report) {
     fmt::format_to(std::back_inserter(out), "view switch: {}\n",
                    viewSwitchWithLimits(*report.viewSwitch));
   }
-  for (const auto& seam : report.seams) {
-    fmt::format_to(std::back_inserter(out), "seam {}: {}{}\n", seam.name,
-                   seam.shiftCm ? fmt::format("ground {:.1f} cm apart at {:.1f} m (response "
-                                              "{:.2f}){}",
-                                              *seam.shiftCm, seam.distanceM, seam.response,
-                                              seam.misaligned ? ", misaligned" : "")
-                                : std::string("not measured yet"),
-                   seam.suggestedCm
-                       ? fmt::format("; {:.1f} cm with the mounts suggested", *seam.suggestedCm)
-                       : std::string());
-  }
-  if (report.mountWatch) {
-    fmt::format_to(std::back_inserter(out),
-                   "mount refinement: {} sets compared, {} comparisons in the last solution, "
-                   "{:.1f} s of CPU\n",
-                   report.mountWatch->setsCompared, report.mountWatch->comparisons,
-                   report.mountWatch->cpuSeconds);
-  }
+  out += watchLines(report);
   for (std::size_t c = 0; c < report.cameras.size(); ++c) {
     const auto& camera = report.cameras[c];
     fmt::format_to(std::back_inserter(out),
@@ -188,6 +195,18 @@ std::string statusText(const PipelineReport& report) {
                    camera.stats.frames, camera.stats.faults, camera.queued,
                    report.sync.unmatchedDropped[c] + report.sync.outOfOrderDropped[c],
                    report.sync.lateMissing[c]);
+  }
+  return out;
+}
+
+std::string calibrationText(const PipelineReport& report) {
+  if (report.seams.empty())
+    return "the calibration watch is off (calibration_watch.interval_s: 0)\n";
+  std::string out = watchLines(report);
+  for (const auto& camera : report.cameras) {
+    fmt::format_to(std::back_inserter(out), "camera {}: {}{}\n", camera.name,
+                   camera.calibrationDrifting ? "calibration drifting" : "no drift seen",
+                   camera.mountSuggestion ? mountText(*camera.mountSuggestion) : std::string());
   }
   return out;
 }

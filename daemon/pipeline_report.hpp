@@ -126,6 +126,10 @@ std::string statusLine(const PipelineReport& report);
 // The status line, then one line per stage with p50/p99, the frame rate, latency and first
 // picture beside their limits, and one line per camera.
 std::string statusText(const PipelineReport& report);
+// The calibration watch alone (surroundctl calibration status): each seam's figure, the mount
+// refinement's work, and per camera whether it drifts and the mount correction suggested or the
+// fault found.
+std::string calibrationText(const PipelineReport& report);
 // For the HTTP page: {"fps": .., "frames": .., "cameras": {"front": "ok", ..}, "latency_ms": ..,
 // "dropped_by_sync": ..}.
 std::string statusJson(const PipelineReport& report);

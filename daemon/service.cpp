@@ -221,6 +221,8 @@ ControlAnswer Service::answer(Pipeline& pipeline, const ControlRequest& request)
                                    vehicleStatus(std::chrono::steady_clock::now()));
     case Kind::kMetrics:
       return ControlReply::success(prometheusText(pipeline.report()));
+    case Kind::kCalibration:
+      return ControlReply::success(calibrationText(pipeline.report()));
     case Kind::kView: {
       const auto view = render::parseViewKind(request.argument);
       if (!view) {

@@ -33,8 +33,9 @@ ParsedRequest parseControlRequest(std::string_view line) {
     Kind kind;
     bool takesArgument;
   };
-  constexpr std::array<Known, 6> kCommands{{{"status", Kind::kStatus, false},
+  constexpr std::array<Known, 7> kCommands{{{"status", Kind::kStatus, false},
                                             {"metrics", Kind::kMetrics, false},
+                                            {"calibration", Kind::kCalibration, false},
                                             {"view", Kind::kView, true},
                                             {"signal", Kind::kSignal, true},
                                             {"snapshot", Kind::kSnapshot, false},
@@ -42,8 +43,8 @@ ParsedRequest parseControlRequest(std::string_view line) {
   const auto* known = std::ranges::find(kCommands, command, &Known::name);
   if (known == kCommands.end()) {
     return {{},
-            fmt::format("unknown request '{}' (status, metrics, view NAME, signal ITEMS, "
-                        "snapshot, reload)",
+            fmt::format("unknown request '{}' (status, metrics, calibration, view NAME, signal "
+                        "ITEMS, snapshot, reload)",
                         command)};
   }
   if (known->takesArgument && argument.empty()) {

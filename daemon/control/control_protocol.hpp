@@ -27,7 +27,7 @@ namespace surroundd::daemon {
 inline constexpr std::size_t kMaxRequestBytes = 256;
 
 struct ControlRequest {
-  enum class Kind { kStatus, kMetrics, kView, kSignal, kSnapshot, kReload };
+  enum class Kind { kStatus, kMetrics, kView, kSignal, kSnapshot, kReload, kCalibration };
   Kind kind = Kind::kStatus;
   std::string argument;  // view: the view's name; signal: its items
 };

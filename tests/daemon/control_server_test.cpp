@@ -34,6 +34,9 @@ TEST(ControlProtocol, ParsesTheRequestsAndSaysWhatIsWrongWithOthers) {
   EXPECT_EQ(parseControlRequest("metrics").request.kind, Kind::kMetrics);
   EXPECT_EQ(parseControlRequest("snapshot").request.kind, Kind::kSnapshot);
   EXPECT_EQ(parseControlRequest("reload").request.kind, Kind::kReload);
+  EXPECT_EQ(parseControlRequest("calibration").request.kind, Kind::kCalibration);
+  EXPECT_THAT(parseControlRequest("calibration now").error,
+              HasSubstr("'calibration' takes no argument"));
   const auto view = parseControlRequest("view top");
   EXPECT_TRUE(view.error.empty());
   EXPECT_EQ(view.request.kind, Kind::kView);
@@ -144,8 +147,8 @@ TEST_F(ControlServerTest, RequestsRoundTripThroughThePipelineThread) {
 
 TEST_F(ControlServerTest, MisbehavingClientsGetAnErrorAndTheServerGoesOn) {
   EXPECT_EQ(exchange(path_, "shutdown\n", false),
-            "error unknown request 'shutdown' (status, metrics, view NAME, signal ITEMS, snapshot, "
-            "reload)\n");
+            "error unknown request 'shutdown' (status, metrics, calibration, view NAME, signal "
+            "ITEMS, snapshot, reload)\n");
   EXPECT_EQ(exchange(path_, std::string(10000, 'x'), false),
             fmt::format("error request longer than {} bytes\n", kMaxRequestBytes));
   EXPECT_EQ(exchange(path_, "status", true), "error the request ended without a newline\n");

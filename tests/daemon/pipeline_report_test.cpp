@@ -173,6 +173,21 @@ TEST(PipelineReport, AMountTurnedPastTheBoundIsAFaultNotASuggestion) {
   EXPECT_THAT(metrics, ::testing::HasSubstr("surroundd_camera_mount_fault{camera=\"" +
                                             report.cameras[2].name + "\"} 1\n"));
   EXPECT_THAT(metrics, ::testing::HasSubstr("surroundd_camera_mount_fault{camera=\"right\"} 0\n"));
+
+  // The calibration watch alone: its seams and refinement, and each camera's verdict.
+  EXPECT_THAT(calibrationText(report), ::testing::HasSubstr("off"));
+  report.seams = {{"front/right", 13.4, 4.1, 0.71, true, 1.2}};
+  report.cameras[1].calibrationDrifting = true;
+  EXPECT_EQ(calibrationText(report),
+            "seam front/right: ground 13.4 cm apart at 4.1 m (response 0.71), misaligned; 1.2 cm "
+            "with the mounts suggested\n"
+            "mount refinement: 40 sets compared, 900 comparisons in the last solution, 2.5 s of "
+            "CPU\n"
+            "camera front: no drift seen\n"
+            "camera right: calibration drifting, mount would turn yaw +1.5°, pitch -0.4°, roll "
+            "+0.2° (±0.05°)\n"
+            "camera back: no drift seen, mount has turned yaw +8.0°, pitch +0.1°, roll +0.0° "
+            "(±0.04°): past the 5° a correction may make, check its mount\n");
 }
 
 // A switch of view: its first picture, then the new view settled, held to the first picture's

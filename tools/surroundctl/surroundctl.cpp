@@ -25,6 +25,9 @@ commands:
                     step where the driver can time them, latency, time to the first picture
                     (each beside its limit), each camera's health
   metrics           the same and more in Prometheus text format
+  calibration status  the calibration watch: each seam's ground misalignment, the mount
+                    refinement's work, each camera's drift and the mount correction suggested
+                    (calibration_watch.correct: suggest) or the fault found
   view NAME         switch the surround outputs to top, 360, orbit, split or rear
   signal NAME=VALUE...  the vehicle's signals, for vehicles whose signals come from other
                     software: gear=P|R|N|D steering_deg=DEG (the wheel, + left) speed_kmh=KMH
@@ -80,6 +83,10 @@ int main(int argc, char** argv) {
   } else if (command == "signal") {
     if (i + 2 > argc) return usage("signal needs NAME=VALUE items");
     for (int k = i + 1; k < argc; ++k) request += fmt::format(" {}", argv[k]);
+  } else if (command == "calibration") {
+    if (i + 2 != argc || std::string_view(argv[i + 1]) != "status") {
+      return usage("calibration needs 'status'");
+    }
   } else if (command == "snapshot") {
     if (i + 2 != argc) return usage("snapshot needs one FILE");
     snapshotFile = argv[i + 1];
