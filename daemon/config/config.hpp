@@ -294,6 +294,9 @@ struct Config {
   std::filesystem::path file;
   spdlog::level::level_enum logLevel = spdlog::level::info;
   std::vector<RigCamera> cameras;
+  // The rig file the cameras were read from (`rig: {file:}`, where the config found it); none for
+  // cameras written inline.
+  std::optional<std::filesystem::path> rigFile;
   // The config's `vehicle:`, else the rig file's; none: the default car is drawn and no camera is
   // masked.
   std::optional<VehicleConfig> vehicle;

@@ -33,6 +33,7 @@ void readRig(YamlObject& root, Config& config) {
     if (const auto file = rig->existingFile("file")) {
       try {
         auto loaded = loadRig(*file);
+        config.rigFile = *file;
         config.cameras = std::move(loaded.cameras);
         config.vehicle = loaded.vehicle;
       } catch (const ConfigError& e) {

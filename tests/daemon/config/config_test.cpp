@@ -400,6 +400,15 @@ TEST_F(ConfigTest, RigFileRoundTripsExactly) {
     EXPECT_LT(cv::norm(a.pose.rotation - b.pose.rotation, cv::NORM_INF), 1e-12);
     EXPECT_EQ(cameras[i].source->path, config.cameras[i].source->path);
   }
+  // Where the cameras came from: none written inline, the rig file where one is named.
+  EXPECT_FALSE(config.rigFile.has_value());
+  std::ofstream(dir_ / "from-rig.yaml") << "rig: {file: rig.yaml}\n"
+                                        << "outputs:\n  - {type: snapshot, stream: mosaic, path: "
+                                           "s.png}\n";
+  const Config fromRig = loadConfig(dir_ / "from-rig.yaml");
+  ASSERT_TRUE(fromRig.rigFile.has_value());
+  EXPECT_TRUE(std::filesystem::equivalent(*fromRig.rigFile, rigFile));
+  EXPECT_EQ(fromRig.cameras.size(), config.cameras.size());
 }
 
 // The reference config shows every key at its default: loading it must give the code's defaults.

@@ -11,7 +11,6 @@
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
-#include <yaml-cpp/yaml.h>
 
 #include "capture/file_source.hpp"
 #include "common/work_pool.hpp"
@@ -42,10 +41,7 @@ Setup load(const RefineOptions& options) {
   Setup setup;
   if (!options.config.empty()) {
     setup.config = daemon::loadConfig(options.config);
-    const YAML::Node rig = YAML::LoadFile(options.config.string())["rig"];
-    if (rig && rig["file"]) {
-      setup.rigFile = options.config.parent_path() / rig["file"].as<std::string>();
-    }
+    setup.rigFile = setup.config.rigFile;
   } else {
     setup.rigFile = recordingRigFile(options.rig);
     daemon::RigFile rig = daemon::loadRig(*setup.rigFile);
