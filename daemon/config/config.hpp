@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -26,7 +27,6 @@
 #include "processing/surround_mesh.hpp"
 #include "render/egl_context.hpp"
 #include "render/guidelines.hpp"
-#include "render/outputs/credentials.hpp"
 #include "render/view_camera.hpp"
 #include "vehicle/can_signal_reader.hpp"
 #include "vehicle/vehicle_signals.hpp"
@@ -138,12 +138,6 @@ struct RenderConfig {
 // surround view.
 enum class OutputStream { kMosaic, kPanorama, kSurround };
 
-// How a window or display output shows its pictures: read back and handed to it
-// (render::X11WindowSink, render::DrmDisplaySink), or the surround view as OpenGL drew it, through
-// EGL on the GPU with no read-back (render::EglWindowSink, render::EglDisplaySink; the renderer's
-// context is then on that X server, or on that DRM card's GBM device).
-enum class ViewPresent { kPicture, kEgl };
-
 // An output's `type:`: the name of an output type in the registry (output_type.hpp), where each
 // type registers its keys, its factory and what it takes from the pipeline. The built-in types are
 // named here for code that writes configs; a type registered elsewhere is OutputKind{"its-name"}.
@@ -169,15 +163,15 @@ inline constexpr OutputKind OutputKind::kDisplay{"display"};
 inline constexpr OutputKind OutputKind::kSnapshot{"snapshot"};
 inline constexpr OutputKind OutputKind::kRecording{"recording"};
 
-// The settings of an output type registered outside surroundd's own list (a test's, a plug-in's):
-// the struct its schema reads, kept as it is and compared by value. Copies share it (it is not
-// changed once read).
-class OtherOutputSettings {
+// An output's own settings, those of its type (`type:`): the struct its type's key table reads
+// (daemon/outputs/<type>/), kept as it is and compared by value. Copies share it (it is not
+// changed once read). Empty: the type's defaults.
+class OutputSettings {
  public:
   template <class Settings>
-  explicit OtherOutputSettings(Settings settings)
+  explicit OutputSettings(Settings settings)
       : held_(std::make_shared<const Held<Settings>>(std::move(settings))) {}
-  OtherOutputSettings() = default;
+  OutputSettings() = default;
 
   // The settings if they are a `Settings`, else null.
   template <class Settings>
@@ -185,7 +179,8 @@ class OtherOutputSettings {
     const auto* held = dynamic_cast<const Held<Settings>*>(held_.get());
     return held != nullptr ? &held->settings : nullptr;
   }
-  bool operator==(const OtherOutputSettings& other) const {
+  bool empty() const { return held_ == nullptr; }
+  bool operator==(const OutputSettings& other) const {
     return held_ == other.held_ || (held_ && other.held_ && held_->equals(*other.held_));
   }
 
@@ -206,48 +201,28 @@ class OtherOutputSettings {
   std::shared_ptr<const Base> held_;
 };
 
-// One entry of `outputs:`. The keys every output has come first; the built-in types' own settings
-// follow, each read only by its type's schema (daemon/<type>_output.cpp), where its ranges are.
+// One entry of `outputs:`: the keys every output has; its type's own are in `settings`.
 struct OutputConfig {
   OutputKind kind = OutputKind::kVideo;
   OutputStream stream = OutputStream::kMosaic;
-  std::filesystem::path path;    // parent folders are created at start
+  std::filesystem::path path;    // of the types that write files; parent folders are made at start
   std::optional<ViewKind> view;  // surround: the view it starts with; default render.view
-  OtherOutputSettings other;     // a type registered outside surroundd's own list
-  // video and network
-  int crf = 23;
-  std::string preset = "veryfast";
-  std::string pixelFormat = "yuv420p";
-  std::string encoder = "auto";  // H.264: auto | libx264 | an FFmpeg encoder's name
-  double segmentS = 0.0;  // video: a new file every this many seconds of stream time; 0 = one file
-  // video: how many of its files (runs, segments) to keep, and how many MB they may hold; 0: all
-  int keepLast = 0;
-  double maxMb = 0;
+  OutputSettings settings;
   // Set when opened: `path` as configured, where `path` is this run's own <stem>-N<ext>.
   std::filesystem::path family;
-  std::string url;  // network: udp://HOST:PORT (MPEG-TS)
-  // http and rtsp: the server
-  std::string listenAddress = "127.0.0.1";  // only this machine, unless configured otherwise
-  int listenPort = 8080;
-  int jpegQuality = 80;
-  std::vector<std::string> allowedHosts;  // host names it answers to besides IPs and localhost
-  std::optional<render::Credentials> credentials;  // who may watch; required beyond loopback
-  // rtsp: H.264 served at rtsp://<listen>/<rtspName> (listen's default port there: 8554)
-  std::string rtspName;  // empty: what it shows (surround, panorama, mosaic)
-  // window (X11)
-  std::string display;  // empty: $DISPLAY
-  std::string title = "surroundd";
-  ViewPresent present = ViewPresent::kPicture;  // window and display
-  // display (DRM/KMS)
-  std::filesystem::path device;  // empty: the first card with a connected connector
-  std::string connector;         // e.g. HDMI-A-1; empty: the first connected one
-  // snapshot
-  double atSeconds = 1.0;  // stream time of the snapshot; the last frame if the run is shorter
-  // recording (a folder): bit for bit, or H.264 4:4:4 at crf / preset
-  bool lossless = true;
 
   bool operator==(const OutputConfig&) const = default;
 };
+
+// `output`'s settings as its type's `Settings`: the type's defaults where it holds none (an output
+// written by code). Throws std::logic_error if it holds another type's.
+template <class Settings>
+const Settings& settingsOf(const OutputConfig& output) {
+  static const Settings kDefaults{};
+  if (output.settings.empty()) return kDefaults;
+  if (const Settings* held = output.settings.get<Settings>()) return *held;
+  throw std::logic_error("an output's settings are not those of its type");
+}
 
 struct ControlConfig {
   // The control socket (surroundctl); empty: defaultControlSocket(), and none if that is empty.

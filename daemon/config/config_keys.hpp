@@ -220,6 +220,7 @@ class ConfigKeys {
  public:
   ConfigKeys() = default;
   ConfigKeys(std::initializer_list<ConfigKey<Section>> keys) : keys_(keys) {}
+  explicit ConfigKeys(std::vector<ConfigKey<Section>> keys) : keys_(std::move(keys)) {}
 
   void read(YamlObject& object, Section& section) const {
     for (const auto& key : keys_) key.read(object, section);

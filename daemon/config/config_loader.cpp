@@ -151,8 +151,8 @@ OutputConfig readOutput(YamlObject& item) {
                                    type.leftOut));
     return o;
   }
-  type.keys.read(item, o);
-  if (type.readSettings) type.readSettings(item, o);
+  readOutputPath(item, type, o);
+  o.settings = type.readSettings(item, o);
   item.finish();
   return o;
 }

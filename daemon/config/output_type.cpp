@@ -20,12 +20,16 @@ void add(Registry& registry, OutputType type) {
   }
   const bool opens = type.input == OutputInput::kPicture ? bool(type.openPictureSink)
                                                          : bool(type.openCameraFramesSink);
-  const bool hasSchema = !type.keys.empty() || type.readSettings;
-  if (type.leftOut.empty() && (!opens || !hasSchema)) {
+  if (type.leftOut.empty() && (!opens || !type.readSettings)) {
     throw std::logic_error(
         fmt::format("output type '{}' has no schema or no factory for its input", type.name));
   }
   registry.push_back(std::move(type));
+}
+
+ConfigKeys<OutputConfig> pathKeys(const OutputType& type) {
+  if (type.pathDoc.empty()) return {};
+  return {ConfigKey<OutputConfig>::requiredPath("path", &OutputConfig::path, type.pathDoc)};
 }
 
 Registry& registry() {
@@ -36,6 +40,16 @@ Registry& registry() {
 }  // namespace
 
 void registerOutputType(OutputType type) { add(registry(), std::move(type)); }
+
+std::vector<KeyDoc> ownKeyDocs(const OutputType& type) {
+  std::vector<KeyDoc> docs = pathKeys(type).docs();
+  docs.insert(docs.end(), type.keyDocs.begin(), type.keyDocs.end());
+  return docs;
+}
+
+void readOutputPath(YamlObject& item, const OutputType& type, OutputConfig& output) {
+  pathKeys(type).read(item, output);
+}
 
 const OutputType* findOutputType(std::string_view name) {
   const auto& types = registry();

@@ -73,13 +73,14 @@ struct OutputType {
   // Empty when this build has the type; else how to build it in, e.g. "configure with
   // -DSURROUNDD_WITH_HTTP=ON (needs libmicrohttpd-dev libturbojpeg0-dev)" (howToBuildIn()).
   std::string leftOut;
-  // The schema: the type's own keys of one `outputs:` entry (`type`, `stream` and `view` are read
-  // already), a table (config_keys.hpp) whose defaults are OutputConfig's fields; the reference
-  // config documents them.
-  ConfigKeys<OutputConfig> keys;
-  // Then what the table cannot say: its checks across keys, or, for a type without a table, its
-  // whole reading (into `output.other`). Each problem is reported on `item`.
-  std::function<void(YamlObject& item, OutputConfig& output)> readSettings;
+  // The file or folder it writes at `path`, a required key (the reference's doc of it); empty:
+  // it takes no path.
+  std::string pathDoc;
+  // Its own keys, for the reference config (set with readSettings by readsSettings()).
+  std::vector<KeyDoc> keyDocs;
+  // Reads its own keys of one `outputs:` entry (`type`, `stream`, `view` and `path` are read
+  // already, into `output`) into its settings; each problem is reported on `item`.
+  std::function<OutputSettings(YamlObject& item, const OutputConfig& output)> readSettings;
   // What its `path` is (kNone when it has none).
   std::function<OutputPathUse(const OutputConfig& output)> pathUse = [](const OutputConfig&) {
     return OutputPathUse::kNone;
@@ -100,6 +101,29 @@ struct OutputType {
   // output does not ask for that. Throws RenderError naming what could not be opened.
   std::function<std::unique_ptr<render::EglContext>(const OutputConfig& output)> openRenderer;
 };
+
+// Gives `type` its settings: `keys`, a table over `Settings` (config_keys.hpp) whose defaults are
+// its fields' initialisers, then `check` (optional): what the table cannot say, across keys.
+template <class Settings>
+void readsSettings(
+    OutputType& type, ConfigKeys<Settings> keys,
+    std::function<void(YamlObject& item, const OutputConfig& output, const Settings& settings)>
+        check = {}) {
+  type.keyDocs = keys.docs();
+  type.readSettings = [keys = std::move(keys), check = std::move(check)](
+                          YamlObject& item, const OutputConfig& output) {
+    Settings settings;
+    keys.read(item, settings);
+    if (check) check(item, output, settings);
+    return OutputSettings(std::move(settings));
+  };
+}
+
+// Every key a type's outputs have of their own, in the order the reference writes them: `path`
+// where it takes one, then its settings'.
+std::vector<KeyDoc> ownKeyDocs(const OutputType& type);
+// Reads `path` into `output` where its type takes one.
+void readOutputPath(YamlObject& item, const OutputType& type, OutputConfig& output);
 
 // Adds a type; throws std::logic_error if its name is taken or it has no factory for its input
 // (a left-out type needs none).

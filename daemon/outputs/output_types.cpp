@@ -6,6 +6,13 @@
 
 #include "common/build_info.hpp"
 #include "daemon/outputs/built_in_outputs.hpp"
+#include "daemon/outputs/display/display_output.hpp"
+#include "daemon/outputs/http/http_output.hpp"
+#include "daemon/outputs/recording/recording_output.hpp"
+#include "daemon/outputs/rtsp/rtsp_output.hpp"
+#include "daemon/outputs/snapshot/snapshot_output.hpp"
+#include "daemon/outputs/video/video_output.hpp"
+#include "daemon/outputs/window/window_output.hpp"
 
 namespace surroundd::daemon {
 namespace {

@@ -171,10 +171,8 @@ TEST_F(LiveCameras, TheyAreListedTakenByDeviceAutoAndCheckedForTheFormatAndSize)
 }
 
 TEST_F(LiveCameras, FourV4l2CamerasThroughTheKernelMakeTheMosaicAndMatchedSets) {
-  OutputConfig video = videoOutputAt(dir_.path() / "mosaic.mkv");
+  OutputConfig video = videoOutputAt(dir_.path() / "mosaic.mkv", losslessBgr());
   video.stream = OutputStream::kMosaic;
-  video.crf = 0;
-  video.pixelFormat = "bgr24";
   const Config config =
       vividConfig(devices_, dir_, video, {capture::V4l2Format::kYuyv, capture::V4l2Format::kNv12});
   const std::vector<std::string> names = namesOf(config);

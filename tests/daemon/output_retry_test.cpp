@@ -47,7 +47,7 @@ bool flakyRegistered() {
   static const bool kDone = [] {
     OutputType type;
     type.name = "flaky";
-    type.readSettings = [](YamlObject&, OutputConfig&) {};
+    type.readSettings = [](YamlObject&, const OutputConfig&) { return OutputSettings(); };
     type.openPictureSink = [](const OutputConfig&, const OutputContext&) {
       ++flaky().opens;
       if (flaky().openFails) throw std::runtime_error("flaky: cannot open");
@@ -147,8 +147,9 @@ TEST(OutputRetry, AFailedOutputIsOpenedAgainAndNothingItWroteIsLost) {
   const testing::TempDir dir;
   // The recording looping in real time, so that the retry after 1 s comes within the run however
   // slow the machine (an emulator too: scripts/cross-arm64.sh); stopped by the watch.
-  OutputConfig video = videoOutputAt(dir / "drive.mkv");
-  video.segmentS = 0.25;
+  VideoOutputSettings segmented;
+  segmented.segmentS = 0.25;
+  OutputConfig video = videoOutputAt(dir / "drive.mkv", segmented);
   Config config = fixtureReplay("synth_drop", {video});
   config.capture.pacing = capture::Pacing::kRealtime;
   for (auto& camera : config.cameras) camera.source->loop = true;

@@ -8,6 +8,8 @@
 
 #include "daemon/config/config.hpp"
 #include "daemon/config/rig_yaml.hpp"
+#include "daemon/outputs/snapshot/snapshot_output.hpp"
+#include "daemon/outputs/video/video_output.hpp"
 
 namespace surroundd::daemon {
 
@@ -43,14 +45,24 @@ inline OutputConfig snapshotAt(const std::filesystem::path& path, OutputStream s
   snapshot.kind = OutputKind::kSnapshot;
   snapshot.stream = stream;
   snapshot.path = path;
-  snapshot.atSeconds = atSeconds;
+  snapshot.settings = OutputSettings(SnapshotOutputSettings{atSeconds});
   return snapshot;
 }
 
 // One video output (a single file) at `path`.
-inline OutputConfig videoOutputAt(const std::filesystem::path& path) {
+inline OutputConfig videoOutputAt(const std::filesystem::path& path,
+                                  VideoOutputSettings settings = {}) {
   OutputConfig video;
   video.path = path;
+  video.settings = OutputSettings(std::move(settings));
+  return video;
+}
+
+// H.264 at crf 0 on BGR: each picture as it was handed over, bit for bit.
+inline VideoOutputSettings losslessBgr() {
+  VideoOutputSettings video;
+  video.h264.crf = 0;
+  video.h264.pixelFormat = "bgr24";
   return video;
 }
 

@@ -13,6 +13,7 @@
 #include "capture/file_source.hpp"
 #include "daemon/config/rig_yaml.hpp"
 #include "daemon/pipeline.hpp"
+#include "tests/daemon/replay_config.hpp"
 #include "tests/support/temp_dir.hpp"
 
 namespace surroundd::daemon {
@@ -49,12 +50,7 @@ class ReplayTest : public ::testing::Test {
     config_.capture.pacing = capture::Pacing::kAsFastAsPossible;
     config_.render.widthPx = 320;
     config_.render.heightPx = 180;
-    OutputConfig snapshot;
-    snapshot.kind = OutputKind::kSnapshot;
-    snapshot.stream = stream;
-    snapshot.path = file;
-    snapshot.atSeconds = 1e6;
-    config_.outputs = {snapshot};
+    config_.outputs = {snapshotAt(file, stream, 1e6)};
   }
 
   Config config_;
@@ -151,12 +147,7 @@ class HoldUntilQueued final : public PipelineObserver {
 TEST_F(ReplayTest, LatestWinsSkipsStaleSetsAndCountsThem) {
   const testing::TempDir dir;
   config_.capture.pacing = capture::Pacing::kAsFastAsPossible;
-  OutputConfig panorama;
-  panorama.kind = OutputKind::kSnapshot;
-  panorama.stream = OutputStream::kPanorama;
-  panorama.path = dir / "last.png";
-  panorama.atSeconds = 1e6;
-  config_.outputs = {panorama};
+  config_.outputs = {snapshotAt(dir / "last.png", OutputStream::kPanorama, 1e6)};
   const auto replay = [&](CaptureConfig::LatestWins latestWins) {
     config_.capture.latestWins = latestWins;
     Pipeline pipeline(config_);

@@ -101,13 +101,14 @@ TEST(ViewTableTest, AViewSwitchedToIsDrawnWhileItsTableIsMadeBesideTheSets) {
 // 4:2:0 costs the sharp edges.
 TEST(ViewTableTest, AFixedViewForA420VideoIsMadeInI420AsItsBgrPicture) {
   const testing::TempDir dir;
-  OutputConfig yuv = videoOutputAt(dir / "yuv.mkv");
+  VideoOutputSettings lossless420 = losslessBgr();
+  lossless420.h264.pixelFormat = "yuv420p";
+  OutputConfig yuv = videoOutputAt(dir / "yuv.mkv", lossless420);
   yuv.stream = OutputStream::kSurround;
   yuv.view = ViewKind::kTop;
-  yuv.crf = 0;
-  OutputConfig rgb = yuv;
-  rgb.path = dir / "rgb.mkv";
-  rgb.pixelFormat = "bgr24";
+  OutputConfig rgb = videoOutputAt(dir / "rgb.mkv", losslessBgr());
+  rgb.stream = OutputStream::kSurround;
+  rgb.view = ViewKind::kTop;
   Config config = fixtureReplay("synth_small", {yuv, rgb});
   config.pipeline.threads = 2;
   std::atomic<bool> stop{false};

@@ -73,6 +73,15 @@ expect "the config including an output kind" \
   "daemon/config/loader.cpp:1: includes daemon/outputs/built_in_outputs.hpp"
 
 clean
+# An output kind uses what the kinds share, never another kind.
+mkdir -p "$work/tree/daemon/config" "$work/tree/daemon/outputs/video" "$work/tree/daemon/outputs/http"
+printf '#pragma once\n' >"$work/tree/daemon/outputs/h264_settings.hpp"
+printf '#include "daemon/outputs/h264_settings.hpp"\n' >"$work/tree/daemon/outputs/video/video_output.cpp"
+printf '#include "daemon/outputs/video/video_output.hpp"\n' >"$work/tree/daemon/outputs/http/http_output.cpp"
+expect "an output kind including another" \
+  "daemon/outputs/http/http_output.cpp:1: includes daemon/outputs/video/video_output.hpp"
+
+clean
 mkdir -p "$work/tree/tools/calibrate"
 printf '#include "tools/synth/y.hpp"\n' >"$work/tree/tools/calibrate/c.cpp"
 expect "a tool including another" "tools/calibrate/c.cpp:1: includes tools/synth/y.hpp"

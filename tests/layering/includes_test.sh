@@ -14,7 +14,10 @@ cd "$root"
 # shellcheck disable=SC2116 # echo joins the lines into one list of words
 below_daemon=$(echo common capture vehicle processing processing/stitch processing/colour \
   processing/calibration render render/outputs)
-libraries="$below_daemon daemon/control daemon/config daemon/outputs daemon daemon/stages"
+# One folder per output kind (daemon/outputs/<kind>), each a part of surroundd_output_kinds.
+output_kinds=$(find daemon/outputs -mindepth 1 -type d 2>/dev/null | sort | tr '\n' ' ')
+libraries="$below_daemon daemon/control daemon/config daemon/outputs $output_kinds daemon \
+  daemon/stages"
 
 # folder: the folders its headers and sources may include from (besides its own).
 allowed() {
@@ -27,10 +30,12 @@ allowed() {
     render/outputs) echo "common render" ;;
     # The daemon: its control protocol stands alone; its config reads into every part's
     # settings; the output kinds are registered into the config's registry; the runtime (its
-    # stages and the rest of it, one part) wires every part together.
+    # stages and the rest of it, one part) wires every part together. An output kind uses what
+    # the kinds share, never another kind; their list names each.
     daemon/control) echo "common" ;;
     daemon/config) echo "$below_daemon" ;;
-    daemon/outputs) echo "$below_daemon daemon/config" ;;
+    daemon/outputs) echo "$below_daemon daemon/config $output_kinds" ;;
+    daemon/outputs/*) echo "$below_daemon daemon/config daemon/outputs" ;;
     daemon | daemon/stages) echo "$libraries" ;;
     # The tools use the libraries, never one another, but the benchmark measures on the
     # generator's recordings; a tool's own folders (one per command) are one part.

@@ -16,6 +16,8 @@
 
 #include "daemon/config/logging.hpp"
 #include "daemon/config/rig_yaml.hpp"
+#include "daemon/outputs/video/video_output.hpp"
+#include "daemon/outputs/window/window_output.hpp"
 #include "daemon/pipeline.hpp"
 #include "render/gpu_timer.hpp"
 #include "tools/bench/recording_truth.hpp"
@@ -110,11 +112,15 @@ daemon::Config configFor(const std::filesystem::path& folder, const RecordingTru
   output.stream = daemon::OutputStream::kSurround;
   if (options.output == BenchOutput::kVideo) {
     output.path = scratch / "surround.mp4";
-    output.preset = "ultrafast";
+    daemon::VideoOutputSettings video;
+    video.h264.preset = "ultrafast";
+    output.settings = daemon::OutputSettings(video);
   } else {
     output.kind = daemon::OutputKind::kWindow;
-    output.present = options.output == BenchOutput::kEglWindow ? daemon::ViewPresent::kEgl
+    daemon::WindowOutputSettings window;
+    window.present = options.output == BenchOutput::kEglWindow ? daemon::ViewPresent::kEgl
                                                                : daemon::ViewPresent::kPicture;
+    output.settings = daemon::OutputSettings(window);
   }
   config.outputs = {output};
   return config;

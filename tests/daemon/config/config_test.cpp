@@ -11,6 +11,13 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include "daemon/outputs/display/display_output.hpp"
+#include "daemon/outputs/http/http_output.hpp"
+#include "daemon/outputs/recording/recording_output.hpp"
+#include "daemon/outputs/rtsp/rtsp_output.hpp"
+#include "daemon/outputs/snapshot/snapshot_output.hpp"
+#include "daemon/outputs/video/video_output.hpp"
+#include "daemon/outputs/window/window_output.hpp"
 #include "tests/daemon/config/config_test_support.hpp"
 #include "tests/support/temp_dir.hpp"
 
@@ -37,9 +44,9 @@ TEST_F(ConfigTest, GoodConfigLoads) {
   EXPECT_DOUBLE_EQ(config.capture.syncToleranceMs, 5.0);
   ASSERT_EQ(config.outputs.size(), 2u);
   EXPECT_EQ(config.outputs[0].path, dir_ / "out/mosaic.mp4");
-  EXPECT_EQ(config.outputs[0].crf, 18);
+  EXPECT_EQ(settingsOf<VideoOutputSettings>(config.outputs[0]).h264.crf, 18);
   EXPECT_EQ(config.outputs[1].kind, OutputKind::kSnapshot);
-  EXPECT_DOUBLE_EQ(config.outputs[1].atSeconds, 0.5);
+  EXPECT_DOUBLE_EQ(settingsOf<SnapshotOutputSettings>(config.outputs[1]).atSeconds, 0.5);
   EXPECT_EQ(config.panorama.widthPx, PanoramaConfig{}.widthPx);  // absent sections keep defaults
 }
 
@@ -135,8 +142,8 @@ TEST_F(ConfigTest, ARecordingIsAFolder) {
   ASSERT_EQ(config.outputs.size(), 3u);
   EXPECT_EQ(config.outputs[2].kind, OutputKind::kRecording);
   EXPECT_EQ(config.outputs[2].path, dir_ / "out/drive");
-  EXPECT_FALSE(config.outputs[2].lossless);
-  EXPECT_EQ(config.outputs[2].crf, 20);
+  EXPECT_FALSE(settingsOf<RecordingOutputSettings>(config.outputs[2]).lossless);
+  EXPECT_EQ(settingsOf<RecordingOutputSettings>(config.outputs[2]).h264.crf, 20);
   expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
                  "  - {type: recording, path: front.mkv}",
                  {"outputs[1].path: expected a folder for the recording, got the file"});
@@ -152,17 +159,18 @@ TEST_F(ConfigTest, SegmentedVideoNetworkStreamAndTheControlSocket) {
                  "  - {type: network, stream: surround, url: \"udp://239.0.0.1:5600\", crf: 28}\n"
                  "control: {socket: run/control.sock}"));
   ASSERT_EQ(config.outputs.size(), 3u);
-  EXPECT_DOUBLE_EQ(config.outputs[1].segmentS, 60.0);
+  EXPECT_DOUBLE_EQ(settingsOf<VideoOutputSettings>(config.outputs[1]).segmentS, 60.0);
   EXPECT_EQ(config.outputs[2].kind, OutputKind::kNetwork);
-  EXPECT_EQ(config.outputs[2].url, "udp://239.0.0.1:5600");
-  EXPECT_EQ(config.outputs[2].crf, 28);
-  EXPECT_EQ(config.outputs[1].encoder, "auto");
+  EXPECT_EQ(settingsOf<NetworkOutputSettings>(config.outputs[2]).url, "udp://239.0.0.1:5600");
+  EXPECT_EQ(settingsOf<NetworkOutputSettings>(config.outputs[2]).h264.crf, 28);
+  EXPECT_EQ(settingsOf<VideoOutputSettings>(config.outputs[1]).h264.encoder, "auto");
   EXPECT_TRUE(config.outputs[2].path.empty());
   // The H.264 encoder by name: one this FFmpeg has, and H.264.
-  EXPECT_EQ(loadConfig(configWith("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
-                                  "  - {type: video, path: out/a.mp4, encoder: libx264}"))
-                .outputs[1]
-                .encoder,
+  EXPECT_EQ(settingsOf<VideoOutputSettings>(
+                loadConfig(configWith("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
+                                      "  - {type: video, path: out/a.mp4, encoder: libx264}"))
+                    .outputs[1])
+                .h264.encoder,
             "libx264");
   expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
                  "  - {type: video, path: out/a.mp4, encoder: h264_warp}",
@@ -188,14 +196,17 @@ TEST_F(ConfigTest, SegmentedVideoNetworkStreamAndTheControlSocket) {
                  "crf: 30, password_file: viewers.pw}"));
   ASSERT_EQ(pages.outputs.size(), 7u);
   EXPECT_EQ(pages.outputs[1].kind, OutputKind::kHttp);
-  EXPECT_EQ(pages.outputs[1].listenAddress, "0.0.0.0");
-  EXPECT_EQ(pages.outputs[1].listenPort, 9000);
-  EXPECT_EQ(pages.outputs[1].jpegQuality, 60);
-  ASSERT_TRUE(pages.outputs[1].credentials.has_value());
-  EXPECT_EQ(pages.outputs[1].credentials->user, "driver");
-  EXPECT_EQ(pages.outputs[1].credentials->password, "correct horse battery");
-  EXPECT_EQ(pages.outputs[6].credentials, pages.outputs[1].credentials);
-  EXPECT_FALSE(pages.outputs[3].credentials.has_value());  // 127.0.0.1: none asked
+  EXPECT_EQ(settingsOf<HttpOutputSettings>(pages.outputs[1]).server.address, "0.0.0.0");
+  EXPECT_EQ(settingsOf<HttpOutputSettings>(pages.outputs[1]).server.port, 9000);
+  EXPECT_EQ(settingsOf<HttpOutputSettings>(pages.outputs[1]).jpegQuality, 60);
+  ASSERT_TRUE(settingsOf<HttpOutputSettings>(pages.outputs[1]).server.credentials.has_value());
+  EXPECT_EQ(settingsOf<HttpOutputSettings>(pages.outputs[1]).server.credentials->user, "driver");
+  EXPECT_EQ(settingsOf<HttpOutputSettings>(pages.outputs[1]).server.credentials->password,
+            "correct horse battery");
+  EXPECT_EQ(settingsOf<RtspOutputSettings>(pages.outputs[6]).server.credentials,
+            settingsOf<HttpOutputSettings>(pages.outputs[1]).server.credentials);
+  EXPECT_FALSE(settingsOf<HttpOutputSettings>(pages.outputs[3])
+                   .server.credentials.has_value());  // 127.0.0.1: none asked
   expectOneError("  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
                  "  - {type: http, listen: \"0.0.0.0:9000\"}",
                  {"outputs[1].listen: listens on 0.0.0.0, beyond this machine, and no "
@@ -211,21 +222,23 @@ TEST_F(ConfigTest, SegmentedVideoNetworkStreamAndTheControlSocket) {
                   "viewers.pw: others than its owner may read or "
                   "change it (mode 640): chmod 600 it"});
   EXPECT_EQ(pages.outputs[2].kind, OutputKind::kWindow);
-  EXPECT_EQ(pages.outputs[2].display, ":3");
-  EXPECT_EQ(pages.outputs[2].title, "rig");
-  EXPECT_EQ(pages.outputs[3].listenAddress, "127.0.0.1");  // only this machine by default
-  EXPECT_EQ(pages.outputs[3].listenPort, 8080);
+  EXPECT_EQ(settingsOf<WindowOutputSettings>(pages.outputs[2]).display, ":3");
+  EXPECT_EQ(settingsOf<WindowOutputSettings>(pages.outputs[2]).title, "rig");
+  EXPECT_EQ(settingsOf<HttpOutputSettings>(pages.outputs[3]).server.address,
+            "127.0.0.1");  // only this machine by default
+  EXPECT_EQ(settingsOf<HttpOutputSettings>(pages.outputs[3]).server.port, 8080);
   EXPECT_EQ(pages.outputs[4].kind, OutputKind::kDisplay);
-  EXPECT_EQ(pages.outputs[4].device, "/dev/dri/card1");
-  EXPECT_EQ(pages.outputs[4].connector, "HDMI-A-1");
+  EXPECT_EQ(settingsOf<DisplayOutputSettings>(pages.outputs[4]).device, "/dev/dri/card1");
+  EXPECT_EQ(settingsOf<DisplayOutputSettings>(pages.outputs[4]).connector, "HDMI-A-1");
   EXPECT_EQ(pages.outputs[5].kind, OutputKind::kRtsp);
-  EXPECT_EQ(pages.outputs[5].listenAddress, "127.0.0.1");
-  EXPECT_EQ(pages.outputs[5].listenPort, 8554);  // RTSP's own port by default
-  EXPECT_EQ(pages.outputs[5].rtspName, "");      // named by what it shows
-  EXPECT_EQ(pages.outputs[6].listenAddress, "0.0.0.0");
-  EXPECT_EQ(pages.outputs[6].listenPort, 9554);
-  EXPECT_EQ(pages.outputs[6].rtspName, "cameras");
-  EXPECT_EQ(pages.outputs[6].crf, 30);
+  EXPECT_EQ(settingsOf<RtspOutputSettings>(pages.outputs[5]).server.address, "127.0.0.1");
+  EXPECT_EQ(settingsOf<RtspOutputSettings>(pages.outputs[5]).server.port,
+            8554);  // RTSP's own port by default
+  EXPECT_EQ(settingsOf<RtspOutputSettings>(pages.outputs[5]).name, "");  // named by what it shows
+  EXPECT_EQ(settingsOf<RtspOutputSettings>(pages.outputs[6]).server.address, "0.0.0.0");
+  EXPECT_EQ(settingsOf<RtspOutputSettings>(pages.outputs[6]).server.port, 9554);
+  EXPECT_EQ(settingsOf<RtspOutputSettings>(pages.outputs[6]).name, "cameras");
+  EXPECT_EQ(settingsOf<RtspOutputSettings>(pages.outputs[6]).h264.crf, 30);
   expectOneError(
       "  - {type: snapshot, path: out/mosaic.png, at_s: 0.5}",
       "  - {type: http, listen: \"localhost\"}",
@@ -451,10 +464,12 @@ TEST(ReferenceConfig, DocumentsTheDefaults) {
   ASSERT_EQ(config.outputs.size(), 2u);
   OutputConfig video;
   video.path = config.outputs[0].path;
+  video.settings = OutputSettings(VideoOutputSettings{});
   EXPECT_EQ(config.outputs[0], video);
   OutputConfig snapshot;
   snapshot.kind = OutputKind::kSnapshot;
   snapshot.path = config.outputs[1].path;
+  snapshot.settings = OutputSettings(SnapshotOutputSettings{});
   EXPECT_EQ(config.outputs[1], snapshot);
 }
 

@@ -140,6 +140,7 @@ TEST(OutputFiles, RetentionRemovesTheOldestOfTheFamilyNeverTheOneBeingWritten) {
   }
   const auto family = render::numberedFiles(dir / "drive.mp4");
   std::vector<std::string> names;
+  names.reserve(family.size());
   for (const auto& file : family) names.push_back(file.path.filename().string());
   EXPECT_THAT(names, ::testing::ElementsAre("drive.mp4", "drive-1.mp4", "drive-2.mp4.part",
                                             "drive-10.mp4"));
@@ -164,11 +165,13 @@ TEST(OutputFiles, RetentionRemovesTheOldestOfTheFamilyNeverTheOneBeingWritten) {
 // is the newest, each whole.
 TEST(OutputFiles, RestartsAndSegmentsStayWithinTheirRetention) {
   const testing::TempDir dir;
-  OutputConfig runs = videoOutputAt(dir / "whole.mkv");
-  runs.keepLast = 3;
-  OutputConfig segments = videoOutputAt(dir / "seg.mkv");
-  segments.segmentS = 0.25;
-  segments.keepLast = 2;
+  VideoOutputSettings lastThree;
+  lastThree.keepLast = 3;
+  VideoOutputSettings lastTwoSegments;
+  lastTwoSegments.segmentS = 0.25;
+  lastTwoSegments.keepLast = 2;
+  const OutputConfig runs = videoOutputAt(dir / "whole.mkv", lastThree);
+  const OutputConfig segments = videoOutputAt(dir / "seg.mkv", lastTwoSegments);
   const Config config = fixtureReplay("synth_small", {runs, segments});
   const std::atomic<bool> stop{false};
   for (int run = 0; run < 10; ++run) {

@@ -69,14 +69,12 @@ class TallySink final : public render::FrameSink {
 OutputType tallyType() {
   OutputType type;
   type.name = "tally";
-  type.readSettings = [](YamlObject& item, OutputConfig& output) {
-    TallySettings settings;
-    settings.every = item.integer("every", settings.every, 1, 100);
-    output.other = OtherOutputSettings(settings);
-  };
+  readsSettings<TallySettings>(
+      type, {ConfigKey<TallySettings>::integer("every", &TallySettings::every, 1, 100,
+                                               "every this many pictures is kept")});
   type.openPictureSink = [](const OutputConfig& output, const OutputContext& context) {
     ++tally().opened;
-    return queuedSink(std::make_unique<TallySink>(*output.other.get<TallySettings>()), context, 2);
+    return queuedSink(std::make_unique<TallySink>(settingsOf<TallySettings>(output)), context, 2);
   };
   return type;
 }
@@ -105,11 +103,12 @@ TEST_F(ConfigTest, ATypeRegisteredFromOutsideReadsItsOwnKeys) {
   const Config config = loadConfig(configWith(snapshot, "{type: tally, every: 3}"));
   ASSERT_EQ(config.outputs.size(), 2u);
   EXPECT_EQ(config.outputs[1].kind, OutputKind{"tally"});
-  ASSERT_NE(config.outputs[1].other.get<TallySettings>(), nullptr);
-  EXPECT_EQ(config.outputs[1].other.get<TallySettings>()->every, 3);
-  EXPECT_EQ(config.outputs[0].other.get<TallySettings>(), nullptr);  // a video has none
-  EXPECT_EQ(loadConfig(configWith(snapshot, "{type: tally}")).outputs[1].other,
-            OtherOutputSettings(TallySettings{}));
+  ASSERT_NE(config.outputs[1].settings.get<TallySettings>(), nullptr);
+  EXPECT_EQ(config.outputs[1].settings.get<TallySettings>()->every, 3);
+  EXPECT_EQ(config.outputs[0].settings.get<TallySettings>(), nullptr);  // a snapshot's are not
+  EXPECT_THROW(settingsOf<TallySettings>(config.outputs[0]), std::logic_error);
+  EXPECT_EQ(loadConfig(configWith(snapshot, "{type: tally}")).outputs[1].settings,
+            OutputSettings(TallySettings{}));
 
   expectOneError(snapshot, "{type: tally, every: 0}",
                  {"outputs[1].every: expected a whole number in [1, 100]"});
@@ -134,7 +133,7 @@ TEST(OutputType, ANameIsRegisteredOnce) {
   EXPECT_THROW(registerOutputType(tallyType()), std::logic_error);
   OutputType noFactory;
   noFactory.name = "nothing";
-  noFactory.readSettings = [](YamlObject&, OutputConfig&) {};
+  noFactory.readSettings = [](YamlObject&, const OutputConfig&) { return OutputSettings(); };
   EXPECT_THROW(registerOutputType(noFactory), std::logic_error);
   EXPECT_EQ(findOutputType("nothing"), nullptr);
 }

@@ -215,7 +215,7 @@ TEST(ReferenceConfig, DocumentsEveryOutputTypesKeys) {
   for (const std::string_view name : outputTypeNames()) {
     const OutputType& type = *findOutputType(name);
     if (!type.leftOut.empty()) continue;
-    const auto docs = type.keys.docs();
+    const auto docs = ownKeyDocs(type);
     std::vector<ReferenceKey> entry;
     std::ranges::copy_if(keys, std::back_inserter(entry), [&](const ReferenceKey& k) {
       return k.section == "outputs" && k.block == name;

@@ -5,6 +5,8 @@
 // video of the same view holds (the last, unless a flip was still pending), and the snapshot reads
 // the last one back. Anywhere: the config's rules for it and a card that cannot be opened.
 
+#include "daemon/outputs/display/display_output.hpp"
+
 #include <atomic>
 #include <limits>
 #include <string>
@@ -35,8 +37,8 @@ OutputConfig eglDisplay(const std::filesystem::path& card) {
   display.kind = OutputKind::kDisplay;
   display.stream = OutputStream::kSurround;
   display.view = ViewKind::kOrbit;
-  display.device = card;
-  display.present = ViewPresent::kEgl;
+  display.settings = OutputSettings(
+      DisplayOutputSettings{.device = card, .connector = "", .present = ViewPresent::kEgl});
   return display;
 }
 
@@ -45,11 +47,9 @@ using DisplayOutputOnAScreen = testing::KmsScreenTest;
 TEST_F(DisplayOutputOnAScreen, AnEglDisplayShowsTheSetsViewsAsALosslessVideoOfThemHasThem) {
   const std::filesystem::path& card = card_;
   const testing::TempDir dir;
-  OutputConfig video = videoOutputAt(dir.path() / "orbit.mkv");
+  OutputConfig video = videoOutputAt(dir.path() / "orbit.mkv", losslessBgr());
   video.stream = OutputStream::kSurround;
   video.view = ViewKind::kOrbit;
-  video.crf = 0;
-  video.pixelFormat = "bgr24";
   Config config = fixtureReplay("synth_small", {video, eglDisplay(card)});
   config.panorama.cacheDir = dir.path() / "cache";
   const std::atomic<bool> stop{false};

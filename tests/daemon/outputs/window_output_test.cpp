@@ -4,6 +4,8 @@
 // picture that a lossless video of the same view holds, and what a snapshot reads back. And the
 // config's rules for it.
 
+#include "daemon/outputs/window/window_output.hpp"
+
 #include <atomic>
 #include <string>
 #include <vector>
@@ -29,18 +31,15 @@ using ::testing::HasSubstr;
 TEST(WindowOutput, AnEglWindowShowsEachSetsViewAsALosslessVideoOfItHasIt) {
   const testing::XvfbServer server;
   const testing::TempDir dir;
-  OutputConfig video = videoOutputAt(dir.path() / "orbit.mkv");
+  OutputConfig video = videoOutputAt(dir.path() / "orbit.mkv", losslessBgr());
   video.stream = OutputStream::kSurround;
   video.view = ViewKind::kOrbit;
-  video.crf = 0;
-  video.pixelFormat = "bgr24";
   OutputConfig window;
   window.kind = OutputKind::kWindow;
   window.stream = OutputStream::kSurround;
   window.view = ViewKind::kOrbit;
-  window.display = server.display();
-  window.title = "surroundd egl";
-  window.present = ViewPresent::kEgl;
+  window.settings = OutputSettings(WindowOutputSettings{
+      .display = server.display(), .title = "surroundd egl", .present = ViewPresent::kEgl});
   const Config config = fixtureReplay("synth_small", {video, window});
   const testing::X11Observer observer(server.display());
   const std::atomic<bool> stop{false};
@@ -73,8 +72,8 @@ TEST(WindowOutput, AnEglWindowOnAServerThatCannotBeReachedIsNamed) {
   OutputConfig window;
   window.kind = OutputKind::kWindow;
   window.stream = OutputStream::kSurround;
-  window.display = ":97";
-  window.present = ViewPresent::kEgl;
+  window.settings = OutputSettings(
+      WindowOutputSettings{.display = ":97", .title = "surroundd", .present = ViewPresent::kEgl});
   const Config config = fixtureReplay("synth_small", {window});
   const testing::LogCapture capture;
   EXPECT_THAT([&] { const Pipeline pipeline(config); },

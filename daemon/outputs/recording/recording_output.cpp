@@ -1,16 +1,16 @@
-// The `recording` output: every camera's own stream into a folder, with a rig file that replays
-// it (RigRecorder).
+#include "daemon/outputs/recording/recording_output.hpp"
+
 #include <filesystem>
 
 #include <fmt/format.h>
 
-#include "daemon/outputs/built_in_outputs.hpp"
-#include "daemon/outputs/rig_recorder.hpp"
+#include "daemon/outputs/recording/rig_recorder.hpp"
 
 namespace surroundd::daemon {
 namespace {
 
-void checkRecording(YamlObject& item, OutputConfig& o) {
+void checkRecording(YamlObject& item, const OutputConfig& o,
+                    const RecordingOutputSettings& /*settings*/) {
   if (item.has("stream")) {
     item.error("stream", "a recording writes every camera's own stream; it takes no 'stream'");
   }
@@ -24,8 +24,9 @@ void checkRecording(YamlObject& item, OutputConfig& o) {
 
 std::unique_ptr<CameraFramesSink> openRecording(const OutputConfig& output,
                                                 const OutputContext& context) {
+  const auto& own = settingsOf<RecordingOutputSettings>(output);
   return std::make_unique<RigRecorder>(
-      RecordingSettings{output.path, output.lossless, output.crf, output.preset}, *context.cameras,
+      RecordingSettings{output.path, own.lossless, own.h264.crf, own.h264.preset}, *context.cameras,
       context.nominalFps);
 }
 
@@ -35,13 +36,15 @@ OutputType recordingOutputType() {
   OutputType type;
   type.name = "recording";
   type.input = OutputInput::kCameraFrames;
-  using Key = ConfigKey<OutputConfig>;
-  type.keys = {
-      Key::requiredPath("path", &OutputConfig::path, "the folder written"),
-      Key::flag("lossless", &OutputConfig::lossless, "bit for bit"),
-      crfKey(),
-  };
-  type.readSettings = checkRecording;
+  type.pathDoc = "the folder written";
+  readsSettings<RecordingOutputSettings>(
+      type,
+      {
+          ConfigKey<RecordingOutputSettings>::flag("lossless", &RecordingOutputSettings::lossless,
+                                                   "bit for bit"),
+          crfKey<RecordingOutputSettings>(),
+      },
+      checkRecording);
   type.pathUse = [](const OutputConfig&) { return OutputPathUse::kFolder; };
   type.openCameraFramesSink = openRecording;
   return type;

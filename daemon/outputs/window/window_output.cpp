@@ -1,11 +1,8 @@
-// The `window` output: an X11 window on a desk. With `present: picture` (render::X11WindowSink)
-// it is handed each picture read back, and shows it from a thread of its own behind a queue; with
-// `present: egl` (render::EglWindowSink) it shows the surround view as OpenGL drew it, on the
-// renderer's thread, through EGL: the renderer's context is then made on the window's X server.
+#include "daemon/outputs/window/window_output.hpp"
+
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include "daemon/outputs/built_in_outputs.hpp"
 #include "render/outputs/egl_window_sink.hpp"
 #include "render/outputs/x11_window_sink.hpp"
 
@@ -20,13 +17,14 @@ constexpr std::size_t kWindowQueue = 1;
 
 std::unique_ptr<render::FrameSink> openWindow(const OutputConfig& output,
                                               const OutputContext& context) {
-  render::X11WindowSettings settings{output.display, output.title, context.pictureSize};
-  if (output.present == ViewPresent::kPicture) {
+  const auto& own = settingsOf<WindowOutputSettings>(output);
+  render::X11WindowSettings settings{own.display, own.title, context.pictureSize};
+  if (own.present == ViewPresent::kPicture) {
     return queuedSink(std::make_unique<render::X11WindowSink>(std::move(settings)), context,
                       kWindowQueue);
   }
   const std::string shown =
-      fmt::format("window on {}", output.display.empty() ? "$DISPLAY" : output.display);
+      fmt::format("window on {}", own.display.empty() ? "$DISPLAY" : own.display);
   render::EglContext& gl =
       presentingRenderer(context, render::EglPlatform::kX11, shown, "X server");
   if (gl.software()) {
@@ -41,19 +39,26 @@ std::unique_ptr<render::FrameSink> openWindow(const OutputConfig& output,
 // The renderer's context on the X server of a window that shows the views through EGL; it keeps
 // its own connection there.
 std::unique_ptr<render::EglContext> openRendererOnServer(const OutputConfig& output) {
-  if (output.present != ViewPresent::kEgl) return nullptr;
-  auto display = std::make_shared<render::XlibDisplay>(output.display);
+  const auto& own = settingsOf<WindowOutputSettings>(output);
+  if (own.present != ViewPresent::kEgl) return nullptr;
+  auto display = std::make_shared<render::XlibDisplay>(own.display);
   void* native = display->get();
   return std::make_unique<render::EglContext>(render::EglPlatform::kX11, native,
                                               std::move(display));
 }
 
-void checkWindow(YamlObject& item, OutputConfig& output) { checkPresent(item, output, "window"); }
+void checkWindow(YamlObject& item, const OutputConfig& output,
+                 const WindowOutputSettings& settings) {
+  checkPresent(item, output, settings.present, "window");
+}
 
 // The renderer draws on one X server: every egl window is on it.
-std::optional<OutputConflict> otherServer(const OutputConfig& earlier, const OutputConfig& output) {
-  if (earlier.present != ViewPresent::kEgl || output.present != ViewPresent::kEgl ||
-      earlier.display == output.display) {
+std::optional<OutputConflict> otherServer(const OutputConfig& earlierOutput,
+                                          const OutputConfig& output) {
+  const auto& earlier = settingsOf<WindowOutputSettings>(earlierOutput);
+  const auto& own = settingsOf<WindowOutputSettings>(output);
+  if (earlier.present != ViewPresent::kEgl || own.present != ViewPresent::kEgl ||
+      earlier.display == own.display) {
     return std::nullopt;
   }
   return OutputConflict{
@@ -67,15 +72,18 @@ std::optional<OutputConflict> otherServer(const OutputConfig& earlier, const Out
 OutputType windowOutputType() {
   OutputType type;
   type.name = "window";
-  using Key = ConfigKey<OutputConfig>;
-  type.keys = {
-      // Empty, its default, is $DISPLAY: the reference shows an example.
-      Key::text("display", &OutputConfig::display, "X display", Shown::kExample),
-      Key::text("title", &OutputConfig::title, "the window's title"),
-      presentKey("how it shows the view: picture (read back, sent to the server) or egl (drawn "
-                 "into the window on the GPU; the renderer then runs on that X server)"),
-  };
-  type.readSettings = checkWindow;
+  using Key = ConfigKey<WindowOutputSettings>;
+  readsSettings<WindowOutputSettings>(
+      type,
+      {
+          // Empty, its default, is $DISPLAY: the reference shows an example.
+          Key::text("display", &WindowOutputSettings::display, "X display", Shown::kExample),
+          Key::text("title", &WindowOutputSettings::title, "the window's title"),
+          presentKey<WindowOutputSettings>(
+              "how it shows the view: picture (read back, sent to the server) or egl (drawn into "
+              "the window on the GPU; the renderer then runs on that X server)"),
+      },
+      checkWindow);
   type.conflict = otherServer;
   type.openPictureSink = openWindow;
   type.openRenderer = openRendererOnServer;

@@ -1,4 +1,4 @@
-#include "daemon/outputs/rig_recorder.hpp"
+#include "daemon/outputs/recording/rig_recorder.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
