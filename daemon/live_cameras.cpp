@@ -15,7 +15,7 @@ namespace {
 constexpr std::string_view kAuto = "auto";
 
 std::string where(const RigCamera& camera) {
-  return fmt::format("camera '{}': {}", camera.calibration.name, camera.device->device.string());
+  return fmt::format("camera '{}': {}", camera.calibration.name, camera.v4l2()->device.string());
 }
 
 // The capture nodes, in number order.
@@ -94,7 +94,7 @@ void listCameras(std::ostream& out, const std::filesystem::path& dev) {
 std::vector<RigCamera> withAutoDevices(std::vector<RigCamera> cameras,
                                        std::vector<std::string>& said,
                                        const std::filesystem::path& dev) {
-  const auto wantsAuto = [](const RigCamera& c) { return c.device && c.device->device == kAuto; };
+  const auto wantsAuto = [](const RigCamera& c) { return c.v4l2() && c.v4l2()->device == kAuto; };
   if (std::ranges::none_of(cameras, wantsAuto)) return cameras;
   const auto nodes = captureNodes(dev);
   auto next = nodes.begin();
@@ -102,8 +102,8 @@ std::vector<RigCamera> withAutoDevices(std::vector<RigCamera> cameras,
     if (!wantsAuto(camera)) continue;
     const auto named = [&](const capture::V4l2Node& node) {
       return std::ranges::any_of(cameras, [&](const RigCamera& other) {
-        return other.device && other.device->device != kAuto &&
-               sameNode(other.device->device, node.path);
+        return other.v4l2() && other.v4l2()->device != kAuto &&
+               sameNode(other.v4l2()->device, node.path);
       });
     };
     while (next != nodes.end() && named(*next)) ++next;
@@ -117,7 +117,7 @@ std::vector<RigCamera> withAutoDevices(std::vector<RigCamera> cameras,
           camera.calibration.name, nodes.size(),
           found.empty() ? "" : fmt::format(": {}", fmt::join(found, ", "))));
     }
-    camera.device->device = next->path;
+    camera.v4l2()->device = next->path;
     said.push_back(fmt::format("camera '{}': device auto is {}{}", camera.calibration.name,
                                next->path.string(),
                                next->persistentNames.empty()
@@ -131,16 +131,16 @@ std::vector<RigCamera> withAutoDevices(std::vector<RigCamera> cameras,
 std::vector<std::string> cameraDeviceProblems(const std::vector<RigCamera>& cameras) {
   std::vector<std::string> problems;
   for (const auto& camera : cameras) {
-    if (!camera.device) continue;
+    if (!camera.v4l2()) continue;
     const auto device = capture::makeKernelV4l2Device();
     try {
-      const auto probe = capture::probeV4l2(camera.device->device, where(camera), *device);
+      const auto probe = capture::probeV4l2(camera.v4l2()->device, where(camera), *device);
       if (!probe.capture) {
         problems.push_back(fmt::format("{} ('{}', driver {}): cannot capture video by streaming",
                                        where(camera), probe.card, probe.driver));
-      } else if (capture::chooseV4l2Format(probe, *camera.device) == nullptr) {
+      } else if (capture::chooseV4l2Format(probe, *camera.v4l2()) == nullptr) {
         problems.push_back(
-            fmt::format("{}: {}", where(camera), capture::notOffered(probe, *camera.device)));
+            fmt::format("{}: {}", where(camera), capture::notOffered(probe, *camera.v4l2())));
       }
     } catch (const capture::CaptureError& error) {
       problems.emplace_back(error.what());

@@ -5,6 +5,7 @@
 #include <future>
 #include <span>
 #include <utility>
+#include <variant>
 
 #include <spdlog/spdlog.h>
 
@@ -12,6 +13,7 @@
 #include "capture/libcamera_source.hpp"
 #include "capture/preloaded_source.hpp"
 #include "capture/v4l2_source.hpp"
+#include "common/overloaded.hpp"
 #include "daemon/live_cameras.hpp"
 
 namespace surroundd::daemon {
@@ -22,13 +24,10 @@ constexpr double kBytesPerMib = 1024.0 * 1024.0;
 // A file preloaded into memory, allowed what capture.preload_max_mb leaves after the cameras
 // preloaded before it (`before`: their names and bytes).
 std::unique_ptr<capture::PreloadedSource> openPreloaded(
-    const Config& config, const RigCamera& camera,
+    const Config& config, const std::string& camera, capture::PreloadSettings settings,
     std::span<const std::pair<std::string, std::uint64_t>> before,
     std::shared_ptr<capture::ReplayStart> start) {
-  capture::PreloadSettings settings;
-  settings.file = *camera.source;
   settings.file.pacing = config.capture.pacing;
-  settings.format = *camera.preload;
   const auto budget = static_cast<std::uint64_t>(config.capture.preloadMaxMb) << 20;
   std::uint64_t used = 0;
   std::string holders;
@@ -42,8 +41,7 @@ std::unique_ptr<capture::PreloadedSource> openPreloaded(
       "capture.preload_max_mb: {} for every preloaded camera together{}",
       config.capture.preloadMaxMb,
       holders.empty() ? "" : fmt::format(", less what the cameras before it hold: {}", holders));
-  return std::make_unique<capture::PreloadedSource>(camera.calibration.name, settings,
-                                                    std::move(start));
+  return std::make_unique<capture::PreloadedSource>(camera, settings, std::move(start));
 }
 
 }  // namespace
@@ -83,37 +81,46 @@ std::vector<std::unique_ptr<capture::CameraStream>> openCameras(const Config& co
   };
   for (const auto& camera : rig) {
     const auto& name = camera.calibration.name;
-    if (camera.libcamera) {
-      opening.push_back(inTurn([&] {
-        return Opened{std::make_unique<capture::LibcameraSource>(name, *camera.libcamera),
-                      fmt::format("libcamera {}", camera.libcamera->camera)};
-      }));
-    } else if (camera.device) {
-      opening.push_back(std::async(std::launch::async, [&camera, &name] {
-        auto device = std::make_unique<capture::V4l2Source>(name, *camera.device);
-        std::string origin = fmt::format("{} ({})", camera.device->device.string(),
-                                         capture::toString(device->format()));
-        return Opened{std::move(device), std::move(origin)};
-      }));
-    } else if (camera.preload) {
-      opening.push_back(inTurn([&] {
-        auto preloaded = openPreloaded(config, camera, preloadedBytes, replayStart);
-        preloadedBytes.emplace_back(name, preloaded->bytes());
-        std::string origin =
-            fmt::format("{} (preloaded as {}, {:.1f} MiB)", camera.source->path.string(),
-                        capture::toString(*camera.preload),
-                        static_cast<double>(preloaded->bytes()) / kBytesPerMib);
-        return Opened{std::move(preloaded), std::move(origin)};
-      }));
-    } else {
-      opening.push_back(std::async(std::launch::async, [&camera, &config, &name, replayStart] {
-        auto settings = *camera.source;
-        settings.pacing = config.capture.pacing;
-        std::string origin = settings.path.string();
-        return Opened{std::make_unique<capture::FileSource>(name, settings, replayStart),
-                      std::move(origin)};
-      }));
-    }
+    // Every camera has a source: a config without one is refused.
+    std::visit(
+        Overloaded{
+            [&](const capture::FileSourceSettings& file) {
+              opening.push_back(std::async(std::launch::async, [&file, &config, &name,
+                                                                replayStart] {
+                auto settings = file;
+                settings.pacing = config.capture.pacing;
+                std::string origin = settings.path.string();
+                return Opened{std::make_unique<capture::FileSource>(name, settings, replayStart),
+                              std::move(origin)};
+              }));
+            },
+            [&](const capture::PreloadSettings& preload) {
+              opening.push_back(inTurn([&] {
+                auto preloaded = openPreloaded(config, name, preload, preloadedBytes, replayStart);
+                preloadedBytes.emplace_back(name, preloaded->bytes());
+                std::string origin =
+                    fmt::format("{} (preloaded as {}, {:.1f} MiB)", preload.file.path.string(),
+                                capture::toString(preload.format),
+                                static_cast<double>(preloaded->bytes()) / kBytesPerMib);
+                return Opened{std::move(preloaded), std::move(origin)};
+              }));
+            },
+            [&](const capture::V4l2Settings& device) {
+              opening.push_back(std::async(std::launch::async, [&device, &name] {
+                auto opened = std::make_unique<capture::V4l2Source>(name, device);
+                std::string origin = fmt::format("{} ({})", device.device.string(),
+                                                 capture::toString(opened->format()));
+                return Opened{std::move(opened), std::move(origin)};
+              }));
+            },
+            [&](const capture::LibcameraSettings& libcamera) {
+              opening.push_back(inTurn([&] {
+                return Opened{std::make_unique<capture::LibcameraSource>(name, libcamera),
+                              fmt::format("libcamera {}", libcamera.camera)};
+              }));
+            },
+        },
+        *camera.source);
   }
   // In the config's order: the first camera that fails is the one named, as when they opened in
   // turn; the others' threads are waited for (their futures' destruction) and what they opened

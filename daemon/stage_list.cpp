@@ -35,7 +35,7 @@ void lendCameraBuffers(const Config& config, const SurroundStage& surround,
                        std::vector<std::unique_ptr<capture::CameraStream>>& cameras) {
   const std::string& refusal = surround.dmabufImportRefusal();
   for (std::size_t c = 0; c < cameras.size(); ++c) {
-    if (!config.cameras[c].device) continue;
+    if (!config.cameras[c].v4l2()) continue;
     const std::string& name = cameras[c]->name();
     const char* why = refusal.empty() ? cameras[c]->lendBuffers() : refusal.c_str();
     if (why == nullptr) {

@@ -46,7 +46,7 @@ void readRig(YamlObject& root, Config& config) {
   }
   rig->finish();
   for (const auto& camera : config.cameras) {
-    if (!camera.source && !camera.live()) {
+    if (!camera.source) {
       rig->errorHere(fmt::format("camera '{}' has no 'source' (surroundd needs one per camera)",
                                  camera.calibration.name));
     }

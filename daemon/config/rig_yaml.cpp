@@ -66,15 +66,7 @@ std::vector<RigCamera> readRigCameras(YamlObject& rig) {
       health->finish();
     }
     if (auto source = entry.object("source")) {
-      if (source->has("device")) {
-        camera.device = readV4l2Source(*source);
-        camera.device->size = calibration.intrinsics.imageSize;
-      } else if (source->has("libcamera")) {
-        camera.libcamera = readLibcameraSource(*source);
-        camera.libcamera->size = calibration.intrinsics.imageSize;
-      } else {
-        camera.source = readFileSource(*source, camera.preload);
-      }
+      camera.source = readCameraSource(*source, calibration.intrinsics.imageSize);
     }
     if (auto mask = entry.object("body_mask")) {
       camera.bodyMask = readBodyMask(*mask, calibration.intrinsics.imageSize);
@@ -140,53 +132,8 @@ void emitCamera(YAML::Emitter& out, const RigCamera& camera, const std::filesyst
   out << YAML::Key << "role" << YAML::Value
       << (c.role == processing::ColourRole::kSource ? "source" : "target");
   if (camera.source) {
-    const auto& path = camera.source->path;
-    const bool inside = path.parent_path() == folder;
-    out << YAML::Key << "source" << YAML::Value << YAML::Flow << YAML::BeginMap;
-    out << YAML::Key << "file" << YAML::Value << (inside ? path.filename() : path).string();
-    if (camera.source->loop || capture::isStillPicturePath(path)) {
-      out << YAML::Key << "loop" << YAML::Value << camera.source->loop;
-    }
-    if (camera.source->sequenceFps != capture::FileSourceSettings{}.sequenceFps) {
-      out << YAML::Key << "sequence_fps" << YAML::Value << camera.source->sequenceFps;
-    }
-    if (camera.preload) {
-      out << YAML::Key << "preload" << YAML::Value << true;
-      for (const auto& [word, format] : kPreloadFormats) {
-        if (format == *camera.preload) {
-          out << YAML::Key << "format" << YAML::Value << std::string(word);
-        }
-      }
-    }
-    out << YAML::EndMap;
-  }
-  if (camera.libcamera) {
-    const auto& l = *camera.libcamera;
-    out << YAML::Key << "source" << YAML::Value << YAML::Flow << YAML::BeginMap;
-    out << YAML::Key << "libcamera" << YAML::Value << l.camera;
-    out << YAML::Key << "fps" << YAML::Value << l.fps;
-    out << YAML::Key << "buffers" << YAML::Value << l.buffers;
-    out << YAML::Key << "timeout_ms" << YAML::Value << l.timeout.count();
-    out << YAML::EndMap;
-  }
-  if (camera.device) {
-    const auto& d = *camera.device;
-    out << YAML::Key << "source" << YAML::Value << YAML::Flow << YAML::BeginMap;
-    out << YAML::Key << "device" << YAML::Value << d.device.string();
-    for (const auto& [word, format] : kV4l2Formats) {
-      if (format == d.format) out << YAML::Key << "format" << YAML::Value << std::string(word);
-    }
-    out << YAML::Key << "fps" << YAML::Value << d.fps;
-    out << YAML::Key << "buffers" << YAML::Value << d.buffers;
-    out << YAML::Key << "timeout_ms" << YAML::Value << d.timeout.count();
-    if (!d.controls.empty()) {
-      out << YAML::Key << "controls" << YAML::Value << YAML::BeginMap;
-      for (const auto& control : d.controls) {
-        out << YAML::Key << control.name << YAML::Value << control.value;
-      }
-      out << YAML::EndMap;
-    }
-    out << YAML::EndMap;
+    out << YAML::Key << "source" << YAML::Value;
+    writeCameraSource(out, *camera.source, folder);
   }
   out << YAML::Key << "lens" << YAML::Value << YAML::BeginMap;
   emitLensFields(out, c.intrinsics);

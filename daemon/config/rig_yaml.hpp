@@ -33,10 +33,7 @@
 #include <string_view>
 #include <vector>
 
-#include "capture/file_source.hpp"
-#include "capture/libcamera_source.hpp"
-#include "capture/pixel_conversion.hpp"
-#include "capture/v4l2_source.hpp"
+#include "daemon/config/camera_source_yaml.hpp"
 #include "daemon/config/vehicle_yaml.hpp"
 #include "daemon/config/yaml_reader.hpp"
 #include "processing/rig.hpp"
@@ -49,17 +46,33 @@ enum class FrozenCheck { kAuto, kOn, kOff };
 
 struct RigCamera {
   processing::CameraCalibration calibration;
-  // Where the frames come from: a file (replay), or a live V4L2 device. Both absent in rig presets
-  // (generator input).
-  std::optional<capture::FileSourceSettings> source;
-  // With a file source: decoded once at start into memory in this pixel format (YUYV, UYVY or
-  // NV12) and played from there, each frame held as a V4L2 camera's is (capture::PreloadedSource).
-  std::optional<capture::PixelLayout> preload;
-  std::optional<capture::V4l2Settings> device;
-  std::optional<capture::LibcameraSettings> libcamera;
+  // Where the frames come from. None in rig presets (generator input).
+  std::optional<CameraSource> source;
   std::optional<BodyMaskConfig> bodyMask;  // added to or replacing the vehicle's computed mask
   FrozenCheck frozenCheck = FrozenCheck::kAuto;
-  bool live() const { return device.has_value() || libcamera.has_value(); }
+  bool live() const { return source && isLive(*source); }
+  // The file it replays; null for a live camera or one with no source.
+  const capture::FileSourceSettings* replayedFile() const {
+    return source ? daemon::replayedFile(*source) : nullptr;
+  }
+  capture::FileSourceSettings* replayedFile() {
+    return source ? daemon::replayedFile(*source) : nullptr;
+  }
+  // Replays its file decoded once into memory in `format`, or as it plays (none); see
+  // withPreload().
+  void preload(std::optional<capture::PixelLayout> format) {
+    if (source) source = withPreload(*source, format);
+  }
+  std::optional<capture::PixelLayout> preloaded() const {
+    return source ? preloadFormat(*source) : std::nullopt;
+  }
+  // Its V4L2 device; null for any other source.
+  const capture::V4l2Settings* v4l2() const {
+    return source ? std::get_if<capture::V4l2Settings>(&*source) : nullptr;
+  }
+  capture::V4l2Settings* v4l2() {
+    return source ? std::get_if<capture::V4l2Settings>(&*source) : nullptr;
+  }
 };
 
 struct RigFile {

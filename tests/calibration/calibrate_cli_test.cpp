@@ -73,9 +73,9 @@ void expectRigKept(const std::filesystem::path& rig, const std::vector<daemon::R
   const auto after = daemon::loadRigFile(rig);
   ASSERT_EQ(after.size(), 2u);
   ASSERT_TRUE(after[0].source.has_value());
-  EXPECT_EQ(after[0].source->path.filename(), "still.png");
-  EXPECT_EQ(after[0].source->sequenceFps, 12.5);
-  EXPECT_TRUE(after[0].source->loop);
+  EXPECT_EQ(after[0].replayedFile()->path.filename(), "still.png");
+  EXPECT_EQ(after[0].replayedFile()->sequenceFps, 12.5);
+  EXPECT_TRUE(after[0].replayedFile()->loop);
   EXPECT_EQ(after[0].frozenCheck, daemon::FrozenCheck::kOff);
   EXPECT_EQ(after[0].calibration.role, processing::ColourRole::kTarget);
   // The other camera, value for value.
@@ -345,9 +345,10 @@ TEST(CalibrateCli, UsageErrorsNameTheOption) {
   const CalibrateRun version = calibrate(dir, {"--version"});  // issue 50
   EXPECT_EQ(version.status, 0) << version.output;
   EXPECT_THAT(version.output, AllOf(HasSubstr("surround-calibrate 0."), HasSubstr("built with: ")));
-  expectFailure(calibrate(dir, {}), 2,
-                "surround-calibrate: missing the subcommand: intrinsics, guide, extrinsics, import, "
-                "mask or refine (see --help)");
+  expectFailure(
+      calibrate(dir, {}), 2,
+      "surround-calibrate: missing the subcommand: intrinsics, guide, extrinsics, import, "
+      "mask or refine (see --help)");
   expectFailure(calibrate(dir, {"calibrate"}), 2,
                 "unknown subcommand 'calibrate': expected intrinsics, guide, extrinsics, import, "
                 "mask or refine");

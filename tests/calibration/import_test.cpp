@@ -467,8 +467,8 @@ TEST(Import, PjlabJsonLayoutWithAGroundPerCamera) {
     EXPECT_EQ(reread[i].calibration.intrinsics, imported[i].calibration.intrinsics);
     EXPECT_LT(cv::norm(reread[i].calibration.pose.position - truth[i].pose.position), 0.01);
     ASSERT_TRUE(reread[i].source.has_value());
-    EXPECT_EQ(reread[i].source->path.filename(), fileName(truth[i]) + ".png");
-    EXPECT_TRUE(std::filesystem::exists(reread[i].source->path));
+    EXPECT_EQ(reread[i].replayedFile()->path.filename(), fileName(truth[i]) + ".png");
+    EXPECT_TRUE(std::filesystem::exists(reread[i].replayedFile()->path));
   }
   EXPECT_FALSE(std::filesystem::exists(rigFile.string() + ".part"));
 }

@@ -53,7 +53,7 @@ std::filesystem::path writeConfig(const TempDir& dir, const std::filesystem::pat
 }
 
 cv::Mat firstFrame(const daemon::RigCamera& camera) {
-  auto settings = *camera.source;
+  auto settings = *camera.replayedFile();
   settings.pacing = capture::Pacing::kAsFastAsPossible;
   capture::FileSource source(camera.calibration.name, settings);
   capture::Frame frame;

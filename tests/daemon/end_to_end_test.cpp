@@ -103,7 +103,7 @@ TEST(EndToEnd, MosaicVideoMatchesTheSourceFrames) {
   std::vector<std::vector<cv::Mat>> sources;
   for (const auto& camera : rig) {
     names.push_back(camera.calibration.name);
-    sources.push_back(testing::decodeAll(camera.source->path).images);
+    sources.push_back(testing::decodeAll(camera.replayedFile()->path).images);
   }
   const auto video = testing::decodeAll(dir / "out/mosaic.mp4").images;
   ASSERT_EQ(video.size(),
@@ -136,7 +136,7 @@ struct Replay {
         rig(daemon::rigOf(config, pool)),
         lut(daemon::obtainPanoramaLut(config, rig, pool)) {
     for (const auto& camera : config.cameras) {
-      auto decoded = testing::decodeAll(camera.source->path);
+      auto decoded = testing::decodeAll(camera.replayedFile()->path);
       sources.push_back(std::move(decoded.images));
       timestamps.push_back(std::move(decoded.timestamps));
     }
@@ -344,7 +344,7 @@ outputs:
   std::vector<cv::Mat> last;
   for (const auto& camera : rig) {
     names.push_back(camera.calibration.name);
-    last.push_back(testing::decodeAll(camera.source->path).images.back());
+    last.push_back(testing::decodeAll(camera.replayedFile()->path).images.back());
   }
   std::vector<const cv::Mat*> frames;
   frames.reserve(last.size());
@@ -391,10 +391,10 @@ TEST(EndToEnd, ALiveCameraThatIsNotThereIsNamed) {
   const auto rig = daemon::loadRigFile(recording() / "rig.yaml");
   std::vector<daemon::RigCamera> live(rig.begin(), rig.end());
   for (auto& camera : live) {
-    camera.source.reset();
-    camera.device = capture::V4l2Settings{};
-    camera.device->device = "/dev/v4l/by-id/usb-surroundd-test-" + camera.calibration.name;
-    camera.device->size = camera.calibration.intrinsics.imageSize;
+    capture::V4l2Settings device;
+    device.device = "/dev/v4l/by-id/usb-surroundd-test-" + camera.calibration.name;
+    device.size = camera.calibration.intrinsics.imageSize;
+    camera.source = device;
   }
   daemon::writeRigFile(dir / "rig.yaml", live, "live rig");
   const auto config = dir.write("config.yaml", R"(rig: {file: rig.yaml}

@@ -73,11 +73,10 @@ Config vividConfig(const std::vector<std::filesystem::path>& devices, const test
   config.capture.syncToleranceMs = 50;
   for (std::size_t i = 0; i < config.cameras.size(); ++i) {
     RigCamera& camera = config.cameras[i];
-    camera.source.reset();
     capture::V4l2Settings settings = testing::vividSettings(devices[i], formats[i % 2], {320, 180});
     // 10 FPS: time for a set on the machine's emulated CPU, sanitizers and all.
     settings.fps = 10;
-    camera.device = settings;
+    camera.source = settings;
     // vivid's bars stand still (only its text at the top changes): left on, the check reports
     // every camera frozen after a second, rightly, and the mosaic dims their tiles.
     camera.frozenCheck = FrozenCheck::kOff;
@@ -127,15 +126,15 @@ TEST_F(LiveCameras, TheyAreListedTakenByDeviceAutoAndCheckedForTheFormatAndSize)
     return std::stoi(p.filename().string().substr(5));
   });
   for (std::size_t i = 0; i < 4; ++i) {
-    config.cameras[i].device->device = i == 1 ? sorted[0] : std::filesystem::path("auto");
+    config.cameras[i].v4l2()->device = i == 1 ? sorted[0] : std::filesystem::path("auto");
   }
   std::vector<std::string> said;
   const auto cameras = withAutoDevices(config.cameras, said);
   ASSERT_EQ(said.size(), 3U);
-  EXPECT_EQ(cameras[0].device->device, sorted[1]);
-  EXPECT_EQ(cameras[1].device->device, sorted[0]);
-  EXPECT_EQ(cameras[2].device->device, sorted[2]);
-  EXPECT_EQ(cameras[3].device->device, sorted[3]);
+  EXPECT_EQ(cameras[0].v4l2()->device, sorted[1]);
+  EXPECT_EQ(cameras[1].v4l2()->device, sorted[0]);
+  EXPECT_EQ(cameras[2].v4l2()->device, sorted[2]);
+  EXPECT_EQ(cameras[3].v4l2()->device, sorted[3]);
   EXPECT_THAT(said[0], ::testing::HasSubstr(
                            fmt::format("camera 'front': device auto is {}", sorted[1].string())));
   EXPECT_THAT(cameraDeviceProblems(cameras), ::testing::IsEmpty());
@@ -144,7 +143,7 @@ TEST_F(LiveCameras, TheyAreListedTakenByDeviceAutoAndCheckedForTheFormatAndSize)
   auto five = config.cameras;
   five.push_back(five.back());
   five.back().calibration.name = "fifth";
-  five.back().device->device = "auto";
+  five.back().v4l2()->device = "auto";
   try {
     withAutoDevices(five, said);
     ADD_FAILURE() << "a fifth camera was given a device";
@@ -157,7 +156,7 @@ TEST_F(LiveCameras, TheyAreListedTakenByDeviceAutoAndCheckedForTheFormatAndSize)
 
   // A size the devices do not offer: each camera named, with what its device offers.
   auto odd = cameras;
-  for (auto& camera : odd) camera.device->size = {333, 111};
+  for (auto& camera : odd) camera.v4l2()->size = {333, 111};
   const auto problems = cameraDeviceProblems(odd);
   ASSERT_EQ(problems.size(), 4U);
   for (std::size_t i = 0; i < 4; ++i) {
@@ -165,7 +164,7 @@ TEST_F(LiveCameras, TheyAreListedTakenByDeviceAutoAndCheckedForTheFormatAndSize)
         problems[i],
         ::testing::AllOf(
             ::testing::HasSubstr(fmt::format("camera '{}': {}", config.cameras[i].calibration.name,
-                                             odd[i].device->device.string())),
+                                             odd[i].v4l2()->device.string())),
             ::testing::HasSubstr("333x111 (it offers"), ::testing::HasSubstr("320x180")));
   }
 }
@@ -280,15 +279,14 @@ TEST(CameraDevices, AMissingDeviceIsNamedAndAutoWithNoneThereSaysSo) {
   const testing::TempDir dev;
   Config config = fixtureReplay("synth_small", {});
   for (auto& camera : config.cameras) {
-    camera.source.reset();
-    camera.device = testing::vividSettings(dev.path() / "video9", capture::V4l2Format::kAuto);
+    camera.source = testing::vividSettings(dev.path() / "video9", capture::V4l2Format::kAuto);
   }
   const auto problems = cameraDeviceProblems(config.cameras);
   ASSERT_EQ(problems.size(), config.cameras.size());
   EXPECT_EQ(problems[0], fmt::format("camera 'front': {}: cannot open: No such file or directory",
                                      (dev.path() / "video9").string()));
 
-  config.cameras[2].device->device = "auto";
+  config.cameras[2].v4l2()->device = "auto";
   std::vector<std::string> said;
   try {
     withAutoDevices(config.cameras, said, dev.path());

@@ -152,7 +152,7 @@ TEST(OutputRetry, AFailedOutputIsOpenedAgainAndNothingItWroteIsLost) {
   OutputConfig video = videoOutputAt(dir / "drive.mkv", segmented);
   Config config = fixtureReplay("synth_drop", {video});
   config.capture.pacing = capture::Pacing::kRealtime;
-  for (auto& camera : config.cameras) camera.source->loop = true;
+  for (auto& camera : config.cameras) camera.replayedFile()->loop = true;
   Pipeline pipeline(config);
   std::atomic<bool> stop{false};
   OutputWatch watch(dir / "drive-00002.mkv.part" / "taken", stop);

@@ -20,18 +20,18 @@ using ::testing::HasSubstr;
 TEST_F(ConfigTest, APreloadedFileIsHeldInTheFormatItNames) {
   const Config config =
       loadConfig(configWith("source: {file: left.mkv}", "source: {file: left.mkv, preload: true}"));
-  EXPECT_EQ(config.cameras[0].preload, std::nullopt);                 // decoded as it plays
-  EXPECT_EQ(config.cameras[1].preload, capture::PixelLayout::kYuyv);  // the default format
+  EXPECT_EQ(config.cameras[0].preloaded(), std::nullopt);                 // decoded as it plays
+  EXPECT_EQ(config.cameras[1].preloaded(), capture::PixelLayout::kYuyv);  // the default format
   EXPECT_EQ(config.capture.preloadMaxMb, 2048);
 
   const Config nv12 = loadConfig(configWith(
       "source: {file: left.mkv}", "source: {file: left.mkv, preload: true, format: nv12}"));
-  EXPECT_EQ(nv12.cameras[1].preload, capture::PixelLayout::kNv12);
+  EXPECT_EQ(nv12.cameras[1].preloaded(), capture::PixelLayout::kNv12);
   // And back through a rig file.
   writeRigFile(dir_ / "rig.yaml", nv12.cameras, "test");
   const auto cameras = loadRigFile(dir_ / "rig.yaml");
-  EXPECT_EQ(cameras[0].preload, std::nullopt);
-  EXPECT_EQ(cameras[1].preload, capture::PixelLayout::kNv12);
+  EXPECT_EQ(cameras[0].preloaded(), std::nullopt);
+  EXPECT_EQ(cameras[1].preloaded(), capture::PixelLayout::kNv12);
 
   const Config bounded = loadConfig(
       configWith("  sync_tolerance_ms: 5", "  sync_tolerance_ms: 5\n  preload_max_mb: 512"));
@@ -65,8 +65,8 @@ TEST_F(ConfigTest, PreloadMistakesAreNamedByTheirKey) {
 TEST(PreloadReplay, ThePipelineReplaysPreloadedCamerasLosingNothing) {
   Config config = fixtureReplay("synth_small", {});
   for (std::size_t c = 0; c < config.cameras.size(); ++c) {
-    config.cameras[c].preload =
-        c % 2 == 0 ? capture::PixelLayout::kYuyv : capture::PixelLayout::kNv12;
+    config.cameras[c].preload(c % 2 == 0 ? capture::PixelLayout::kYuyv
+                                         : capture::PixelLayout::kNv12);
   }
   Pipeline pipeline(config);
   const std::atomic<bool> stop{false};
@@ -82,14 +82,14 @@ TEST(PreloadReplay, ThePipelineReplaysPreloadedCamerasLosingNothing) {
 // 5 MiB hold one camera, and the second is refused with what is left.
 TEST(PreloadReplay, TheBoundIsForEveryPreloadedCameraTogether) {
   Config config = fixtureReplay("synth_small", {});
-  for (auto& camera : config.cameras) camera.preload = capture::PixelLayout::kYuyv;
+  for (auto& camera : config.cameras) camera.preload(capture::PixelLayout::kYuyv);
   config.capture.preloadMaxMb = 5;
   const auto& second = config.cameras[1];
   EXPECT_THAT(
       [&] { openCameras(config); },
       ::testing::ThrowsMessage<capture::CaptureError>(AllOf(
           HasSubstr(fmt::format("camera '{}'", second.calibration.name)),
-          HasSubstr(second.source->path.string()), HasSubstr("needs 3456000 bytes"),
+          HasSubstr(second.replayedFile()->path.string()), HasSubstr("needs 3456000 bytes"),
           HasSubstr("more than the 1786880 bytes (1.7 MiB) allowed by capture.preload_max_mb: 5 "
                     "for every preloaded camera together, less what the cameras before it hold: "
                     "'front' 3.3 MiB"))));

@@ -116,7 +116,7 @@ TEST_F(ProcessingBackendTest, EveryViewFromTheGpuStitchIsTheCpuPathsPicture) {
     const char* const held = preload ? capture::toString(*preload) : "BGR";
     SCOPED_TRACE(held);
     Config config = replayOf("synth_small", false);
-    for (auto& camera : config.cameras) camera.preload = preload;
+    for (auto& camera : config.cameras) camera.preload(preload);
     const BackendRun cpu = runOn(config, ProcessingBackend::kCpu, snapshots);
     const BackendRun gpu = runOn(config, ProcessingBackend::kGpu, snapshots);
     EXPECT_THAT(cpu.log, Contains(HasSubstr("processing: cpu (processing.backend: cpu)")));
@@ -147,7 +147,7 @@ TEST_F(ProcessingBackendTest, ASetWithAFaultyCameraIsMadeOnTheCpuAndMarked) {
                                                            {ViewKind::kTop, 0.9}};
   Config config = replayOf("synth_faults", true);
   config.render.viewLut = false;
-  for (auto& camera : config.cameras) camera.preload = capture::PixelLayout::kYuyv;
+  for (auto& camera : config.cameras) camera.preload(capture::PixelLayout::kYuyv);
   const BackendRun cpu = runOn(config, ProcessingBackend::kCpu, snapshots);
   const BackendRun gpu = runOn(config, ProcessingBackend::kGpu, snapshots);
   EXPECT_THAT(gpu.summary.renderer, HasSubstr("panorama stitched on the GPU"));
@@ -181,7 +181,7 @@ TEST_F(ProcessingBackendTest, AutoAndGainCompensationKeepTheCpuAndSayWhy) {
 // panorama's upload, the draw and read-back, no stitch. An orbit video draws every set.
 TEST_F(ProcessingBackendTest, TheReportHasTheGpusOwnTimeOfEachStepItRan) {
   Config config = replayOf("synth_small", true);
-  for (auto& camera : config.cameras) camera.preload = capture::PixelLayout::kYuyv;
+  for (auto& camera : config.cameras) camera.preload(capture::PixelLayout::kYuyv);
   OutputConfig orbit = videoOutputAt(dir_ / "orbit.mkv");
   orbit.stream = OutputStream::kSurround;
   orbit.view = ViewKind::kOrbit;

@@ -38,7 +38,7 @@ class ReplayTest : public ::testing::Test {
   void SetUp() override {
     config_.cameras = loadRigFile(recording() / "rig.yaml");
     for (const auto& camera : config_.cameras)
-      timestamps_.push_back(timestampsOf(camera.source->path));
+      timestamps_.push_back(timestampsOf(camera.replayedFile()->path));
     const auto fewest =
         std::min_element(timestamps_.begin(), timestamps_.end(),
                          [](const auto& a, const auto& b) { return a.size() < b.size(); });
@@ -181,8 +181,8 @@ TEST_F(ReplayTest, AVideoOfAnotherSizeThanItsCalibrationIsRefused) {
 // The cameras open all at once (each file's decoder set up on a thread of its own): when several
 // cannot, the one named is the first in the rig, every time, as when they opened in turn.
 TEST_F(ReplayTest, OfCamerasThatCannotOpenTheFirstInTheRigIsNamed) {
-  config_.cameras[1].source->path = "/nonexistent/right.mkv";
-  config_.cameras[3].source->path = "/nonexistent/left.mkv";
+  config_.cameras[1].replayedFile()->path = "/nonexistent/right.mkv";
+  config_.cameras[3].replayedFile()->path = "/nonexistent/left.mkv";
   for (int attempt = 0; attempt < 5; ++attempt) {
     try {
       Pipeline pipeline(config_);
@@ -201,7 +201,7 @@ TEST_F(ReplayTest, ARendererOpenedBesideACameraThatCannotOpenGoesWithIt) {
   const testing::TempDir dir;
   replayIntoLastPicture(dir / "last.png", OutputStream::kSurround);
   Config broken = config_;
-  broken.cameras[2].source->path = "/nonexistent/back.mkv";
+  broken.cameras[2].replayedFile()->path = "/nonexistent/back.mkv";
   try {
     const Pipeline pipeline(broken);
     FAIL() << "a rig with a missing video was opened";

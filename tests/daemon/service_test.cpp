@@ -39,7 +39,7 @@ class ServiceTest : public ::testing::Test {
   void SetUp() override {
     // The recording's rig, looping: the daemon runs until it is told to stop.
     auto cameras = loadRigFile(recording() / "rig.yaml");
-    for (auto& camera : cameras) camera.source->loop = true;
+    for (auto& camera : cameras) camera.replayedFile()->loop = true;
     writeRigFile(dir_ / "rig.yaml", cameras, "looping replay");
     std::filesystem::remove_all(socket_.parent_path());
   }

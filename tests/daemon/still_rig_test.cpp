@@ -95,7 +95,7 @@ TEST_F(StillRigTest, StillPicturesRunLiveWithEveryCameraOk) {
   const auto rig = writeStillRig();
   for (const auto& camera : loadRigFile(rig)) {
     ASSERT_TRUE(camera.source.has_value());
-    EXPECT_TRUE(camera.source->loop) << camera.calibration.name;  // a bare picture loops
+    EXPECT_TRUE(camera.replayedFile()->loop) << camera.calibration.name;  // a bare picture loops
   }
   std::vector<capture::CameraHealth> health;
   const RunSummary summary = run(rig, health);

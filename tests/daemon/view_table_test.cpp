@@ -66,7 +66,7 @@ TEST(ViewTableTest, AViewSwitchedToIsDrawnWhileItsTableIsMadeBesideTheSets) {
   OutputConfig video = videoOutputAt(dir / "surround.mp4");
   video.stream = OutputStream::kSurround;
   Config config = fixtureReplay("synth_small", {video});
-  for (auto& camera : config.cameras) camera.source->loop = true;
+  for (auto& camera : config.cameras) camera.replayedFile()->loop = true;
   config.pipeline.threads = 2;
   config.render.view = ViewKind::kOrbit;
   config.render.views.transitionS = 0;  // switched at once: no transition to wait out

@@ -102,7 +102,7 @@ daemon::Config configFor(const std::filesystem::path& folder, const RecordingTru
   config.panorama.cacheDir = scratch / "lut-cache";
   config.colour.poisson.solver = options.solver;
   if (options.input == BenchInput::kRaw) {
-    for (auto& camera : config.cameras) camera.preload = options.rawFormat;
+    for (auto& camera : config.cameras) camera.preload(options.rawFormat);
   }
   config.render.view = options.view;
   config.processing.backend = options.backend;

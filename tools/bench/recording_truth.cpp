@@ -29,7 +29,8 @@ RecordingTruth loadRecordingTruth(const std::filesystem::path& folder) {
   const daemon::RigFile rig = daemon::loadRig(folder / "rig.yaml");
   for (const auto& camera : rig.cameras) {
     truth.rig.cameras.push_back(camera.calibration);
-    truth.videos.push_back(camera.source ? camera.source->path : std::filesystem::path());
+    truth.videos.push_back(camera.replayedFile() ? camera.replayedFile()->path
+                                                 : std::filesystem::path());
   }
   // The body the recording shows, masked as surroundd would mask it.
   if (rig.vehicle && rig.vehicle->bodyMasks) {

@@ -22,16 +22,16 @@ constexpr int kTimingRepeats = 21;
 std::vector<cv::Mat> firstFrames(const daemon::Config& config) {
   std::vector<cv::Mat> frames;
   for (const auto& camera : config.cameras) {
-    if (!camera.source) {
+    if (!camera.replayedFile()) {
       throw std::runtime_error(fmt::format("{}: camera '{}' is live; the report needs files",
                                            config.file.string(), camera.calibration.name));
     }
-    capture::FileSource source(camera.calibration.name, *camera.source);
+    capture::FileSource source(camera.calibration.name, *camera.replayedFile());
     capture::Frame frame;
     frame.image.create(source.frameSize(), CV_8UC3);
     if (source.read(frame) != capture::ReadStatus::kFrame) {
       throw std::runtime_error(
-          fmt::format("cannot read a frame of {}", camera.source->path.string()));
+          fmt::format("cannot read a frame of {}", camera.replayedFile()->path.string()));
     }
     frames.push_back(frame.image);
   }

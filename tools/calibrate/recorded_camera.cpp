@@ -13,13 +13,13 @@ std::filesystem::path recordingRigFile(const std::filesystem::path& given) {
 std::unique_ptr<capture::FileSource> openRecordedCamera(const daemon::RigCamera& camera,
                                                         const std::filesystem::path& recording) {
   const std::string& name = camera.calibration.name;
-  if (!camera.source) {
+  if (!camera.replayedFile()) {
     throw UsageError(
         fmt::format("{}: camera '{}' is live, not recorded: record a drive first "
                     "(a recording output), then give its folder",
                     recording.string(), name));
   }
-  auto settings = *camera.source;
+  auto settings = *camera.replayedFile();
   settings.pacing = capture::Pacing::kAsFastAsPossible;
   settings.loop = false;
   std::unique_ptr<capture::FileSource> source;

@@ -104,8 +104,6 @@ void writeCalibrationSession(const SynthOptions& options, std::ostream& log) {
     }
   });
   camera.source.reset();
-  camera.device.reset();
-  camera.libcamera.reset();
   daemon::writeRigFile(
       options.out / "rig.yaml", std::span(&camera, 1),
       fmt::format("Written by surround-synth --calibration-session {} from {} (seed {}): the "

@@ -21,11 +21,10 @@ RigRecorder::RigRecorder(RecordingSettings settings, std::vector<RigCamera> rig,
     video.pixelFormat = settings_.lossless ? "bgr24" : "yuv444p";
     encoders_.push_back(std::make_unique<render::VideoEncoder>(std::move(video)));
     // The replayed rig: the same calibration, its source this file.
-    camera.device.reset();
-    camera.libcamera.reset();
-    camera.preload.reset();  // the recording replays as a file, whatever the camera was
-    camera.source = capture::FileSourceSettings{};
-    camera.source->path = settings_.folder / (camera.calibration.name + ".mp4");
+    // The recording replays as a file, whatever the camera was.
+    capture::FileSourceSettings file;
+    file.path = settings_.folder / (camera.calibration.name + ".mp4");
+    camera.source = file;
   }
 }
 

@@ -32,7 +32,7 @@ TEST_F(ConfigTest, GoodConfigLoads) {
   ASSERT_EQ(config.cameras.size(), 2u);
   const auto& front = config.cameras[0];
   EXPECT_EQ(front.calibration.name, "front");
-  EXPECT_EQ(front.source->path, dir_ / "front.mkv");  // relative to the config's folder
+  EXPECT_EQ(front.replayedFile()->path, dir_ / "front.mkv");  // relative to the config's folder
   EXPECT_EQ(front.calibration.role, processing::ColourRole::kSource);
   EXPECT_EQ(config.cameras[1].calibration.role, processing::ColourRole::kTarget);
   EXPECT_EQ(config.cameras[1].calibration.intrinsics.model, processing::LensModel::kFisheye);
@@ -92,21 +92,22 @@ TEST_F(ConfigTest, ALiveCameraIsAV4l2DeviceOfTheLensSize) {
       "source: {device: /dev/v4l/by-path/pci-0000:00:14.0-usb-0:1:1.0-video-index0, format: "
       "mjpeg, fps: 25, timeout_ms: 300, controls: {gain: 40, exposure_auto: 1}}"));
   const auto& left = config.cameras[1];
-  EXPECT_FALSE(left.source.has_value());
-  ASSERT_TRUE(left.device.has_value());
-  EXPECT_EQ(left.device->device, "/dev/v4l/by-path/pci-0000:00:14.0-usb-0:1:1.0-video-index0");
-  EXPECT_EQ(left.device->format, capture::V4l2Format::kMjpeg);
-  EXPECT_EQ(left.device->size, cv::Size(640, 360));
-  EXPECT_DOUBLE_EQ(left.device->fps, 25.0);
-  EXPECT_EQ(left.device->timeout, std::chrono::milliseconds(300));
-  EXPECT_EQ(left.device->controls,
+  EXPECT_TRUE(left.live());
+  EXPECT_EQ(left.replayedFile(), nullptr);
+  ASSERT_NE(left.v4l2(), nullptr);
+  EXPECT_EQ(left.v4l2()->device, "/dev/v4l/by-path/pci-0000:00:14.0-usb-0:1:1.0-video-index0");
+  EXPECT_EQ(left.v4l2()->format, capture::V4l2Format::kMjpeg);
+  EXPECT_EQ(left.v4l2()->size, cv::Size(640, 360));
+  EXPECT_DOUBLE_EQ(left.v4l2()->fps, 25.0);
+  EXPECT_EQ(left.v4l2()->timeout, std::chrono::milliseconds(300));
+  EXPECT_EQ(left.v4l2()->controls,
             (std::vector<capture::V4l2Control>{{"exposure_auto", 1}, {"gain", 40}}));
 
   // And back through a rig file.
   writeRigFile(dir_ / "rig.yaml", config.cameras, "test");
   const auto cameras = loadRigFile(dir_ / "rig.yaml");
-  ASSERT_TRUE(cameras[1].device.has_value());
-  EXPECT_EQ(*cameras[1].device, *left.device);
+  ASSERT_NE(cameras[1].v4l2(), nullptr);
+  EXPECT_EQ(*cameras[1].v4l2(), *left.v4l2());
 }
 
 TEST_F(ConfigTest, ALiveCameraWithAnUnknownFormatOrControlOrMixedWithFilesIsRefused) {
@@ -126,12 +127,14 @@ TEST_F(ConfigTest, ALiveCameraWithAnUnknownFormatOrControlOrMixedWithFilesIsRefu
 TEST_F(ConfigTest, ALibcameraCameraIsNamedByItsId) {
   const Config config = loadConfig(liveConfigWith("source: {libcamera: imx219@10, fps: 25}"));
   const auto& left = config.cameras[1];
-  ASSERT_TRUE(left.libcamera.has_value());
-  EXPECT_EQ(left.libcamera->camera, "imx219@10");
-  EXPECT_EQ(left.libcamera->size, cv::Size(640, 360));
-  EXPECT_DOUBLE_EQ(left.libcamera->fps, 25.0);
+  ASSERT_TRUE(left.source.has_value());
+  const auto* libcamera = std::get_if<capture::LibcameraSettings>(&*left.source);
+  ASSERT_NE(libcamera, nullptr);
+  EXPECT_EQ(libcamera->camera, "imx219@10");
+  EXPECT_EQ(libcamera->size, cv::Size(640, 360));
+  EXPECT_DOUBLE_EQ(libcamera->fps, 25.0);
   writeRigFile(dir_ / "rig.yaml", config.cameras, "test");
-  EXPECT_EQ(*loadRigFile(dir_ / "rig.yaml")[1].libcamera, *left.libcamera);
+  EXPECT_EQ(loadRigFile(dir_ / "rig.yaml")[1].source, left.source);
 }
 
 TEST_F(ConfigTest, ARecordingIsAFolder) {
@@ -316,15 +319,15 @@ TEST_F(ConfigTest, StillPicturesLoopAndTheFrozenCheckIsPerCamera) {
       "source: {file: front.mkv}\n",
       "source: {file: front.png, sequence_fps: 10}\n      health: {frozen_check: on}\n"));
   ASSERT_TRUE(config.cameras[0].source.has_value());
-  EXPECT_TRUE(config.cameras[0].source->loop);
-  EXPECT_EQ(config.cameras[0].source->sequenceFps, 10.0);
+  EXPECT_TRUE(config.cameras[0].replayedFile()->loop);
+  EXPECT_EQ(config.cameras[0].replayedFile()->sequenceFps, 10.0);
   EXPECT_EQ(config.cameras[0].frozenCheck, FrozenCheck::kOn);
-  EXPECT_FALSE(config.cameras[1].source->loop);  // a video plays once by default
+  EXPECT_FALSE(config.cameras[1].replayedFile()->loop);  // a video plays once by default
   EXPECT_EQ(config.cameras[1].frozenCheck, FrozenCheck::kAuto);
 
   const Config once =
       loadConfig(configWith("source: {file: front.mkv}", "source: {file: front.png, loop: false}"));
-  EXPECT_FALSE(once.cameras[0].source->loop);
+  EXPECT_FALSE(once.cameras[0].replayedFile()->loop);
   expectOneError("source: {file: front.mkv}\n",
                  "source: {file: front.mkv}\n      health: {frozen_check: never}\n",
                  {"rig.cameras[0].health.frozen_check: expected one of 'auto' 'on' 'off'"});
@@ -411,7 +414,7 @@ TEST_F(ConfigTest, RigFileRoundTripsExactly) {
     EXPECT_EQ(a.intrinsics, b.intrinsics);
     EXPECT_EQ(a.pose.position, b.pose.position);
     EXPECT_LT(cv::norm(a.pose.rotation - b.pose.rotation, cv::NORM_INF), 1e-12);
-    EXPECT_EQ(cameras[i].source->path, config.cameras[i].source->path);
+    EXPECT_EQ(cameras[i].replayedFile()->path, config.cameras[i].replayedFile()->path);
   }
   // Where the cameras came from: none written inline, the rig file where one is named.
   EXPECT_FALSE(config.rigFile.has_value());

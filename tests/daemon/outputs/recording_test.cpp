@@ -42,9 +42,10 @@ TEST(Recording, ReplaysFrameForFrameWithTheOriginalTimestamps) {
     EXPECT_EQ(copy[c].calibration.intrinsics.fx, original[c].calibration.intrinsics.fx);
     EXPECT_EQ(cv::norm(copy[c].calibration.pose.position, original[c].calibration.pose.position),
               0.0);
-    EXPECT_EQ(copy[c].source->path, dir / "drive" / (original[c].calibration.name + ".mp4"));
-    const auto before = surroundd::testing::decodeAll(original[c].source->path);
-    const auto after = surroundd::testing::decodeAll(copy[c].source->path);
+    EXPECT_EQ(copy[c].replayedFile()->path,
+              dir / "drive" / (original[c].calibration.name + ".mp4"));
+    const auto before = surroundd::testing::decodeAll(original[c].replayedFile()->path);
+    const auto after = surroundd::testing::decodeAll(copy[c].replayedFile()->path);
     ASSERT_EQ(after.images.size(), before.images.size());
     EXPECT_EQ(after.timestamps, before.timestamps);
     for (std::size_t k = 0; k < before.images.size(); ++k) {

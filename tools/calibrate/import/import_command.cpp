@@ -240,10 +240,10 @@ ImportedRig importRig(const ImportOptions& options) {
       // Relative to the rig file, so that the rig and the pictures can move together.
       const auto folder = std::filesystem::absolute(options.out).parent_path();
       camera.source = capture::FileSourceSettings{};
-      camera.source->path =
+      camera.replayedFile()->path =
           std::filesystem::absolute(*picture).lexically_normal().lexically_relative(
               folder.lexically_normal());
-      camera.source->loop = true;
+      camera.replayedFile()->loop = true;
     } else if (options.images) {
       throw UsageError(fmt::format("--images: no picture named '{}' (.png, .jpg, ...) in {}",
                                    input.sourceName, options.images->string()));
@@ -291,7 +291,7 @@ void runImport(const ImportOptions& options, std::ostream& log) {
         "{:<6} x {:+.3f} y {:+.3f} z {:.3f} m, yaw {:+.2f} pitch {:+.2f} roll {:+.2f} deg{}\n",
         camera.calibration.name, pose.position[0], pose.position[1], pose.position[2],
         angles.yawDeg, angles.pitchDeg, angles.rollDeg,
-        camera.source ? ", picture " + camera.source->path.string() : "");
+        camera.replayedFile() ? ", picture " + camera.replayedFile()->path.string() : "");
   }
   log << "wrote " << options.out.string() << "\n";
 }

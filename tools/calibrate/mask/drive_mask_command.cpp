@@ -41,7 +41,7 @@ FoundBody findBody(const daemon::RigCamera& camera, const std::filesystem::path&
                    double everyS) {
   const std::string& name = camera.calibration.name;
   const auto source = openRecordedCamera(camera, recording);
-  const std::filesystem::path& path = camera.source->path;
+  const std::filesystem::path& path = camera.replayedFile()->path;
   const cv::Size size = camera.calibration.intrinsics.imageSize;
   FoundBody found;
   try {

@@ -24,9 +24,9 @@ namespace {
 cv::Mat firstPicture(const daemon::RigCamera& camera) {
   const cv::Size size = camera.calibration.intrinsics.imageSize;
   // A live camera's stand-in picture: dark, so that the tint and the outline still show.
-  if (!camera.source) return {size, CV_8UC3, cv::Scalar::all(64)};
+  if (!camera.replayedFile()) return {size, CV_8UC3, cv::Scalar::all(64)};
   const std::string& name = camera.calibration.name;
-  auto settings = *camera.source;
+  auto settings = *camera.replayedFile();
   settings.pacing = capture::Pacing::kAsFastAsPossible;  // no wait for the first frame's time
   try {
     capture::FileSource source(name, settings);
