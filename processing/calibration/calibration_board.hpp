@@ -35,6 +35,7 @@ struct BoardView {
   std::string name;                  // for reports, e.g. the image file
   std::vector<cv::Point2f> corners;  // pixels, sub-pixel refined
   std::vector<cv::Point> grid;       // each corner's (column, row) on the board's grid
+  double edgeWidthPx = 0;            // how blurred its edges are (view_acceptance.hpp); 0: unknown
 };
 
 // Fewer corners than this in a view, or all of them on one line, pin nothing down.

@@ -6,12 +6,31 @@
 
 #include <fmt/format.h>
 
+#include "processing/calibration/view_acceptance.hpp"
 #include "processing/camera_model.hpp"
 
 namespace surroundd::processing {
 namespace {
 
 constexpr double kToDeg = 180 / std::numbers::pi;
+
+// The views' edge width as a whole: their median.
+double typicalEdgeWidthPx(const IntrinsicCalibration& result) {
+  std::vector<double> widths;
+  for (const auto& view : result.views) widths.push_back(view.edgeWidthPx);
+  if (widths.empty()) return 0;
+  const auto middle = widths.begin() + static_cast<std::ptrdiff_t>(widths.size() / 2);
+  std::nth_element(widths.begin(), middle, widths.end());
+  return *middle;
+}
+
+// "the limit of 1 px", or where the pictures set it, "the limit of 1.75 px (0.35 of the views'
+// 5.0 px wide edges)".
+std::string limitText(double limitPx, double floorPx, double perEdge, double edgeWidthPx) {
+  if (limitPx <= floorPx) return fmt::format("the limit of {:.3g} px", limitPx);
+  return fmt::format("the limit of {:.3g} px ({:g} of the views' {:.1f} px wide edges)", limitPx,
+                     perEdge, edgeWidthPx);
+}
 
 std::vector<const ViewResiduals*> worstFirst(const IntrinsicCalibration& result) {
   std::vector<const ViewResiduals*> views;
@@ -36,8 +55,25 @@ Verdict judgeCalibration(const IntrinsicCalibration& result, double coverage,
     fail(fmt::format("{} views were used, at least {} are needed", result.views.size(),
                      limits.minViews));
   }
-  if (!std::isfinite(result.rmsPx) || result.rmsPx > limits.maxRmsPx) {
-    fail(fmt::format("RMS {:.3g} px is above the limit of {:g} px", result.rmsPx, limits.maxRmsPx));
+  const double edgeWidth = typicalEdgeWidthPx(result);
+  if (const double limit = limits.rmsLimitPx(edgeWidth);
+      !std::isfinite(result.rmsPx) || result.rmsPx > limit) {
+    fail(fmt::format("RMS {:.3g} px is above {}", result.rmsPx,
+                     limitText(limit, limits.maxRmsPx, limits.rmsPerEdgeWidth, edgeWidth)));
+  }
+  const auto& sd = result.uncertainty;
+  if (const double focalSdPercent = 100 * std::max(sd.fx / lens.fx, sd.fy / lens.fy);
+      !(focalSdPercent <= limits.maxFocalSdPercent)) {
+    fail(fmt::format(
+        "the focal length is not pinned down: +-{:.2f} % (one standard deviation), at most {:g} % "
+        "(more views, tilted other ways)",
+        focalSdPercent, limits.maxFocalSdPercent));
+  }
+  if (const double ppSd = std::max(sd.cx, sd.cy); !(ppSd <= limits.maxPrincipalSdPx)) {
+    fail(fmt::format(
+        "the principal point is not pinned down: +-{:.2f} px (one standard deviation), at most "
+        "{:g} px (more views near the edges)",
+        ppSd, limits.maxPrincipalSdPx));
   }
   for (const double f : {lens.fx, lens.fy}) {
     if (!std::isfinite(f) || f < limits.minFocalPerWidth * width ||
@@ -81,14 +117,19 @@ Verdict judgeCalibration(const IntrinsicCalibration& result, double coverage,
                     100 * coverage, 100 * limits.minCoverage));
   }
   for (const auto* view : worstFirst(result)) {
-    if (!(view->rmsPx <= limits.maxViewRmsPx)) verdict.viewsToDrop.push_back(view->name);
-  }
-  // A failed solve with no single bad view: the worst few are where to look first.
-  if (!verdict.passed && verdict.viewsToDrop.empty() && !result.views.empty()) {
-    const auto worst = worstFirst(result);
-    for (std::size_t i = 0; i < std::min<std::size_t>(3, worst.size()); ++i) {
-      verdict.viewsToDrop.push_back(worst[i]->name);
+    if (!(view->rmsPx <= limits.viewRmsLimitPx(view->edgeWidthPx))) {
+      verdict.viewsToDrop.push_back(view->name);
     }
+  }
+  // A failed solve with no view bad by itself: dropping views only weakens it (advice to drop
+  // the worst few would go round until too few were left).
+  if (!verdict.passed && verdict.viewsToDrop.empty() && !result.views.empty()) {
+    const auto* worst = worstFirst(result).front();
+    verdict.failures.push_back(fmt::format(
+        "no view is to blame (the worst, {}, is {:.3g} px, within its {:.3g} px): add pictures "
+        "rather than drop them, with the board tilted 30 to 45 degrees different ways and in the "
+        "parts of the picture that have no corners yet",
+        worst->name, worst->rmsPx, limits.viewRmsLimitPx(worst->edgeWidthPx)));
   }
   return verdict;
 }
@@ -102,12 +143,27 @@ RobustCalibration calibrateLeavingOutBadViews(LensModel model, cv::Size imageSiz
     const auto worst = std::max_element(
         robust.result.views.begin(), robust.result.views.end(),
         [](const auto& a, const auto& b) { return a.rmsPx < b.rmsPx || std::isnan(b.rmsPx); });
-    if (worst->rmsPx <= limits.maxViewRmsPx) break;
-    robust.leftOut.push_back(fmt::format("{}: RMS {:.3g} px", worst->name, worst->rmsPx));
+    const double limit = limits.viewRmsLimitPx(worst->edgeWidthPx);
+    if (worst->rmsPx <= limit) break;
+    robust.leftOut.push_back(
+        fmt::format("{}: RMS {:.3g} px, above its {:.3g} px", worst->name, worst->rmsPx, limit));
     views.erase(views.begin() + (worst - robust.result.views.begin()));
     robust.result = calibrateIntrinsics(model, imageSize, views);
   }
   return robust;
+}
+
+std::optional<std::string> blurProblem(const BoardView& view, const CalibrationLimits& limits) {
+  const double square = squareSizePx(view);
+  const double limit = limits.edgeWidthLimitPx(square);
+  if (view.edgeWidthPx <= limit) return std::nullopt;
+  return fmt::format("too blurred: its edges are {:.1f} px wide, the limit is {:.3g} px ({})",
+                     view.edgeWidthPx, limit,
+                     limits.edgeWidthPerSquare > 0
+                         ? fmt::format("{:g} of its board's {:.0f} px squares, at least {:g} px; "
+                                       "--max-edge-width-px",
+                                       limits.edgeWidthPerSquare, square, limits.maxEdgeWidthPx)
+                         : std::string("--max-edge-width-px"));
 }
 
 }  // namespace surroundd::processing

@@ -31,6 +31,7 @@ ViewResiduals residualsOf(const CameraModel& model, const BoardView& view,
                           const cv::Vec3d& tvec) {
   ViewResiduals out;
   out.name = view.name;
+  out.edgeWidthPx = view.edgeWidthPx;
   cv::Rodrigues(rvec, out.boardInCamera.rotation);
   out.boardInCamera.position = tvec;
   out.corners = view.corners;

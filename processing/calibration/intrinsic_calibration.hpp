@@ -27,6 +27,7 @@ struct ViewResiduals {
   std::vector<cv::Point2f> corners;    // as detected
   std::vector<cv::Point2f> residuals;  // reprojected - detected, pixels
   double rmsPx = 0;
+  double edgeWidthPx = 0;  // the view's (BoardView::edgeWidthPx)
 };
 
 // One standard deviation of each solved parameter, pixels for the focal lengths and principal

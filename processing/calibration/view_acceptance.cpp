@@ -40,31 +40,52 @@ double hullOverlap(const std::vector<cv::Point2f>& a, const std::vector<cv::Poin
   return united > 0 ? intersection / united : 0;
 }
 
-}  // namespace
-
-double edgeWidthPx(const cv::Mat& gray, const BoardView& view) {
+// Each pair of corners next to each other on the board's grid (a square's side).
+std::vector<std::pair<cv::Point2f, cv::Point2f>> neighbourPairs(const BoardView& view) {
   std::map<std::pair<int, int>, cv::Point2f> byGrid;
   for (std::size_t i = 0; i < view.grid.size(); ++i) {
     byGrid[{view.grid[i].x, view.grid[i].y}] = view.corners[i];
   }
-  std::vector<double> widths;
+  std::vector<std::pair<cv::Point2f, cv::Point2f>> pairs;
   for (const auto& [at, corner] : byGrid) {
     for (const auto& next : {std::pair{at.first + 1, at.second}, {at.first, at.second + 1}}) {
-      const auto neighbour = byGrid.find(next);
-      if (neighbour == byGrid.end() || cv::norm(neighbour->second - corner) < 6) continue;
-      const auto profile = profileAcross(gray, corner, neighbour->second);
-      float steepest = 0;
-      for (std::size_t i = 1; i < profile.size(); ++i) {
-        steepest = std::max(steepest, std::abs(profile[i] - profile[i - 1]) / kProfileStepPx);
+      if (const auto neighbour = byGrid.find(next); neighbour != byGrid.end()) {
+        pairs.emplace_back(corner, neighbour->second);
       }
-      const auto [darkest, brightest] = std::minmax_element(profile.begin(), profile.end());
-      if (steepest > 0) widths.push_back((*brightest - *darkest) / steepest);
     }
   }
-  if (widths.empty()) return 0;
-  const auto middle = widths.begin() + static_cast<std::ptrdiff_t>(widths.size() / 2);
-  std::nth_element(widths.begin(), middle, widths.end());
+  return pairs;
+}
+
+// The middle value (the upper of the two middle ones); 0 for none.
+double median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
   return *middle;
+}
+
+}  // namespace
+
+double edgeWidthPx(const cv::Mat& gray, const BoardView& view) {
+  std::vector<double> widths;
+  for (const auto& [corner, next] : neighbourPairs(view)) {
+    if (cv::norm(next - corner) < 6) continue;
+    const auto profile = profileAcross(gray, corner, next);
+    float steepest = 0;
+    for (std::size_t i = 1; i < profile.size(); ++i) {
+      steepest = std::max(steepest, std::abs(profile[i] - profile[i - 1]) / kProfileStepPx);
+    }
+    const auto [darkest, brightest] = std::minmax_element(profile.begin(), profile.end());
+    if (steepest > 0) widths.push_back((*brightest - *darkest) / steepest);
+  }
+  return median(widths);
+}
+
+double squareSizePx(const BoardView& view) {
+  std::vector<double> sides;
+  for (const auto& [corner, next] : neighbourPairs(view)) sides.push_back(cv::norm(next - corner));
+  return median(sides);
 }
 
 std::vector<DuplicateView> findDuplicateViews(std::span<const BoardView> views, double minOverlap) {

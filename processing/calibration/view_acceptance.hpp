@@ -18,6 +18,9 @@ namespace surroundd::processing {
 // sharp picture, 2.5 sigma for one blurred by a Gaussian of sigma pixels.
 double edgeWidthPx(const cv::Mat& gray, const BoardView& view);
 
+// The board's squares in the picture, pixels: the median distance between neighbouring corners.
+double squareSizePx(const BoardView& view);
+
 struct DuplicateView {
   std::size_t view;    // index of the repeat
   std::size_t of;      // index of the earlier view it repeats

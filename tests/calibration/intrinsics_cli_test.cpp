@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <regex>
 
 #include <fmt/format.h>
 #include <gmock/gmock.h>
@@ -20,6 +21,7 @@ namespace {
 
 using surroundd::testing::TempDir;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 std::filesystem::path writeViews(const TempDir& dir, const std::vector<cv::Mat>& images) {
   auto folder = dir / "views";
@@ -106,6 +108,45 @@ TEST(IntrinsicsCli, ABlurredPictureIsSkippedAndNamed) {
   const auto images = writeViews(dir, views);
   expectRefused(calibrate(dir, arguments(dir, images, "9x6")), 1,
                 "view_03.png: too blurred: its edges are", dir);
+}
+
+// What an automotive camera's pictures are like (issue 47): 1920x1080 JPEG, a board seen large,
+// its edges 4 to 5 px wide. The limits scale with the pictures, so the set passes with the
+// defaults and the lens is the true one; held to the fixed pixel limit, the same pictures are
+// skipped as blurred.
+TEST(IntrinsicsCli, BlurredJpegPicturesOfALargeBoardPassWithTheDefaults) {
+  const TempDir dir;
+  processing::Intrinsics truth = pinhole();
+  truth.imageSize = {1920, 1080};
+  truth.fx *= 3;
+  truth.fy *= 3;
+  truth.cx = 959.5;
+  truth.cy = 539.5;
+  const auto views = anyBoardViews(truth, chessboard(7, 7), 10, 31, 0, Hardship{1.8, 3.0, 0.5});
+  const auto folder = dir / "views";
+  std::filesystem::create_directories(folder);
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    cv::imwrite((folder / fmt::format("view_{:02}.jpg", i)).string(), views[i],
+                {cv::IMWRITE_JPEG_QUALITY, 75});
+  }
+  const auto run = calibrate(dir, arguments(dir, folder, "7x7"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("verdict: PASS"));
+  EXPECT_THAT(run.output, Not(HasSubstr("too blurred")));
+  // The lens as the report prints it: "fx 805.2 +- 0.3  fy ...".
+  std::smatch focal;
+  ASSERT_TRUE(
+      std::regex_search(run.output, focal, std::regex(R"(fx ([0-9.]+) \+- .* fy ([0-9.]+) \+- )")))
+      << run.output;
+  EXPECT_NEAR(std::stod(focal[1]) / truth.fx, 1, 0.02) << run.output;
+  EXPECT_NEAR(std::stod(focal[2]) / truth.fy, 1, 0.02) << run.output;
+
+  const TempDir fixed;
+  auto fixedArgs = arguments(fixed, folder, "7x7");
+  fixedArgs.insert(fixedArgs.end(), {"--max-edge-width-px", "4"});
+  const auto held = calibrate(fixed, fixedArgs);
+  EXPECT_NE(held.status, 0) << held.output;
+  EXPECT_THAT(held.output, HasSubstr("the limit is 4 px (--max-edge-width-px)"));
 }
 
 TEST(IntrinsicsCli, ASolveOutsideItsLimitsWritesNothingAndNamesViews) {

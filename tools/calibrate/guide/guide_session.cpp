@@ -22,7 +22,11 @@ std::string hintFor(const std::string& part) {
 
 }  // namespace
 
-GuideSession::GuideSession(const GuideSettings& settings) : settings_(settings) {}
+GuideSession::GuideSession(const GuideSettings& settings) : settings_(settings) {
+  auto& limits = settings_.limits;
+  limits.maxFocalSdPercent = std::min(limits.maxFocalSdPercent, kGuideFocalSdPercent);
+  limits.maxPrincipalSdPx = std::min(limits.maxPrincipalSdPx, kGuidePrincipalSdPx);
+}
 
 FrameResult GuideSession::offer(const cv::Mat& gray, std::chrono::nanoseconds streamTime) {
   if (imageSize_.area() == 0) {
@@ -62,13 +66,12 @@ FrameResult GuideSession::offer(const cv::Mat& gray, std::chrono::nanoseconds st
     out.note = "the lens passed; nothing more is needed";
     return out;
   }
-  GuideView candidate{
-      {fmt::format("view {}", views_.size() + 1), search.corners, search.grid}, streamTime, 0};
-  candidate.edgeWidthPx = processing::edgeWidthPx(gray, candidate.view);
-  if (candidate.edgeWidthPx > settings_.limits.maxEdgeWidthPx) {
+  GuideView candidate{{fmt::format("view {}", views_.size() + 1), search.corners, search.grid},
+                      streamTime};
+  candidate.view.edgeWidthPx = processing::edgeWidthPx(gray, candidate.view);
+  if (const auto blurred = processing::blurProblem(candidate.view, settings_.limits)) {
     out.outcome = FrameOutcome::kBlurred;
-    out.note = fmt::format("blurred: edges {:.1f} px wide, at most {:g} px (hold the board still)",
-                           candidate.edgeWidthPx, settings_.limits.maxEdgeWidthPx);
+    out.note = fmt::format("{} (hold the board still)", *blurred);
     return out;
   }
   std::vector<processing::BoardView> boards;
@@ -119,23 +122,6 @@ void GuideSession::solve(std::chrono::nanoseconds streamTime) {
   solved.field = limitField(solved.result.intrinsics, circle_, boards, settings_.fieldOfViewDeg);
   solved.verdict =
       processing::judgeCalibration(solved.result, coverage_.coveredShare, settings_.limits);
-  const auto& lens = solved.result.intrinsics;
-  const auto& sd = solved.result.uncertainty;
-  const double focalSdPercent = 100 * std::max(sd.fx / lens.fx, sd.fy / lens.fy);
-  if (focalSdPercent > settings_.maxFocalSdPercent) {
-    solved.verdict.passed = false;
-    solved.verdict.failures.push_back(fmt::format(
-        "the focal length is not pinned down yet: +-{:.2f} %, at most {:g} % (more views, tilted "
-        "other ways)",
-        focalSdPercent, settings_.maxFocalSdPercent));
-  }
-  if (const double ppSd = std::max(sd.cx, sd.cy); ppSd > settings_.maxPrincipalSdPx) {
-    solved.verdict.passed = false;
-    solved.verdict.failures.push_back(fmt::format(
-        "the principal point is not pinned down yet: +-{:.2f} px, at most {:g} px (more views "
-        "near the edges)",
-        ppSd, settings_.maxPrincipalSdPx));
-  }
   solve_ = std::move(solved);
   if (solve_->verdict.passed) passedAt_ = streamTime;
 }

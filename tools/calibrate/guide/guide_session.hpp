@@ -33,13 +33,14 @@ struct GuideSettings {
   // is held, and a guide wants views that add something.
   double repeatOverlap = 0.7;
   std::optional<double> fieldOfViewDeg;  // fisheye: as --field-of-view-deg
-  // A guide solves as soon as it may, so it asks more of a pass than the verdict's limits: the
-  // solve's own uncertainty (one standard deviation, from its covariance) must be this small. A
-  // few views that all lean the same way fit to a tenth of a pixel and still leave the focal
-  // length a percent off; these limits are what keeps such a solve from passing.
-  double maxFocalSdPercent = 0.1;
-  double maxPrincipalSdPx = 0.3;
 };
+
+// A guide solves as soon as it may, so it asks more of the solve's own uncertainty than a folder
+// of pictures is asked (CalibrationLimits): a few views that all lean the same way fit to a tenth
+// of a pixel and still leave the focal length a percent off; these are what keep such a solve
+// from passing. The session holds its limits to them at most.
+inline constexpr double kGuideFocalSdPercent = 0.1;
+inline constexpr double kGuidePrincipalSdPx = 0.3;
 
 enum class FrameOutcome {
   kAccepted,         // a new view was kept
@@ -59,7 +60,6 @@ struct FrameResult {
 struct GuideView {
   processing::BoardView view;  // name: "view N"
   std::chrono::nanoseconds streamTime{0};
-  double edgeWidthPx = 0;
 };
 
 struct GuideSolve {

@@ -93,7 +93,7 @@ std::string guideStateJson(const GuideSession& session, const GuideRunState& run
     views += fmt::format(
         R"({}{{"name": {}, "timeS": {:.3f}, "corners": {}, "edgePx": {:.2f}, "outline": {}}})",
         i ? ", " : "", jsonString(v.view.name), seconds(v.streamTime), v.view.corners.size(),
-        v.edgeWidthPx, outlineJson(v.view.corners));
+        v.view.edgeWidthPx, outlineJson(v.view.corners));
   }
   views += "]";
   const char* phase = session.passed() ? "passed" : run.ended ? "ended" : "collecting";

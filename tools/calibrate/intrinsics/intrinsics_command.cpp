@@ -137,13 +137,11 @@ Detections detectBoards(const std::vector<std::filesystem::path>& files,
           fmt::format("{}: no board found within {:g} s of CPU time (--detect-timeout-s)", name,
                       options.detectTimeoutS));
     } else if (result.outcome == PictureSearch::Outcome::kFound) {
-      if (result.edgeWidthPx > options.limits.maxEdgeWidthPx) {
-        found.notes.push_back(
-            fmt::format("{}: too blurred: its edges are {:.1f} px wide, the limit is {:g} px "
-                        "(--max-edge-width-px)",
-                        name, result.edgeWidthPx, options.limits.maxEdgeWidthPx));
+      processing::BoardView view{name, result.corners, result.grid, result.edgeWidthPx};
+      if (const auto blurred = processing::blurProblem(view, options.limits)) {
+        found.notes.push_back(fmt::format("{}: {}", name, *blurred));
       } else {
-        found.views.push_back({name, result.corners, result.grid});
+        found.views.push_back(std::move(view));
       }
     } else {
       found.notes.push_back(fmt::format("{}: no board", name));
@@ -241,7 +239,7 @@ void runIntrinsics(const IntrinsicsOptions& options, std::ostream& log) {
   const auto coverage = processing::coverageOf(used, found.imageSize, circle.lit);
   auto& lens = result.intrinsics;
   const auto field = limitField(lens, circle, used, options.fieldOfViewDeg);
-  printViewTable(result, options.squareMm, options.limits.maxViewRmsPx, log);
+  printViewTable(result, options.squareMm, options.limits, log);
   printLens(result, field, log);
   log << fmt::format("coverage {:.0f} % of the lens's cells", 100 * coverage.coveredShare);
   if (const auto parts = coverage.uncoveredParts(); !parts.empty()) {

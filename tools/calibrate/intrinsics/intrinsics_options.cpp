@@ -53,10 +53,20 @@ it already was) are skipped with a note.
   --camera NAME              with --update-rig: the camera to update
   --detect-timeout-s S       give up the board search in one picture after S seconds of its CPU
                              time (default 10; the machine's load does not change which count)
-limits of the verdict (a solve outside any of them fails):
-  --max-rms-px X             RMS over all corners (default 1)
-  --max-view-rms-px X        a view above it is left out and named (default 2)
-  --max-edge-width-px X      pictures with wider (blurred) edges are skipped (default 4)
+limits of the verdict (a solve outside any of them fails). By default the pixel limits scale
+with the pictures: blur moves corners by a share of the edges' width, and a board seen large may
+be blurred more before its corners move; each is the larger of its value and that share. Given,
+a pixel limit is exactly what is given:
+  --max-rms-px X             RMS over all corners (default 1, or 0.35 of the views' median edge
+                             width)
+  --max-view-rms-px X        a view above it is left out and named (default 2, or 0.7 of its
+                             edge width)
+  --max-edge-width-px X      pictures with wider (blurred) edges are skipped (default 4, or a
+                             tenth of the board's squares in that picture)
+  --max-focal-sd-percent P   the solve's focal length, one standard deviation (default 0.5 %;
+                             the guide asks 0.1 %)
+  --max-principal-sd-px X    the solve's principal point, one standard deviation (default 2 px;
+                             the guide asks 0.3 px)
   --min-coverage F           share of the lens's image cells with corners, 0..1 (default 0.35)
   --min-views N              views needed (default 5)
 )";
@@ -115,6 +125,13 @@ IntrinsicsOptions parseLensOptions(std::span<const std::string_view> arguments, 
                         std::string_view expected) {
     return [=, &field](std::string_view v) { field = parseDouble(option, v, min, max, expected); };
   };
+  // A pixel limit given is the limit itself: the share of the pictures no longer raises it.
+  const auto exactLimit = [&](std::string_view option, double& field, double& share) {
+    return [&field, &share, option](std::string_view v) {
+      field = parseDouble(option, v, 0.01, 100, "pixels, 0.01 to 100");
+      share = 0;
+    };
+  };
   Handlers lensOptions{
       {"--images", [&](auto v) { o.images = std::string(v); }},
       {"--board",
@@ -155,11 +172,15 @@ IntrinsicsOptions parseLensOptions(std::span<const std::string_view> arguments, 
       {"--camera", [&](auto v) { o.camera = std::string(v); }},
       {"--detect-timeout-s",
        limit("--detect-timeout-s", o.detectTimeoutS, 0.1, 3600, "seconds from 0.1 to 3600")},
-      {"--max-rms-px", limit("--max-rms-px", limits.maxRmsPx, 0.01, 100, "pixels, 0.01 to 100")},
+      {"--max-rms-px", exactLimit("--max-rms-px", limits.maxRmsPx, limits.rmsPerEdgeWidth)},
       {"--max-view-rms-px",
-       limit("--max-view-rms-px", limits.maxViewRmsPx, 0.01, 100, "pixels, 0.01 to 100")},
+       exactLimit("--max-view-rms-px", limits.maxViewRmsPx, limits.viewRmsPerEdgeWidth)},
       {"--max-edge-width-px",
-       limit("--max-edge-width-px", limits.maxEdgeWidthPx, 0.5, 100, "pixels, 0.5 to 100")},
+       exactLimit("--max-edge-width-px", limits.maxEdgeWidthPx, limits.edgeWidthPerSquare)},
+      {"--max-focal-sd-percent", limit("--max-focal-sd-percent", limits.maxFocalSdPercent, 0.001,
+                                       100, "a percentage, 0.001 to 100")},
+      {"--max-principal-sd-px",
+       limit("--max-principal-sd-px", limits.maxPrincipalSdPx, 0.01, 1000, "pixels, 0.01 to 1000")},
       {"--min-coverage", limit("--min-coverage", limits.minCoverage, 0, 1, "a share, 0 to 1")},
       {"--min-views", [&](auto v) {
          limits.minViews = static_cast<int>(

@@ -18,7 +18,7 @@ constexpr int kMinimumWidth = 1280;  // as the residual picture: legible dots an
 }  // namespace
 
 void printViewTable(const processing::IntrinsicCalibration& result, std::optional<double> squareMm,
-                    double maxViewRmsPx, std::ostream& log) {
+                    const processing::CalibrationLimits& limits, std::ostream& log) {
   log << fmt::format("  {:<28} {:>7} {:>9} {:>8} {:>10}\n", "view", "corners", "RMS px", "tilt deg",
                      squareMm ? "distance m" : "dist. sq.");
   for (const auto& view : result.views) {
@@ -29,9 +29,10 @@ void printViewTable(const processing::IntrinsicCalibration& result, std::optiona
     const double tilt =
         std::acos(std::min(1.0, std::abs(normal.dot(position)) / cv::norm(position))) * kToDeg;
     const double distance = cv::norm(position) * (squareMm ? *squareMm / 1000 : 1);
-    log << fmt::format("  {:<28} {:>7} {:>9.3f} {:>8.1f} {:>10.3g}{}\n", view.name,
-                       view.corners.size(), view.rmsPx, tilt, distance,
-                       view.rmsPx > maxViewRmsPx ? "  <- above the limit" : "");
+    log << fmt::format(
+        "  {:<28} {:>7} {:>9.3f} {:>8.1f} {:>10.3g}{}\n", view.name, view.corners.size(),
+        view.rmsPx, tilt, distance,
+        view.rmsPx > limits.viewRmsLimitPx(view.edgeWidthPx) ? "  <- above the limit" : "");
   }
 }
 

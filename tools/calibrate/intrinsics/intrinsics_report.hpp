@@ -17,9 +17,9 @@
 namespace surroundd::calibrate {
 
 // One row per view: its corners, RMS and the board's pose (tilt from facing the camera, distance
-// in squares, or metres when `squareMm` is given); views above `maxViewRmsPx` are marked.
+// in squares, or metres when `squareMm` is given); views above their limit are marked.
 void printViewTable(const processing::IntrinsicCalibration& result, std::optional<double> squareMm,
-                    double maxViewRmsPx, std::ostream& log);
+                    const processing::CalibrationLimits& limits, std::ostream& log);
 
 // The lens, each parameter +- one standard deviation, and the field of view.
 void printLens(const processing::IntrinsicCalibration& result, const processing::FieldOfView& field,
