@@ -40,26 +40,6 @@ std::unique_ptr<render::EglContext> openRendererOnCard(const OutputConfig& outpu
   return std::make_unique<render::EglContext>(render::EglPlatform::kGbm, device, std::move(card));
 }
 
-void checkDisplay(YamlObject& item, const OutputConfig& output,
-                  const DisplayOutputSettings& settings) {
-  checkPresent(item, output, settings.present, "display");
-}
-
-// The renderer draws on one card: every egl display is on it.
-std::optional<OutputConflict> otherCard(const OutputConfig& earlierOutput,
-                                        const OutputConfig& output) {
-  const auto& earlier = settingsOf<DisplayOutputSettings>(earlierOutput);
-  const auto& own = settingsOf<DisplayOutputSettings>(output);
-  if (earlier.present != ViewPresent::kEgl || own.present != ViewPresent::kEgl ||
-      earlier.device == own.device) {
-    return std::nullopt;
-  }
-  return OutputConflict{"device",
-                        fmt::format("an egl display must be on the card of the renderer, which an "
-                                    "earlier egl display puts on {}",
-                                    cardName(earlier))};
-}
-
 }  // namespace
 
 OutputType displayOutputType() {
@@ -77,8 +57,8 @@ OutputType displayOutputType() {
               "how it shows the view: picture (read back, copied to the screen) or egl (drawn "
               "into the screen's buffers on the GPU; the renderer then runs on that card)"),
       },
-      checkDisplay);
-  type.conflict = otherCard;
+      presentCheck<DisplayOutputSettings>("display"));
+  type.conflict = onePlaceForEgl<DisplayOutputSettings>("display", "card", "device", cardName);
   type.openPictureSink = openDisplay;
   type.openRenderer = openRendererOnCard;
   return type;

@@ -47,24 +47,9 @@ std::unique_ptr<render::EglContext> openRendererOnServer(const OutputConfig& out
                                               std::move(display));
 }
 
-void checkWindow(YamlObject& item, const OutputConfig& output,
-                 const WindowOutputSettings& settings) {
-  checkPresent(item, output, settings.present, "window");
-}
-
-// The renderer draws on one X server: every egl window is on it.
-std::optional<OutputConflict> otherServer(const OutputConfig& earlierOutput,
-                                          const OutputConfig& output) {
-  const auto& earlier = settingsOf<WindowOutputSettings>(earlierOutput);
-  const auto& own = settingsOf<WindowOutputSettings>(output);
-  if (earlier.present != ViewPresent::kEgl || own.present != ViewPresent::kEgl ||
-      earlier.display == own.display) {
-    return std::nullopt;
-  }
-  return OutputConflict{
-      "display", fmt::format("an egl window must be on the X server of the renderer, which an "
-                             "earlier egl window puts on '{}'",
-                             earlier.display.empty() ? "$DISPLAY" : earlier.display)};
+// How the conflict names a window's X server.
+std::string serverName(const WindowOutputSettings& settings) {
+  return fmt::format("'{}'", settings.display.empty() ? "$DISPLAY" : settings.display);
 }
 
 }  // namespace
@@ -83,8 +68,8 @@ OutputType windowOutputType() {
               "how it shows the view: picture (read back, sent to the server) or egl (drawn into "
               "the window on the GPU; the renderer then runs on that X server)"),
       },
-      checkWindow);
-  type.conflict = otherServer;
+      presentCheck<WindowOutputSettings>("window"));
+  type.conflict = onePlaceForEgl<WindowOutputSettings>("window", "X server", "display", serverName);
   type.openPictureSink = openWindow;
   type.openRenderer = openRendererOnServer;
   return type;
