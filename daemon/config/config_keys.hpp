@@ -225,7 +225,6 @@ class ConfigKeys {
   void read(YamlObject& object, Section& section) const {
     for (const auto& key : keys_) key.read(object, section);
   }
-  bool empty() const { return keys_.empty(); }
 
   std::vector<KeyDoc> docs() const {
     std::vector<KeyDoc> docs;
