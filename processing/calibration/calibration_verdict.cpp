@@ -17,11 +17,9 @@ constexpr double kToDeg = 180 / std::numbers::pi;
 // The views' edge width as a whole: their median.
 double typicalEdgeWidthPx(const IntrinsicCalibration& result) {
   std::vector<double> widths;
+  widths.reserve(result.views.size());
   for (const auto& view : result.views) widths.push_back(view.edgeWidthPx);
-  if (widths.empty()) return 0;
-  const auto middle = widths.begin() + static_cast<std::ptrdiff_t>(widths.size() / 2);
-  std::nth_element(widths.begin(), middle, widths.end());
-  return *middle;
+  return median(std::move(widths));
 }
 
 // "the limit of 1 px", or where the pictures set it, "the limit of 1.75 px (0.35 of the views'

@@ -57,14 +57,6 @@ std::vector<std::pair<cv::Point2f, cv::Point2f>> neighbourPairs(const BoardView&
   return pairs;
 }
 
-// The middle value (the upper of the two middle ones); 0 for none.
-double median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
-
 }  // namespace
 
 double edgeWidthPx(const cv::Mat& gray, const BoardView& view) {
@@ -86,6 +78,13 @@ double squareSizePx(const BoardView& view) {
   std::vector<double> sides;
   for (const auto& [corner, next] : neighbourPairs(view)) sides.push_back(cv::norm(next - corner));
   return median(sides);
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
 }
 
 std::vector<DuplicateView> findDuplicateViews(std::span<const BoardView> views, double minOverlap) {

@@ -18,6 +18,9 @@ namespace surroundd::processing {
 // sharp picture, 2.5 sigma for one blurred by a Gaussian of sigma pixels.
 double edgeWidthPx(const cv::Mat& gray, const BoardView& view);
 
+// The middle value of a view's measures (the upper of the two middle ones); 0 for none.
+double median(std::vector<double> values);
+
 // The board's squares in the picture, pixels: the median distance between neighbouring corners.
 double squareSizePx(const BoardView& view);
 
