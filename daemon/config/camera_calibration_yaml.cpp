@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 
 namespace surroundd::daemon {
 namespace {

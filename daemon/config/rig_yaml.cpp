@@ -14,7 +14,7 @@
 #include "common/camera_limit.hpp"
 #include "daemon/config/camera_calibration_yaml.hpp"
 #include "daemon/config/camera_source_yaml.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 
 namespace surroundd::daemon {
 

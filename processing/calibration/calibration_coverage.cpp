@@ -9,7 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "processing/calibration/intrinsic_calibration.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 
 namespace surroundd::processing {
 namespace {

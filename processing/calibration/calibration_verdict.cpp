@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "processing/calibration/view_acceptance.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 
 namespace surroundd::processing {
 namespace {

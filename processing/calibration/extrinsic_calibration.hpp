@@ -17,7 +17,7 @@
 #include <opencv2/core.hpp>
 
 #include "processing/calibration/calibration_error.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 #include "processing/rig.hpp"
 
 namespace surroundd::processing {

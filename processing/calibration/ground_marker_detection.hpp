@@ -14,7 +14,7 @@
 
 #include "processing/calibration/calibration_targets.hpp"
 #include "processing/calibration/extrinsic_calibration.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 #include "processing/rig.hpp"
 
 namespace surroundd::processing {

@@ -16,7 +16,7 @@
 
 #include "processing/calibration/calibration_board.hpp"
 #include "processing/calibration/calibration_error.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 #include "processing/rig.hpp"
 
 namespace surroundd::processing {

@@ -10,7 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "processing/calibration/target_detection.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 
 namespace surroundd::processing {
 namespace {

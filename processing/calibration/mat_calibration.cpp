@@ -8,7 +8,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "processing/calibration/calibration_error.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 
 namespace surroundd::processing {
 namespace {

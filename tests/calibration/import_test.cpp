@@ -19,7 +19,7 @@
 #include <sys/stat.h>
 
 #include "daemon/config/rig_yaml.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 #include "tests/calibration/import_test_support.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tools/calibrate/calibrate_options.hpp"

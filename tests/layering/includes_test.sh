@@ -12,8 +12,8 @@ root="$1"
 cd "$root"
 
 # shellcheck disable=SC2116 # echo joins the lines into one list of words
-below_daemon=$(echo common capture vehicle processing processing/stitch processing/colour \
-  processing/calibration render render/outputs)
+below_daemon=$(echo common capture vehicle processing processing/lens processing/stitch \
+  processing/colour processing/calibration render render/outputs)
 # One folder per output kind (daemon/outputs/<kind>), each a part of surroundd_output_kinds.
 output_kinds=$(find daemon/outputs -mindepth 1 -type d 2>/dev/null | sort | tr '\n' ' ')
 libraries="$below_daemon daemon/control daemon/config daemon/outputs $output_kinds daemon \
@@ -23,10 +23,14 @@ libraries="$below_daemon daemon/control daemon/config daemon/outputs $output_kin
 allowed() {
   case "$1" in
     common) echo "" ;;
-    capture | vehicle | processing) echo "common" ;;
-    processing/stitch) echo "common processing" ;;
-    processing/colour | processing/calibration) echo "common processing processing/stitch" ;;
-    render) echo "common processing processing/stitch" ;;
+    capture | vehicle | processing/lens) echo "common" ;;
+    # The lens models are the shared geometry's own folder: one library with it.
+    processing) echo "common processing/lens" ;;
+    processing/stitch) echo "common processing processing/lens" ;;
+    processing/colour | processing/calibration)
+      echo "common processing processing/lens processing/stitch"
+      ;;
+    render) echo "common processing processing/lens processing/stitch" ;;
     render/outputs) echo "common render" ;;
     # The daemon: its control protocol stands alone; its config reads into every part's
     # settings; the output kinds are registered into the config's registry; the runtime (its

@@ -2,7 +2,7 @@
 // ../shared/data/README.md), unproject as the inverse of project over the whole field of view, and
 // the field cut where a lens's polynomial stops increasing.
 
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 
 #include <filesystem>
 #include <functional>

@@ -7,7 +7,7 @@
 
 #include "common/work_pool.hpp"
 #include "daemon/config/rig_yaml.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 #include "processing/vehicle_body.hpp"
 #include "tests/synth/synth_test_support.hpp"
 

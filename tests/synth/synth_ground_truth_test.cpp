@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "daemon/config/rig_yaml.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 #include "tests/synth/synth_test_support.hpp"
 #include "tools/synth/scene.hpp"
 #include "tools/synth/vehicle_path.hpp"

@@ -4,7 +4,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 
 namespace surroundd::bench {
 namespace {

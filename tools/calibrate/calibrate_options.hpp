@@ -17,7 +17,7 @@
 #include <opencv2/core.hpp>
 
 #include "processing/calibration/mat_calibration.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 #include "render/outputs/credentials.hpp"
 #include "tools/calibrate/guide/guide_options.hpp"
 #include "tools/calibrate/guide/mat_guide_options.hpp"

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -104,6 +105,10 @@ Fields mountFields(const processing::Pose& pose) {
 
 bool near(double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(1.0, std::abs(b)); }
 
+bool near(std::span<const double> a, std::span<const double> b) {
+  return std::ranges::equal(a, b, [](double x, double y) { return near(x, y); });
+}
+
 // Equal within the digits written (12 significant; a pose also goes through its angles).
 bool sameCalibration(const processing::CameraCalibration& a,
                      const processing::CameraCalibration& b) {
@@ -113,11 +118,10 @@ bool sameCalibration(const processing::CameraCalibration& a,
       a.name == b.name && a.role == b.role && i.model == j.model && i.imageSize == j.imageSize &&
       near(i.fx, j.fx) && near(i.fy, j.fy) && near(i.cx, j.cx) && near(i.cy, j.cy) &&
       // A pinhole's field is not written: it follows from the distortion.
-      (i.model != processing::LensModel::kFisheye || near(i.maxFieldAngleRad, j.maxFieldAngleRad));
-  const std::size_t coefficients = i.model == processing::LensModel::kFisheye ? 4 : 5;
-  for (std::size_t k = 0; k < coefficients; ++k) {
-    same = same && near(i.distortion[k], j.distortion[k]);
-  }
+      (!processing::isWideAngle(i.model) || near(i.maxFieldAngleRad, j.maxFieldAngleRad)) &&
+      near(i.distortion, j.distortion) && near(i.ocam.c, j.ocam.c) && near(i.ocam.d, j.ocam.d) &&
+      near(i.ocam.e, j.ocam.e) && near(i.ocam.worldToImage, j.ocam.worldToImage) &&
+      near(i.ocam.imageToWorld, j.ocam.imageToWorld);
   for (int k = 0; k < 3; ++k) same = same && near(a.pose.position[k], b.pose.position[k]);
   for (int k = 0; k < 9; ++k) same = same && near(a.pose.rotation.val[k], b.pose.rotation.val[k]);
   return same;

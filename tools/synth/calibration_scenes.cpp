@@ -12,7 +12,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "processing/calibration/target_detection.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 #include "tools/synth/hash.hpp"
 
 namespace surroundd::synth {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 
 namespace surroundd::synth {
 namespace {

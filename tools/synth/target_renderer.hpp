@@ -16,7 +16,7 @@
 #include <opencv2/core.hpp>
 
 #include "processing/calibration/calibration_targets.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 #include "processing/rig.hpp"
 #include "tools/synth/photometrics.hpp"
 

@@ -103,8 +103,7 @@ std::string guideStateJson(const GuideSession& session, const GuideRunState& run
       R"("frames": {}, "streamTimeS": {:.3f}, "views": {}, "coverage": {}, "minViews": {}, )"
       R"("hints": {}, "last": {{"outcome": "{}", "note": {}}}, "verdict": {}, "passedAtS": {}, )"
       R"("written": {}, "error": {}}})",
-      phase, jsonString(settings.board.describe()),
-      settings.model == processing::LensModel::kFisheye ? "fisheye" : "pinhole",
+      phase, jsonString(settings.board.describe()), processing::lensModelName(settings.model),
       session.imageSize().width, session.imageSize().height, session.framesOffered(),
       seconds(run.streamTime), views,
       session.imageSize().area() > 0 ? coverageJson(session.coverage(), settings.limits.minCoverage)

@@ -10,7 +10,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 #include "tools/calibrate/import/import_options.hpp"
 #include "tools/calibrate/import/source_frame.hpp"
 

@@ -1,6 +1,6 @@
 #pragma once
 // The lens of an imported camera from the parts its files gave (foreign_calibration.hpp), in the
-// project's lens models (processing/camera_model.hpp).
+// project's lens models (processing/lens/camera_model.hpp).
 
 #include <optional>
 #include <string>

@@ -154,9 +154,10 @@ IntrinsicsOptions parseLensOptions(std::span<const std::string_view> arguments, 
        [&](auto v) { o.squareMm = parseDouble("--square", v, 0.1, 10000, "millimetres"); }},
       {"--model",
        [&](auto v) {
-         if (v != "pinhole" && v != "fisheye") throw wrongModel(v);
-         o.model =
-             v == "pinhole" ? processing::LensModel::kPinhole : processing::LensModel::kFisheye;
+         // OpenCV solves these two; an OCamCalib lens comes from its own toolbox (import).
+         const auto named = processing::lensModelNamed(v);
+         if (!named || *named == processing::LensModel::kOcam) throw wrongModel(v);
+         o.model = *named;
          model = true;
        }},
       {"--out", [&](auto v) { o.out = std::string(v); }},

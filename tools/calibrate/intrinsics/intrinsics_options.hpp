@@ -11,7 +11,7 @@
 
 #include "processing/calibration/calibration_board.hpp"
 #include "processing/calibration/calibration_verdict.hpp"
-#include "processing/camera_model.hpp"
+#include "processing/lens/camera_model.hpp"
 
 namespace surroundd::calibrate {
 

@@ -45,7 +45,7 @@ void printLens(const processing::IntrinsicCalibration& result, const processing:
   for (const auto& view : result.views) corners += view.corners.size();
   log << fmt::format("RMS {:.3f} px over {} corners in {} views\n", result.rmsPx, corners,
                      result.views.size());
-  log << fmt::format("{} (+- one standard deviation):\n", fisheye ? "fisheye" : "pinhole");
+  log << fmt::format("{} (+- one standard deviation):\n", processing::lensModelName(in.model));
   log << fmt::format(
       "  fx {:.3f} +- {:.3f}  fy {:.3f} +- {:.3f}  cx {:.3f} +- {:.3f}  cy {:.3f} "
       "+- {:.3f} px\n",
