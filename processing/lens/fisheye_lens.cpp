@@ -16,16 +16,11 @@ Radial fisheyeRadial(const std::array<double, 5>& d, double theta) {
 
 }  // namespace
 
-FisheyeLens::FisheyeLens(const Intrinsics& in)
-    : fx_(in.fx), fy_(in.fy), cx_(in.cx), cy_(in.cy), d_(in.distortion) {
+FisheyeLens::FisheyeLens(const Intrinsics& in) : plane_(in), d_(in.distortion) {
   // No ray is further than 180 degrees off axis, whatever the field asks for.
   field_.askedRad = std::min(in.maxFieldAngleRad, std::numbers::pi);
   field_.fieldRad = monotonicLimit([&](double t) { return fisheyeRadial(d_, t); }, field_.askedRad);
   field_.edgeRadius = fisheyeRadial(d_, field_.fieldRad).value;
-}
-
-cv::Point2d FisheyeLens::sensorPoint(const cv::Point2d& pixel) const {
-  return {(pixel.x - cx_) / fx_, (pixel.y - cy_) / fy_};
 }
 
 std::optional<cv::Point2d> FisheyeLens::project(const cv::Vec3d& p) const {
@@ -39,7 +34,7 @@ std::optional<cv::Point2d> FisheyeLens::project(const cv::Vec3d& p) const {
     xd = p[0] * scale;
     yd = p[1] * scale;
   }
-  return cv::Point2d(fx_ * xd + cx_, fy_ * yd + cy_);
+  return plane_.pixel(xd, yd);
 }
 
 std::optional<cv::Vec3d> FisheyeLens::unproject(const cv::Point2d& pixel) const {

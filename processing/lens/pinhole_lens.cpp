@@ -17,14 +17,9 @@ constexpr double kMaxRadius = 10.0;
 
 }  // namespace
 
-PinholeLens::PinholeLens(const Intrinsics& in)
-    : fx_(in.fx), fy_(in.fy), cx_(in.cx), cy_(in.cy), d_(in.distortion) {
+PinholeLens::PinholeLens(const Intrinsics& in) : plane_(in), d_(in.distortion) {
   maxRadius_ = monotonicLimit([&](double r) { return pinholeRadial(d_, r); }, kMaxRadius);
   field_ = {std::atan(kMaxRadius), std::atan(maxRadius_), pinholeRadial(d_, maxRadius_).value};
-}
-
-cv::Point2d PinholeLens::sensorPoint(const cv::Point2d& pixel) const {
-  return {(pixel.x - cx_) / fx_, (pixel.y - cy_) / fy_};
 }
 
 std::optional<cv::Point2d> PinholeLens::project(const cv::Vec3d& p) const {
@@ -37,7 +32,7 @@ std::optional<cv::Point2d> PinholeLens::project(const cv::Vec3d& p) const {
   const double radial = 1 + r2 * (d[0] + r2 * (d[1] + r2 * d[4]));
   const double xd = x * radial + 2 * d[2] * x * y + d[3] * (r2 + 2 * x * x);
   const double yd = y * radial + d[2] * (r2 + 2 * y * y) + 2 * d[3] * x * y;
-  return cv::Point2d(fx_ * xd + cx_, fy_ * yd + cy_);
+  return plane_.pixel(xd, yd);
 }
 
 std::optional<cv::Vec3d> PinholeLens::unproject(const cv::Point2d& pixel) const {

@@ -9,6 +9,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "processing/lens/focal_plane.hpp"
 #include "processing/lens/intrinsics.hpp"
 #include "processing/lens/radial_polynomial.hpp"
 
@@ -24,13 +25,13 @@ class PinholeLens {
 
   const LensField& field() const { return field_; }
   // The normalized image point of a pixel, still distorted.
-  cv::Point2d sensorPoint(const cv::Point2d& pixel) const;
+  cv::Point2d sensorPoint(const cv::Point2d& pixel) const { return plane_.normalized(pixel); }
   std::optional<cv::Point2d> project(const cv::Vec3d& point) const;
   std::optional<cv::Vec3d> unproject(const cv::Point2d& pixel) const;
-  cv::Vec2d axisFocalPx() const { return {fx_, fy_}; }
+  cv::Vec2d axisFocalPx() const { return {plane_.fx, plane_.fy}; }
 
  private:
-  double fx_, fy_, cx_, cy_;
+  FocalPlane plane_;
   std::array<double, 5> d_;
   double maxRadius_ = 0;  // the undistorted normalized radius at the edge of the valid field
   LensField field_;
