@@ -20,6 +20,10 @@ struct ColourField {
   std::span<const std::uint16_t> shares;
   int block = 4;          // pixels a block side
   bool additive = false;  // values are offsets in levels; otherwise gains (value / 255 + 1)
+  // Per camera, B G R gains every pixel takes before the field (a global balance), as
+  // applyCameraGains() (processing/colour/camera_gains.hpp) applies them; empty: none. Borrowed,
+  // updated in place each set.
+  std::span<const cv::Vec3f> cameraGains;
 };
 
 }  // namespace surroundd::processing

@@ -37,6 +37,7 @@ uniform int u_correction;   // 0 none, 1 multiplicative, 2 additive
 uniform int u_block;        // the correction's block side, pixels
 uniform sampler2D u_field;  // its field on the block grid, levels at 255 (texelFetch only)
 uniform usampler2D u_shares;
+uniform int u_balanced;     // 1: each camera's gains (u_gains) before the field
 out vec4 o_colour;
 
 // cv::cvtColor's BT.601 limited-range constants (its 20-bit fixed point, as yuvToBgr() in
@@ -150,17 +151,33 @@ std::string fragmentSource(const PanoramaLut& lut, PixelFormat format) {
   vec2 fraction = vec2(float(tap.y & 255u), float((tap.y >> 8) & 255u)) / {0}.0;
 {1}  return vec3({2}.0, {3}.0, {4}.0);
 }}
+// applyCameraGains() in processing/colour/camera_gains.cpp: the pixel's camera's gains, in a seam
+// band their harmonic mix with the other camera's, on the stitched panorama's 8-bit levels.
+uniform vec3 u_gains[{5}];
+vec3 balanced(vec3 level, uvec2 tap, uvec2 blend, uint weight) {{
+  uint camera = (tap.y >> 16) & 255u;
+  if (camera == {6}u) return level;
+  vec3 gain = u_gains[camera];
+  uint other = (blend.y >> 16) & 255u;
+  if (weight != 0u && other != {6}u) {{
+    gain = 1.0 / mix(1.0 / gain, 1.0 / u_gains[other], float(weight) / 256.0);
+  }}
+  return clamp(floor(floor(level + 0.5) * gain + 0.5), 0.0, 255.0);
+}}
 void main() {{
   ivec2 pixel = ivec2(gl_FragCoord.xy);
-  vec3 colour = sampleTap(texelFetch(u_taps, pixel, 0).xy);
+  uvec2 tap = texelFetch(u_taps, pixel, 0).xy;
+  vec3 colour = sampleTap(tap);
   uvec2 blend = texelFetch(u_blends, pixel, 0).xy;
   uint weight = blend.y >> 24;
   if (weight != 0u) colour = mix(colour, sampleTap(blend), float(weight) / 256.0);
+  if (u_balanced != 0) colour = balanced(colour, tap, blend, weight);
   if (u_correction != 0) colour = corrected(colour, pixel);
   o_colour = vec4(colour.bgr / 255.0, 1.0);
 }}
 )",
-                        LutTap::kFractionOne, dispatch, unseen[0], unseen[1], unseen[2]);
+                        LutTap::kFractionOne, dispatch, unseen[0], unseen[1], unseen[2],
+                        lut.cameraSizes.size(), static_cast<int>(PanoramaLut::kUnseen));
   return source;
 }
 
@@ -185,7 +202,9 @@ GpuStitcher::GpuStitcher(const PanoramaLut& lut, PixelFormat format, WorkPool& p
       program_(fmt::format("GPU stitch ({})", toString(format)), kVertex,
                fragmentSource(lut, format)),
       correctionUniform_(program_.uniform("u_correction")),
-      blockUniform_(program_.uniform("u_block")) {
+      blockUniform_(program_.uniform("u_block")),
+      balancedUniform_(program_.uniform("u_balanced")),
+      gainsUniform_(program_.uniform("u_gains")) {
   GLint maxSize = 0;
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
   if (size_.width > maxSize || size_.height > maxSize) {
@@ -227,6 +246,7 @@ GpuStitcher::GpuStitcher(const PanoramaLut& lut, PixelFormat format, WorkPool& p
   glUniform1i(program_.uniform("u_field"), 2);
   glUniform1i(program_.uniform("u_shares"), 3);
   glUniform1i(correctionUniform_, 0);
+  glUniform1i(balancedUniform_, 0);
   GLint unit = 4;
   for (std::size_t camera = 0; camera < cameras_.size(); ++camera) {
     glUniform1i(program_.uniform(fmt::format("u_pixels{}", camera).c_str()), unit++);
@@ -287,14 +307,20 @@ void GpuStitcher::upload(std::span<const cv::Mat> frames, std::span<const Dmabuf
 }
 
 void GpuStitcher::correctWith(const std::optional<processing::ColourField>& field) {
+  if (field && field->shares.size() != static_cast<std::size_t>(size_.area())) {
+    throw std::invalid_argument("the correction was set up for another panorama");
+  }
+  if (field && !field->cameraGains.empty() && field->cameraGains.size() != cameras_.size()) {
+    throw std::invalid_argument(fmt::format("the correction has gains for {} cameras, not {}",
+                                            field->cameraGains.size(), cameras_.size()));
+  }
   fieldValues_ = field ? field->values : nullptr;
+  cameraGains_ = field ? field->cameraGains : std::span<const cv::Vec3f>();
   glUseProgram(program_.name());
+  glUniform1i(balancedUniform_, cameraGains_.empty() ? 0 : 1);
   if (!field) {
     glUniform1i(correctionUniform_, 0);
     return;
-  }
-  if (field->shares.size() != static_cast<std::size_t>(size_.area())) {
-    throw std::invalid_argument("the correction was set up for another panorama");
   }
   const cv::Size grid = field->values->size();
   field_ = gl::Texture();
@@ -328,6 +354,12 @@ void GpuStitcher::stitch() {
   glViewport(0, 0, size_.width, size_.height);
   glDisable(GL_DEPTH_TEST);
   glUseProgram(program_.name());
+  if (!cameraGains_.empty()) {
+    // As the last update() left them.
+    static_assert(sizeof(cv::Vec3f) == 3 * sizeof(float));
+    glUniform3fv(gainsUniform_, static_cast<GLsizei>(cameraGains_.size()),
+                 cameraGains_.front().val);
+  }
   const auto bind = [](GLint unit, GLuint texture) {
     glActiveTexture(GL_TEXTURE0 + unit);
     glBindTexture(GL_TEXTURE_2D, texture);

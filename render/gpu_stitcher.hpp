@@ -89,14 +89,17 @@ class GpuStitcher {
   gl::Texture taps_;                             // RG32UI: each pixel's LutTap as two words
   gl::Texture blends_;                    // the same for its blend tap; weight 0 where it has none
   const cv::Mat* fieldValues_ = nullptr;  // the correction's block grid, null with none
-  gl::Texture field_;                     // RGB32F, its copy uploaded per stitch
-  gl::Texture shares_;                    // R16UI, each panorama pixel's source share 0..256
+  std::span<const cv::Vec3f> cameraGains_;  // the correction's, before its field; empty: none
+  gl::Texture field_;                       // RGB32F, its copy uploaded per stitch
+  gl::Texture shares_;                      // R16UI, each panorama pixel's source share 0..256
   gl::Texture panorama_;
   gl::Framebuffer framebuffer_;
   gl::VertexArray emptyArray_;  // the full-screen triangle makes its vertices from gl_VertexID
   ShaderProgram program_;
   GLint correctionUniform_;  // 0 none, 1 multiplicative, 2 additive
   GLint blockUniform_;
+  GLint balancedUniform_;
+  GLint gainsUniform_;
 };
 
 }  // namespace surroundd::render

@@ -247,6 +247,9 @@ const ConfigKeys<ColourCorrectionConfig>& colourKeys() {
                   {std::string(kGainRangeRule)}),
       Key::choice("seam_data", poisson(&Settings::groundSeams), {{"ground", true}, {"all", false}},
                   "which pixels the seams are measured on"),
+      Key::flag("balance", poisson(&Settings::balance),
+                "poisson: each camera's gains first, fitted over the seams' ground, taking every "
+                "camera to the cameras' average; the field then corrects what is left"),
   };
   return kKeys;
 }

@@ -8,6 +8,7 @@
 
 #include "daemon/config/panorama_setup.hpp"
 #include "daemon/pipeline_ends.hpp"
+#include "processing/colour/camera_gains.hpp"
 #include "processing/stitch/i420_picture.hpp"
 #include "processing/stitch/view_lut.hpp"
 
@@ -133,6 +134,9 @@ void PanoramaStage::gather(ViewPicture& view, cv::Mat& picture) {
 
 void PanoramaStage::correct(ViewPicture& view, const FrameWork& work, cv::Mat& picture,
                             cv::Mat* i420) {
+  if (poisson_ && !poisson_->cameraGains().empty()) {
+    processing::applyCameraGains(picture, view.lut_, poisson_->cameraGains(), pool_);
+  }
   const auto faults = std::span(work.faults).first(work.set.cameraCount);
   const bool anyFaulty = std::ranges::any_of(faults, [](const char* f) { return f != nullptr; });
   if (poisson_ && i420 != nullptr && !anyFaulty) {

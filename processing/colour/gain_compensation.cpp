@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "common/work_pool.hpp"
+#include "processing/colour/camera_gains.hpp"
 #include "processing/stitch/bilinear_sample.hpp"
 
 namespace surroundd::processing {
@@ -145,37 +145,7 @@ void GainCompensation::update(std::span<const cv::Mat> frames, PixelFormat forma
 }
 
 void GainCompensation::apply(cv::Mat& picture, const PanoramaLut& lut) {
-  const int width = lut.size.width;
-  pool_.parallelFor(
-      lut.size.height,
-      [&](int first, int last) {
-        for (int v = first; v < last; ++v) {
-          auto* out = picture.ptr<cv::Vec3b>(v);
-          const LutTap* taps = lut.taps.data() + static_cast<std::size_t>(v) * width;
-          const std::uint32_t rowStart =
-              static_cast<std::uint32_t>(v) * static_cast<std::uint32_t>(width);
-          auto blend = lut.blendTaps.begin() + lut.blendRowBegin[v];
-          const auto blendEnd = lut.blendTaps.begin() + lut.blendRowBegin[v + 1];
-          for (int u = 0; u < width; ++u) {
-            const LutTap* other = nullptr;
-            if (blend != blendEnd && blend->pixel == rowStart + static_cast<std::uint32_t>(u)) {
-              other = &blend->tap;
-              ++blend;
-            }
-            if (taps[u].camera == PanoramaLut::kUnseen) continue;
-            cv::Vec3f gain = gains_[taps[u].camera];
-            // In a seam band the pixel mixes two cameras: so do their gains. (A view's pixel at
-            // the edge of what the cameras see mixes in the unseen colour, which no gain changes.)
-            if (other != nullptr && other->camera != PanoramaLut::kUnseen) {
-              const float weight = other->weight / 256.0f;
-              gain = gain * (1 - weight) + gains_[other->camera] * weight;
-            }
-            for (int c = 0; c < 3; ++c)
-              out[u][c] = cv::saturate_cast<std::uint8_t>(out[u][c] * gain[c]);
-          }
-        }
-      },
-      pool_.threads() * 4);
+  applyCameraGains(picture, lut, gains_, pool_);
 }
 
 }  // namespace surroundd::processing

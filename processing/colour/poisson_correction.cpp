@@ -10,6 +10,7 @@
 
 #include "common/camera_limit.hpp"
 #include "common/work_pool.hpp"
+#include "processing/colour/camera_gains.hpp"
 #include "processing/colour/float_lanes.hpp"
 #include "processing/colour/poisson_correction_state.hpp"
 #include "processing/stitch/i420_picture.hpp"
@@ -82,6 +83,14 @@ PoissonColourCorrection::PoissonColourCorrection(const Rig& rig, const PanoramaS
   full_ = &configurationFor(activeCameras_);
   active_ = full_;
   const CorrectionDomain& domain = full_->domain;
+  if (settings.balance) {
+    std::vector<std::string> names;
+    for (const auto& camera : rig.cameras) names.push_back(camera.name);
+    balance_ = std::make_unique<ColourBalance>(std::move(names), settings.minGain, settings.maxGain,
+                                               settings.balanceSmoothing);
+    pairRatios_.resize(domain.seams.size());
+    present_.resize(rig.cameras.size());
+  }
   fieldStorage_.assign(static_cast<std::size_t>(domain.grid.area()) * 3 + 1, 0.0F);
   field_ = cv::Mat(domain.grid, CV_32FC3, fieldStorage_.data());
   for (int r = 0; r < domain.block; ++r) {
@@ -112,7 +121,12 @@ const CorrectionDomain& PoissonColourCorrection::domain() const { return active_
 
 ColourField PoissonColourCorrection::asColourField() const {
   const CorrectionDomain& shape = domain();
-  return {&field_, shape.share, shape.block, settings_.field == CorrectionField::kAdditive};
+  return {&field_, shape.share, shape.block, settings_.field == CorrectionField::kAdditive,
+          cameraGains()};
+}
+
+std::span<const cv::Vec3f> PoissonColourCorrection::cameraGains() const {
+  return balance_ ? std::span<const cv::Vec3f>(balance_->gains()) : std::span<const cv::Vec3f>();
 }
 
 // Which cameras are present is a bitmask (configurationFor's key); the rig's LUT holds at most
@@ -285,6 +299,7 @@ auto PoissonColourCorrection::kernelFor(KernelPath path, Instance instance) cons
 }
 
 void PoissonColourCorrection::apply(cv::Mat& panorama, KernelPath path) {
+  if (balance_) applyCameraGains(panorama, lut_, balance_->gains(), pool_);
   const auto rows = kernelFor(path, []<CorrectionField kField, KernelPath kPath>() {
     return &PoissonColourCorrection::applyRows<kField, kPath>;
   });

@@ -40,6 +40,7 @@
 #include <opencv2/core.hpp>
 
 #include "common/pixel_format.hpp"
+#include "processing/colour/colour_balance.hpp"
 #include "processing/colour/correction_domain.hpp"
 #include "processing/colour/poisson_solver.hpp"
 #include "processing/colour/seam_statistics.hpp"
@@ -66,6 +67,10 @@ struct ColourCorrectionSettings {
   double minGain = 0.5;            // the field's bounds, as gains (additive: the levels these
   double maxGain = 2.0;            //   gains would add to the seam's source level)
   bool groundSeams = true;         // seam data from the bowl's floor only
+  // A global balance first (colour_balance.hpp): every camera's gains, fitted over the seams'
+  // ground, take the cameras to their average, and the field corrects what is left.
+  bool balance = false;
+  double balanceSmoothing = 0.8;  // the previous set's share of the balance's gains, 0..0.99
 
   bool operator==(const ColourCorrectionSettings&) const = default;
 };
@@ -142,6 +147,9 @@ class PoissonColourCorrection {
                KernelPath path = kNativeKernels);
 
   const std::vector<SeamReport>& seams() const { return seamReports_; }
+  // With settings().balance, each camera's B G R gains that apply() and the view's pictures take
+  // before the field (processing/colour/camera_gains.hpp); empty without.
+  std::span<const cv::Vec3f> cameraGains() const;
 
   // The field at block resolution, CV_32FC3: the levels it adds to a pixel at 255, the most it
   // changes any pixel (0 outside the regions' reach). Additive: simply the levels it adds.
@@ -155,6 +163,9 @@ class PoissonColourCorrection {
   Configuration& configurationFor(std::uint32_t presentCameras);
   void followLostCameras(std::span<const cv::Mat> frames);
   void gatherSeams(std::span<const cv::Mat> frames, PixelFormat format);
+  // Fits the balance to this set's seam levels, then takes the levels and the seam data to what
+  // they are after it.
+  void balanceSeams(std::span<const cv::Mat> frames);
   // Measures part `part` of the seam blocks, with its own meter: of the regions' blocks counted
   // in turn, every meters_.size()-th from the part's, so that the parts cost alike.
   void measureSeamBlocks(std::size_t part, std::span<const cv::Mat> frames, PixelFormat format);
@@ -190,10 +201,13 @@ class PoissonColourCorrection {
   std::vector<int> missingSets_;  // per camera: frame sets in a row without it
   std::vector<std::string> changes_;
   std::vector<SeamReport> seamReports_;
-  std::vector<SeamBlockMeter> meters_;  // one per part of the seam blocks measured at once
-  std::vector<float> window_;           // running median along a seam
-  std::vector<std::uint8_t> resolve_;   // per region
-  std::vector<float> stepScratch_;      // per block of a seam: its step without and with the field
+  std::unique_ptr<ColourBalance> balance_;   // settings_.balance
+  std::vector<CameraPairRatio> pairRatios_;  // one per seam of the full domain
+  std::vector<std::uint8_t> present_;        // per camera, in this set
+  std::vector<SeamBlockMeter> meters_;       // one per part of the seam blocks measured at once
+  std::vector<float> window_;                // running median along a seam
+  std::vector<std::uint8_t> resolve_;        // per region
+  std::vector<float> stepScratch_;  // per block of a seam: its step without and with the field
   // CV_32FC3 over fieldStorage_, which has one float past the last block: the vector applies read
   // four floats for a block's three channels.
   std::vector<float> fieldStorage_;

@@ -21,6 +21,14 @@ float medianOf(float* values, std::size_t count) {
   return values[count / 2];
 }
 
+// What the field is solved for at a seam block, channel c: log(target / source), or the levels'
+// difference for an additive field.
+float seamValue(const SeamBlockLevels& levels, int c, bool multiplicative) {
+  return multiplicative ? std::log(std::max(levels.target[c], kDarkestMean) /
+                                   std::max(levels.source[c], kDarkestMean))
+                        : levels.target[c] - levels.source[c];
+}
+
 // "Worse" is worse by more than 8-bit rounding and sensor noise move a block's step: on cameras
 // that already agree the seams would otherwise drop in and out with the noise.
 constexpr double kWorseLevels = 0.5;
@@ -107,12 +115,7 @@ void PoissonColourCorrection::measureSeamBlocks(std::size_t part, std::span<cons
           active.domain, d, SampledImage::of(target, format), SampledImage::of(source, format));
       state.levels[k] = levels;
       state.measuredValid[k] = levels.valid ? 1 : 0;
-      for (int c = 0; c < 3; ++c) {
-        state.measured[k * 3 + c] = multiplicative
-                                        ? std::log(std::max(levels.target[c], kDarkestMean) /
-                                                   std::max(levels.source[c], kDarkestMean))
-                                        : levels.target[c] - levels.source[c];
-      }
+      for (int c = 0; c < 3; ++c) state.measured[k * 3 + c] = seamValue(levels, c, multiplicative);
     }
   }
 }
@@ -132,6 +135,7 @@ void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames, Pixel
         }
       },
       parts);
+  if (balance_) balanceSeams(frames);
 
   seamReports_.resize(active.domain.seams.size());
   const auto logMin = static_cast<float>(std::log(settings_.minGain));
@@ -193,6 +197,48 @@ void PoissonColourCorrection::gatherSeams(std::span<const cv::Mat> frames, Pixel
     }
   }
   active.firstFrame = false;
+}
+
+void PoissonColourCorrection::balanceSeams(std::span<const cv::Mat> frames) {
+  Configuration& active = *active_;
+  // Per seam, the median over its measured blocks of log(target / source), per channel: what the
+  // balance is fitted to. stepScratch_ holds a seam's blocks four times over.
+  float* values = stepScratch_.data();
+  std::size_t pairs = 0;
+  for (const CorrectionSeam& seam : active.domain.seams) {
+    const CorrectionRegion& region = active.domain.regions[seam.region];
+    const RegionState& state = active.regions[seam.region];
+    if (frames[region.source].empty() || frames[seam.target].empty()) continue;
+    CameraPairRatio& pair = pairRatios_[pairs++];
+    pair = {region.source, seam.target, {}, 0};
+    for (int c = 0; c < 3; ++c) {
+      std::size_t count = 0;
+      for (const auto k : seam.blocks) {
+        if (state.measuredValid[k] == 0) continue;
+        values[count++] = seamValue(state.levels[k], c, true);
+      }
+      pair.weight = static_cast<double>(count);
+      pair.logRatio[c] = count == 0 ? 0.0f : medianOf(values, count);
+    }
+  }
+  for (std::size_t c = 0; c < present_.size(); ++c) present_[c] = frames[c].empty() ? 0 : 1;
+  balance_->update(std::span(pairRatios_).first(pairs), present_);
+  for (const auto& note : balance_->notesOfLastUpdate()) changes_.push_back(note);
+
+  // The levels as the balance leaves them, and the seam data from those.
+  const std::vector<cv::Vec3f>& gains = balance_->gains();
+  const bool multiplicative = settings_.field == CorrectionField::kMultiplicative;
+  for (std::size_t r = 0; r < active.regions.size(); ++r) {
+    const CorrectionRegion& region = active.domain.regions[r];
+    RegionState& state = active.regions[r];
+    for (std::size_t k = 0; k < region.dirichlet.size(); ++k) {
+      if (state.measuredValid[k] == 0) continue;
+      SeamBlockLevels& levels = state.levels[k];
+      levels.source = levels.source.mul(gains[region.source]);
+      levels.target = levels.target.mul(gains[region.dirichlet[k].target]);
+      for (int c = 0; c < 3; ++c) state.measured[k * 3 + c] = seamValue(levels, c, multiplicative);
+    }
+  }
 }
 
 bool PoissonColourCorrection::dropWorseningSeams() {

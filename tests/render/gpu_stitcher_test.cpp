@@ -164,19 +164,24 @@ TEST_F(GpuStitcherTest, ThePanoramaIsTheCpuStitchersForEveryFormat) {
 // A second set of frames through the same stitcher replaces the first (the pixel buffers taken
 // in turn): the panorama follows the frames.
 // Camera 1 a quarter darker, so that the correction has a step to take out; the field solved on
-// the CPU from the held frames, applied by Stitcher + apply() and by the GPU pass.
+// the CPU from the held frames, applied by Stitcher + apply() and by the GPU pass; and with the
+// cameras' balance gains before the field (colour_balance.hpp).
 TEST_F(GpuStitcherTest, BothCorrectionFieldsAreAppliedAsTheCpuAppliesThem) {
   const auto& truth = processing::testing::smallRecording();
   std::vector<cv::Mat> darker = bgrFrames;
   darker[1] = darker[1] * 0.75;
-  for (const auto field :
-       {processing::CorrectionField::kMultiplicative, processing::CorrectionField::kAdditive}) {
+  using processing::CorrectionField;
+  for (const auto& [field, balance] : {std::pair(CorrectionField::kMultiplicative, false),
+                                       std::pair(CorrectionField::kAdditive, false),
+                                       std::pair(CorrectionField::kMultiplicative, true)}) {
     for (const PixelFormat format : kFormats) {
-      SCOPED_TRACE(std::string(processing::correctionFieldName(field)) + ", " + toString(format));
+      SCOPED_TRACE(std::string(processing::correctionFieldName(field)) +
+                   (balance ? " with balance, " : ", ") + toString(format));
       std::vector<cv::Mat> frames(darker.size());
       for (std::size_t i = 0; i < frames.size(); ++i) bgrToHeld(darker[i], format, frames[i]);
       processing::ColourCorrectionSettings settings;
       settings.field = field;
+      settings.balance = balance;
       processing::PoissonColourCorrection correction(
           truth.rig, processing::testing::settingsFor(truth), *lut, settings, *pool);
       correction.update(frames, format);

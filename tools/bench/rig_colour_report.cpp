@@ -1,5 +1,9 @@
 #include "tools/bench/rig_colour_report.hpp"
 
+#include <array>
+#include <span>
+#include <string>
+
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
@@ -69,11 +73,21 @@ void reportRigColour(const RigColourInput& input, WorkPool& pool,
   processing::PoissonColourCorrection correction(rig, settings, lut, colour, pool);
   correction.update(frames);
   correction.apply(poisson);
+  // Poisson after the global balance (colour_correction.balance), whatever the config says.
+  cv::Mat balanced = raw.clone();
+  auto balancedColour = colour;
+  balancedColour.balance = true;
+  processing::PoissonColourCorrection balancing(rig, settings, lut, balancedColour, pool);
+  balancing.update(frames);
+  balancing.apply(balanced);
+  const std::array<const cv::Mat*, 4> methods{&raw, &gained, &poisson, &balanced};
   // The colour stage per frame, as the pipeline runs it: seam data and solve (warm-started from
-  // the frame before), then upsampling and applying the field.
+  // the frame before), then upsampling and applying the field; the same with the balance.
   cv::Mat scratch = raw.clone();
-  const auto stageMs = interleavedMedians(
-      {[&] { correction.update(frames); }, [&] { correction.apply(scratch); }}, kTimingRepeats);
+  const auto stageMs =
+      interleavedMedians({[&] { correction.update(frames); }, [&] { correction.apply(scratch); },
+                          [&] { balancing.update(frames); }, [&] { balancing.apply(scratch); }},
+                         kTimingRepeats);
 
   int masked = 0;
   for (const auto& camera : rig.cameras) masked += camera.bodyMask.empty() ? 0 : 1;
@@ -83,58 +97,81 @@ void reportRigColour(const RigColourInput& input, WorkPool& pool,
       processing::correctionFieldName(colour.field), colour.scale);
   const processing::PanoramaProjector projector(rig, settings);
   const auto seams = seamLines(rig, settings);
-  const auto stepRow = [](const std::array<SeamColourStep, 3>& steps) {
-    return fmt::format("{}  {}  {}     {}  {}  {}", levels(steps[0].nearLevels),
-                       levels(steps[1].nearLevels), levels(steps[2].nearLevels),
-                       levels(steps[0].farLevels), levels(steps[1].farLevels),
-                       levels(steps[2].farLevels));
+  // Per method (none, gain, PLCC: Poisson, bal.: balance + Poisson), near then far.
+  const auto stepRow = [](const auto& step) {
+    std::string near, far;
+    for (const SeamColourStep& s : step) {
+      near += levels(s.nearLevels) + "  ";
+      far += levels(s.farLevels) + "  ";
+    }
+    return near + "   " + far;
   };
-  fmt::print("  {:<14} {:>24}   {:^23}   {:^23}\n", "seam", "misalignment",
-             "step near: none gain PLCC", "step far: none gain PLCC");
+  const std::string heading = "none gain PLCC bal.";
+  fmt::print("  {:<14} {:>24}   step near: {:<17}   step far: {}\n", "seam", "misalignment",
+             heading, heading);
   for (const auto& seam : seams) {
     const auto alignment = processing::seamMisalignment(rig, frames, settings, seam);
+    std::array<SeamColourStep, methods.size()> steps;
+    for (std::size_t m = 0; m < methods.size(); ++m) {
+      steps[m] = seamColourStep(*methods[m], lut, settings, seam);
+    }
     fmt::print("  {:<14} {:>24}   {}\n", seam.name,
                alignment ? fmt::format("{:.1f} cm at {:.1f} m ({:.2f})", alignment->shiftCm,
                                        alignment->distanceM, alignment->response)
                          : std::string("n/a"),
-               stepRow({seamColourStep(raw, lut, settings, seam),
-                        seamColourStep(gained, lut, settings, seam),
-                        seamColourStep(poisson, lut, settings, seam)}));
+               stepRow(steps));
   }
-  fmt::print("  {:<14} {:>24}   {:^23}   {:^23}\n", "seam", "(both cameras' views)",
-             "view near: none gain PLCC", "view far: none gain PLCC");
+  fmt::print("  {:<14} {:>24}   view near: {:<17}   view far: {}\n", "seam",
+             "(both cameras' views)", heading, heading);
   for (const auto& seam : seams) {
-    fmt::print("  {:<14} {:>24}   {}\n", seam.name, "",
-               stepRow({seamViewStep(raw, raw, projector, lut, frames, seam),
-                        seamViewStep(raw, gained, projector, lut, frames, seam),
-                        seamViewStep(raw, poisson, projector, lut, frames, seam)}));
+    std::array<SeamColourStep, methods.size()> steps;
+    for (std::size_t m = 0; m < methods.size(); ++m) {
+      steps[m] = seamViewStep(raw, *methods[m], projector, lut, frames, seam);
+    }
+    fmt::print("  {:<14} {:>24}   {}\n", seam.name, "", stepRow(steps));
   }
   const double before = meanLevel(raw, lut);
-  fmt::print("  mean level: none {:.1f}, gain {:.1f} ({:+.1f} %), Poisson {:.1f} ({:+.1f} %)\n",
-             before, meanLevel(gained, lut), 100 * (meanLevel(gained, lut) / before - 1),
-             meanLevel(poisson, lut), 100 * (meanLevel(poisson, lut) / before - 1));
-  std::string gainText;
-  for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
-    const cv::Vec3f g = gains.gains()[c];
-    gainText += fmt::format("{}{} {:.2f}/{:.2f}/{:.2f}", gainText.empty() ? "" : ", ",
-                            rig.cameras[c].name, g[0], g[1], g[2]);
-  }
-  fmt::print("  gains (B/G/R): {}\n", gainText);
+  const auto change = [&](const cv::Mat& picture) {
+    return fmt::format("{:.1f} ({:+.1f} %)", meanLevel(picture, lut),
+                       100 * (meanLevel(picture, lut) / before - 1));
+  };
+  fmt::print("  mean level: none {:.1f}, gain {}, Poisson {}, balance + Poisson {}\n", before,
+             change(gained), change(poisson), change(balanced));
+  fmt::print(
+      "  chroma spread across cameras (a*b*, ground): none {:.2f}, gain {:.2f}, Poisson {:.2f}, "
+      "balance + Poisson {:.2f}\n",
+      chromaSpread(raw, lut, settings), chromaSpread(gained, lut, settings),
+      chromaSpread(poisson, lut, settings), chromaSpread(balanced, lut, settings));
+  const auto gainsText = [&](std::span<const cv::Vec3f> perCamera) {
+    std::string text;
+    for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+      text += fmt::format("{}{} {:.2f}/{:.2f}/{:.2f}", text.empty() ? "" : ", ",
+                          rig.cameras[c].name, perCamera[c][0], perCamera[c][1], perCamera[c][2]);
+    }
+    return text;
+  };
+  fmt::print("  gains (B/G/R): {}\n", gainsText(gains.gains()));
+  fmt::print("  balance (B/G/R): {}\n", gainsText(balancing.cameraGains()));
   double lowest = 1, highest = 1;
   cv::minMaxLoc(correction.field().reshape(1), &lowest, &highest);
   fmt::print("  Poisson field: x{:.2f} .. x{:.2f} at 255\n", 1 + lowest / 255, 1 + highest / 255);
-  for (const auto& seam : correction.seams()) {
-    fmt::print(
-        "    seam {}/{}: {} of {} blocks measured, {} clamped, {} dropped, step {:.1f} -> "
-        "{:.1f}{}\n",
-        rig.cameras[seam.source].name, rig.cameras[seam.target].name, seam.validBlocks, seam.blocks,
-        seam.clampedBlocks, seam.droppedBlocks, seam.stepUncorrected, seam.stepCorrected,
-        seam.dropped ? " (all dropped: it would have got worse)" : "");
-  }
+  const auto printSeams = [&](const processing::PoissonColourCorrection& method) {
+    for (const auto& seam : method.seams()) {
+      fmt::print(
+          "    seam {}/{}: {} of {} blocks measured, {} clamped, {} dropped, step {:.1f} -> "
+          "{:.1f}{}\n",
+          rig.cameras[seam.source].name, rig.cameras[seam.target].name, seam.validBlocks,
+          seam.blocks, seam.clampedBlocks, seam.droppedBlocks, seam.stepUncorrected,
+          seam.stepCorrected, seam.dropped ? " (all dropped: it would have got worse)" : "");
+    }
+  };
+  printSeams(correction);
+  fmt::print("  balance + Poisson (the steps after the balance, before the field):\n");
+  printSeams(balancing);
   fmt::print(
       "  Poisson per frame, {} thread(s): seam data + solve {:.2f} ms, upsample and apply {:.2f} "
-      "ms\n",
-      pool.threads(), stageMs[0], stageMs[1]);
+      "ms; balance + Poisson {:.2f} and {:.2f} ms\n",
+      pool.threads(), stageMs[0], stageMs[1], stageMs[2], stageMs[3]);
   for (const auto& note : correction.notes()) fmt::print("    note: {}\n", note);
   for (const auto& note : correction.notesOfLastUpdate()) fmt::print("    note: {}\n", note);
   if (!pictures.empty()) {
@@ -143,6 +180,7 @@ void reportRigColour(const RigColourInput& input, WorkPool& pool,
     cv::imwrite((pictures / (stem + "-none.png")).string(), raw);
     cv::imwrite((pictures / (stem + "-gain.png")).string(), gained);
     cv::imwrite((pictures / (stem + "-poisson.png")).string(), poisson);
+    cv::imwrite((pictures / (stem + "-balance.png")).string(), balanced);
     for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
       if (rig.cameras[c].bodyMask.empty()) continue;
       cv::imwrite((pictures / (stem + "-mask-" + rig.cameras[c].name + ".png")).string(),

@@ -212,4 +212,31 @@ double meanLevel(const cv::Mat& panorama, const processing::PanoramaLut& lut) {
   return (mean[0] + mean[1] + mean[2]) / 3;
 }
 
+double chromaSpread(const cv::Mat& panorama, const processing::PanoramaLut& lut,
+                    const processing::PanoramaSettings& settings) {
+  cv::Mat lab;
+  cv::cvtColor(panorama, lab, cv::COLOR_BGR2Lab, 3);
+  lab.convertTo(lab, CV_32FC3);  // 8-bit L*a*b*: a* and b* centred on 128, one unit a level
+  cv::Mat owner = lut.ownerMap();
+  const int horizon =
+      std::clamp(static_cast<int>(std::ceil(settings.geometry.row(0))), 0, owner.rows);
+  owner.rowRange(0, horizon).setTo(processing::PanoramaLut::kUnseen);
+  std::vector<cv::Vec2d> means;
+  for (std::size_t c = 0; c < lut.cameraSizes.size(); ++c) {
+    const cv::Mat owned = owner == static_cast<int>(c);
+    if (cv::countNonZero(owned) == 0) continue;
+    const cv::Scalar mean = cv::mean(lab, owned);
+    means.emplace_back(mean[1], mean[2]);
+  }
+  if (means.empty()) return 0;
+  cv::Vec2d average(0, 0);
+  for (const auto& m : means) average += m / static_cast<double>(means.size());
+  double variance = 0;
+  for (const auto& m : means) {
+    const cv::Vec2d d = m - average;
+    variance += d.dot(d) / static_cast<double>(means.size());
+  }
+  return std::sqrt(variance);
+}
+
 }  // namespace surroundd::bench

@@ -47,4 +47,10 @@ SeamColourStep seamViewStep(const cv::Mat& raw, const cv::Mat& corrected,
 // Mean level (mean of the channels) over the pixels some camera sees.
 double meanLevel(const cv::Mat& panorama, const processing::PanoramaLut& lut);
 
+// How far apart the cameras' tints are: each camera's mean CIE a* and b* over the panorama's
+// ground it owns (the rows below the horizon, `settings`), and the standard deviation of those
+// means across the cameras (the root of a*'s and b*'s variances' sum), in L*a*b* units.
+double chromaSpread(const cv::Mat& panorama, const processing::PanoramaLut& lut,
+                    const processing::PanoramaSettings& settings);
+
 }  // namespace surroundd::bench

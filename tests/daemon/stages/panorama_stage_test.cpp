@@ -111,6 +111,44 @@ TEST_F(PanoramaStageTest, AsksTheLaterStagesAfterTheEarlierOnesFoundAFaultyCamer
   EXPECT_LT(share, 0.6);
 }
 
+// With colour_correction.balance the cameras' gains go before the field, in the panorama and in
+// a view gathered through a LUT of its own alike: a view that samples the panorama pixel for
+// pixel is the panorama, within the field's bilinear sampling (the panorama's is bicubic).
+TEST_F(PanoramaStageTest, AViewIsBalancedAsThePanoramaIs) {
+  const Config balanced = testing::seamsConfig(dir_, "0", R"(rig: {file: rig.yaml}
+panorama: {width_px: 1024, height_px: 512, cache_dir: lut-cache}
+colour_correction: {balance: true}
+outputs:
+  - {type: snapshot, stream: panorama, path: picture.png}
+)");
+  PanoramaStage plain(config_, pool_);
+  PanoramaStage stage(balanced, pool_);
+  ASSERT_NE(process(plain, true, false).panorama, nullptr);
+  ASSERT_NE(process(stage, true, false).panorama, nullptr);
+  const auto meanDifference = [](const cv::Mat& a, const cv::Mat& b) {
+    cv::Mat difference;
+    cv::absdiff(a, b, difference);
+    const cv::Scalar mean = cv::mean(difference);
+    return (mean[0] + mean[1] + mean[2]) / 3;
+  };
+  // The balance changes the picture: agreeing below is not agreeing on nothing.
+  EXPECT_GT(meanDifference(plain.picture(), stage.picture()), 3.0);
+
+  const cv::Size size = stage.lut().size;
+  cv::Mat positions(size, CV_32FC2);
+  for (int v = 0; v < size.height; ++v) {
+    for (int u = 0; u < size.width; ++u) {
+      positions.at<cv::Vec2f>(v, u) = {static_cast<float>(u), static_cast<float>(v)};
+    }
+  }
+  const auto view = stage.buildView(positions).get();
+  cv::Mat picture(size, CV_8UC3);
+  FrameWork work{.set = frames_.set, .bgrBuffers = bgrBuffers_, .outputs = outputs_};
+  stage.gather(*view, picture);
+  stage.correct(*view, work, picture, nullptr);
+  EXPECT_LT(meanDifference(picture, stage.picture()), 0.5);
+}
+
 TEST(StreamOutputStage, NeedsThePanoramaWhereAnOutputShowsIt) {
   const testing::TempDir dir;
   const cv::Mat picture(512, 1024, CV_8UC3, cv::Scalar::all(0));
