@@ -18,7 +18,9 @@
 // target's levels against the source's as the field next to the seam leaves them) is compared
 // with its step uncorrected, and so is each stretch of 16 blocks along it (near and far ground
 // differ); a seam or stretch that got worse (by more than noise: 5 % and half a level) has its
-// data dropped (gain 1 there) and its region is solved again. Clamps, seams with too little
+// data dropped (gain 1 there) and its region is solved again. With the balance first
+// (`balance`), "none" is still the cameras as they are: a dropped block's field gives its source
+// the target's balance gain, so the step stays what it was. Clamps, seams with too little
 // usable data and dropped seams are said once each in notesOfLastUpdate().
 //
 // Set up once (domain, systems, solver factorizations, buffers); update() and apply() are the
@@ -91,7 +93,7 @@ class PoissonColourCorrection {
   struct SeamReport {
     std::uint8_t source = 0, target = 0;
     int blocks = 0, validBlocks = 0, clampedBlocks = 0;
-    int droppedBlocks = 0;  // in stretches the correction would have made worse: gain 1 there
+    int droppedBlocks = 0;  // in stretches the correction would have made worse: left as they were
     bool dropped = false;   // the whole seam would have got worse: gain 1 all along it
     // Median over measured blocks of the mean over channels of |target - source| in levels:
     // without correction, and with the field as it leaves the source next to the seam.
@@ -173,8 +175,11 @@ class PoissonColourCorrection {
   void farGroundAsOneBand(const CorrectionRegion& region, const CorrectionSeam& seam,
                           RegionState& state);
   void solveRegions(std::span<const std::uint8_t> which);
-  // Drops the data of seams the solved field makes worse; true when any was dropped.
+  // Drops the data of seams the solved field makes worse than none; true when any was dropped.
   bool dropWorseningSeams();
+  // The seam data that leaves a dropped seam block's step as it was uncorrected.
+  float asItWas(const CorrectionRegion& region, const RegionState& state, std::size_t block,
+                int channel) const;
   void noteOnce(std::vector<std::uint8_t>& said, std::size_t seam, std::string note);
   // `instance.template operator()<kField, kPath>()` for this correction's field and `path`
   // (a row kernel's instance); throws std::invalid_argument for a path this build lacks.

@@ -241,8 +241,23 @@ void PoissonColourCorrection::balanceSeams(std::span<const cv::Mat> frames) {
   }
 }
 
+float PoissonColourCorrection::asItWas(const CorrectionRegion& region, const RegionState& state,
+                                       std::size_t block, int channel) const {
+  // Without the balance: no field. With it: the field that gives the source the target's gain
+  // there (g_t / g_s on the balanced source), so that the seam's two sides keep the step they had
+  // uncorrected, times the target's gain.
+  const auto gains = cameraGains();
+  if (gains.empty()) return 0;
+  const float ratio =
+      gains[region.dirichlet[block].target][channel] / gains[region.source][channel];
+  return settings_.field == CorrectionField::kMultiplicative
+             ? std::log(ratio)
+             : state.levels[block].source[channel] * (ratio - 1);
+}
+
 bool PoissonColourCorrection::dropWorseningSeams() {
   Configuration& active = *active_;
+  const auto gains = cameraGains();
   const bool multiplicative = settings_.field == CorrectionField::kMultiplicative;
   std::fill(resolve_.begin(), resolve_.end(), 0);
   bool dropped = false;
@@ -281,6 +296,10 @@ bool PoissonColourCorrection::dropWorseningSeams() {
       uncorrected[j] = corrected[j] = std::numeric_limits<float>::quiet_NaN();
       if (state.measuredValid[k] == 0 || count == 0) continue;
       const SeamBlockLevels& levels = state.levels[k];
+      // None is the cameras as they are: with the balance, its levels taken back off.
+      const cv::Vec3f sourceGain = gains.empty() ? cv::Vec3f(1, 1, 1) : gains[region.source];
+      const cv::Vec3f targetGain =
+          gains.empty() ? cv::Vec3f(1, 1, 1) : gains[region.dirichlet[k].target];
       float before = 0;
       float after = 0;
       for (int c = 0; c < 3; ++c) {
@@ -292,7 +311,7 @@ bool PoissonColourCorrection::dropWorseningSeams() {
         field /= static_cast<float>(count);
         const float source =
             multiplicative ? levels.source[c] * std::exp(field) : levels.source[c] + field;
-        before += std::abs(levels.target[c] - levels.source[c]) / 3;
+        before += std::abs(levels.target[c] / targetGain[c] - levels.source[c] / sourceGain[c]) / 3;
         after += std::abs(levels.target[c] - std::clamp(source, 0.0f, 255.0f)) / 3;
       }
       uncorrected[j] = before;
@@ -312,18 +331,19 @@ bool PoissonColourCorrection::dropWorseningSeams() {
       if (!whole && (!steps(first, last, before, after) || !worse(before, after))) continue;
       report.droppedBlocks += static_cast<int>(last - first);
       for (std::size_t j = first; j < last; ++j) {
-        std::fill_n(state.dirichlet.begin() + static_cast<std::ptrdiff_t>(seam.blocks[j]) * 3, 3,
-                    0.0f);
+        const auto k = seam.blocks[j];
+        for (int c = 0; c < 3; ++c) state.dirichlet[k * 3 + c] = asItWas(region, state, k, c);
       }
     }
     if (report.droppedBlocks == 0) continue;
     noteOnce(active.saidDropped, i,
              fmt::format("seam {}/{}: correcting {} of its {} blocks would make their step worse "
                          "(the seam's: {:.1f} against {:.1f} levels uncorrected): their data is "
-                         "dropped (gain 1 there)",
+                         "dropped ({})",
                          rig_.cameras[region.source].name, rig_.cameras[seam.target].name,
                          report.droppedBlocks, report.blocks, report.stepCorrected,
-                         report.stepUncorrected));
+                         report.stepUncorrected,
+                         gains.empty() ? "gain 1 there" : "their step left as it was"));
     report.dropped = whole;
     if (whole) report.stepCorrected = report.stepUncorrected;
     dropped = true;

@@ -166,7 +166,7 @@ void reportRigColour(const RigColourInput& input, WorkPool& pool,
     }
   };
   printSeams(correction);
-  fmt::print("  balance + Poisson (the steps after the balance, before the field):\n");
+  fmt::print("  balance + Poisson:\n");
   printSeams(balancing);
   fmt::print(
       "  Poisson per frame, {} thread(s): seam data + solve {:.2f} ms, upsample and apply {:.2f} "
