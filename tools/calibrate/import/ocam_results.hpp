@@ -3,7 +3,7 @@
 //
 // The file is in OCamCalib's own axes: its centre (xc, yc) is (ROW, COLUMN), its first image axis
 // runs down the rows, and its affine matrix [c d; e 1] maps (row, column) offsets. The project's
-// lens.model ocam (processing/lens/camera_model.hpp) is written in image order instead, as the pjlab
+// lens.model ocam (processing/lens/ocam_lens.hpp) is written in image order instead, as the pjlab
 // files are: cx, cy = (column, row), u = c a + d b + cx, v = e a + b + cy for the projected point
 // (a, b) along (column, row). Swapping the axes gives u = a' + e b', v = d a' + c b'; dividing
 // through by c restores the 1 in the corner, so the polynomials are rescaled by c (exactly).
