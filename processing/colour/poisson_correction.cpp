@@ -125,10 +125,6 @@ ColourField PoissonColourCorrection::asColourField() const {
           cameraGains()};
 }
 
-std::span<const cv::Vec3f> PoissonColourCorrection::cameraGains() const {
-  return balance_ ? std::span<const cv::Vec3f>(balance_->gains()) : std::span<const cv::Vec3f>();
-}
-
 // Which cameras are present is a bitmask (configurationFor's key); the rig's LUT holds at most
 // kMaxCameras (buildPanoramaLut), so every camera has its bit.
 static_assert(kMaxCameras <= 32, "a std::uint32_t camera bitmask holds every camera");

@@ -151,7 +151,9 @@ class PoissonColourCorrection {
   const std::vector<SeamReport>& seams() const { return seamReports_; }
   // With settings().balance, each camera's B G R gains that apply() and the view's pictures take
   // before the field (processing/colour/camera_gains.hpp); empty without.
-  std::span<const cv::Vec3f> cameraGains() const;
+  std::span<const cv::Vec3f> cameraGains() const {
+    return balance_ ? std::span<const cv::Vec3f>(balance_->gains()) : std::span<const cv::Vec3f>();
+  }
 
   // The field at block resolution, CV_32FC3: the levels it adds to a pixel at 255, the most it
   // changes any pixel (0 outside the regions' reach). Additive: simply the levels it adds.
