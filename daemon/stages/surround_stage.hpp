@@ -3,25 +3,14 @@
 // (render/surround_scene.hpp), drawn with OpenGL ES into each surround output's own view. A view's
 // picture is drawn while the next set is stitched and collected when that set comes, so each
 // output gets it one set later; or sooner, when the pipeline has no set to work on and the picture
-// is finished (deliverFinished()). The last one goes out when the run ends.
+// is finished (idle()). The last one goes out when the run ends.
 //
-// Views that do not move (top, 360, and orbit and split with a still eye; render.view_lut) are
-// not drawn per set: the first time an output shows one (on a paced or live rig, once the first
-// picture has gone out), or as a switch to it begins, the renderer maps where each of its pixels
-// samples the panorama and draws the car and background once, and the panorama stage composes
-// the view's table from that on a thread of its own, while the renderer draws the view as it
-// draws those that move. From then on the panorama stage gathers its picture from the camera
-// frames (PanoramaStage::ViewPicture), the car and background are laid where it shows no panorama
-// and the split view's camera picture is scaled into its half, then it is corrected and the
-// guidelines laid over it; for an output that encodes it, it is converted to I420 in the
-// correction's pass (processing/stitch/i420_picture.hpp). The output gets it in the same set. Kept
-// for when the output shows that view again.
-//
-// With processing.backend gpu (or auto on a hardware renderer) the panorama the views sample is
-// stitched and colour-corrected on the GPU (render/gpu_stitcher.hpp) from the set's frames in
-// their own format, and every view is drawn by OpenGL from it (a GPU draws a fixed view faster
-// than the CPU gathers it). The CPU's panorama is then made only when something needs it: an
-// output of the panorama, or a set with a faulty camera (whose part the CPU marks).
+// Made of three parts, each in its own file: the views that do not move, gathered through tables
+// of their own rather than drawn per set (fixed_views.hpp); the panorama stitched on the GPU where
+// processing.backend chooses it (gpu_panorama.hpp), which every view is then drawn from by
+// OpenGL, the CPU's panorama made only when something needs it (an output of the panorama, or a
+// set with a faulty camera, whose part the CPU marks); and the parking guidelines, a layer of
+// every view (render/guideline_layer.hpp).
 //
 // Threads: the renderer (its EGL context and scene) is opened on a thread of its own
 // (openSurroundRenderer()) while the cameras open and the panorama's table is read, and handed to
@@ -30,25 +19,23 @@
 
 #include <array>
 #include <chrono>
-#include <future>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
-#include <utility>
-#include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "daemon/config/config.hpp"
 #include "daemon/duration_histogram.hpp"
 #include "daemon/pipeline_stage.hpp"
+#include "daemon/stages/fixed_views.hpp"
+#include "daemon/stages/gpu_panorama.hpp"
 #include "daemon/stages/panorama_stage.hpp"
 #include "daemon/stages/surround_renderer.hpp"
 #include "daemon/surround_views.hpp"
 #include "render/egl_context.hpp"
-#include "render/gpu_stitcher.hpp"
 #include "render/gpu_timer.hpp"
+#include "render/guideline_layer.hpp"
 #include "render/surround_scene.hpp"
 #include "render/surround_view.hpp"
 #include "vehicle/vehicle_signals.hpp"
@@ -90,60 +77,23 @@ class SurroundStage final : public PipelineStage, public SurroundViews {
 
   // The renderer, and where the panorama is stitched when that is the GPU.
   std::string description() const {
-    return gpu_ ? gl_->description() + "; panorama stitched on the GPU" : gl_->description();
+    return stitchesOnGpu() ? gl_->description() + "; panorama stitched on the GPU"
+                           : gl_->description();
   }
   // Whether the GPU stitches the panorama (processing.backend as it came out on this renderer).
-  bool stitchesOnGpu() const { return gpu_ != nullptr; }
+  bool stitchesOnGpu() const { return gpu_.enabled(); }
   // Why the GPU stitch cannot import camera frames from their DMABUFs (render/dmabuf_import.hpp);
   // empty when it can.
-  const std::string& dmabufImportRefusal() const { return importRefusal_; }
+  const std::string& dmabufImportRefusal() const { return gpu_.dmabufImportRefusal(); }
 
  private:
   enum class Pending { kAll, kFinished };
   // Hands each view's pending picture (the previous set's; or only those finished) to its output.
   void deliver(PipelineOutputs& outputs, StageTimes* times, Pending which = Pending::kAll);
-
-  // A fixed view's picture, and the renderer's car and background to lay over it.
-  struct FixedView {
-    // None while its table is being made, or where that failed.
-    std::unique_ptr<PanoramaStage::ViewPicture> view;
-    // Its table being made, until taken into `view`; and how long OpenGL's part of that took.
-    std::future<std::unique_ptr<PanoramaStage::ViewPicture>> building;
-    std::chrono::duration<double> mappedIn{0};
-    cv::Mat overlay;                       // 8-bit BGR, the renderer's picture of the view
-    cv::Mat overlayMask;                   // CV_8U: where it shows no panorama
-    cv::Mat picture;                       // the last drawn
-    cv::Mat i420;                          // and in I420, for an output that takes that
-    bool inI420 = false;                   // whether `i420` is the picture its output gets
-    std::chrono::nanoseconds drawnAt{-1};  // the stream time of its set
-    bool handOver = false;                 // drawn this set for its output
-    cv::Mat guides;                        // the guidelines as the view shows them, on black
-    cv::Mat guidesGrey;
-    cv::Mat guidesMask;      // CV_8U: where they are
-    int guidesVersion = -1;  // of SurroundStage::guidesVersion_
-  };
-  // Lays the guidelines (the scene has some) over a fixed view's picture, drawing them again when
-  // they have changed.
-  void layGuidelines(render::SurroundView& view, FixedView& fixed);
-  // The output's fixed view, its building started the first time it shows it; null until built
-  // and the switch to it has ended, for a view that moves, with render.view_lut off, on the GPU
-  // backend, or where the renderer cannot map views (said once).
-  FixedView* fixedView(render::SurroundView& view);
-  // The output's fixed view, as fixedView(); none for a sink that shows the view on the GPU.
-  FixedView* fixedViewFor(PipelineOutputs::PictureOutput& output);
-  // The fixed view the output shows now, as fixedViewFor() gives it once taken into use; with
-  // nothing started or taken.
-  const FixedView* shownFixedView(const PipelineOutputs::PictureOutput& output) const;
-  // Maps the view onto the panorama (OpenGL, here), then has the panorama stage build its table.
-  void startFixedView(render::SurroundView& view, FixedView& fixed);
-  // Whether the GPU stitches this set: the GPU backend, and no camera faulty.
-  bool gpuStitches(const FrameWork& work) const;
-  // The set's panorama into the texture the scene samples: stitched on the GPU, or the CPU's
-  // uploaded.
-  void stitchOnGpu();
-  // Which way each camera's lent frames reached the GPU (imported, or uploaded and why), when it
-  // changes.
-  void sayHowFramesReachTheGpu();
+  // Whether any output shows a surround view.
+  static bool anyView(const PipelineOutputs& outputs);
+  // Draws `output`'s view of the set with OpenGL, from the panorama the scene samples.
+  void drawView(PipelineOutputs::PictureOutput& output, FrameWork& work, bool& cameraUploaded);
   void uploadPanorama();
   // The GPU times of the runs finished since the last call into gpuTimes_.
   void collectGpuTimes();
@@ -157,24 +107,13 @@ class SurroundStage final : public PipelineStage, public SurroundViews {
   // The GPU's own time of each run of its steps so far (render/gpu_timer.hpp), read a set or two
   // after the run; none where the driver cannot time them.
   std::array<DurationHistogram, render::kGpuSteps> gpuTimes_{};
-  PanoramaStage& panoramaStage_;
   const cv::Mat& panorama_;
-  std::unique_ptr<render::GpuStitcher> gpu_;  // processing.backend: gpu
-  std::string importRefusal_;
-  std::vector<char> importSaid_;  // per camera: 0 nothing said, 1 imported, 2 uploaded
-  bool panoramaOnGpu_ = false;    // the scene samples gpu_'s panorama (the last set's)
-  bool viewLut_;
+  GpuPanorama gpu_;
+  bool panoramaOnGpu_ = false;  // the scene samples gpu_'s panorama (the last set's)
+  FixedViews fixed_;
   GuidelineMode guidelineMode_;
-  render::GuidelineSettings guide_;
-  processing::VehicleDimensions car_;
-  std::vector<render::GuidelineVertex> guideVertices_;  // reserved at start: filled in place
-  // What the guidelines show now (travel, steering in tenths of a degree); none: not shown.
-  std::optional<std::pair<render::Travel, long>> guidesShown_;
-  int guidesVersion_ = 0;
-  bool tablesAfterFirstPicture_ = false;  // prepare() without waiting: no table started yet
-  // Per output's view (its address; each lives as long as the pipeline) and the kind it shows.
-  std::map<std::pair<const render::SurroundView*, ViewKind>, FixedView> fixedViews_;
-  std::size_t splitCamera_ = 0;
+  std::optional<render::GuidelineLayer> guides_;  // none: guidelines off
+  std::size_t splitCamera_;
   std::chrono::nanoseconds lastStreamTime_{0};
 };
 
