@@ -183,12 +183,21 @@ void readSection(YamlObject& root, std::string_view key, Read&& read) {
   }
 }
 
-void checkSplitCamera(YamlObject& section, const Config& config) {
-  const auto& split = config.render.splitCamera;
-  if (!split.empty() && std::ranges::none_of(config.cameras, [&](const RigCamera& c) {
-        return c.calibration.name == split;
+// A key that names a camera (none: empty) names one of the rig's.
+void checkNamesACamera(YamlObject& section, std::string_view key, const std::string& name,
+                       const Config& config) {
+  if (!name.empty() && std::ranges::none_of(config.cameras, [&](const RigCamera& c) {
+        return c.calibration.name == name;
       })) {
-    section.error("split_camera", fmt::format("no camera is named '{}'", split));
+    section.error(key, fmt::format("no camera is named '{}'", name));
+  }
+}
+
+void checkBalanceReference(YamlObject& section, const Config& config) {
+  const auto& poisson = config.colour.poisson;
+  checkNamesACamera(section, "balance_reference", poisson.balanceReference, config);
+  if (!poisson.balanceReference.empty() && !poisson.balance) {
+    section.error("balance_reference", "is the balance's: it needs balance: true");
   }
 }
 
@@ -293,14 +302,17 @@ std::span<const ConfigSection> configSections() {
       {"panorama", [] { return panoramaKeys().docs(); }, nullptr,
        [](YamlObject& s, Config& c) { readPanorama(s, c.panorama); }},
       {"colour_correction", [] { return colourKeys().docs(); }, nullptr,
-       [](YamlObject& s, Config& c) { colourKeys().read(s, c.colour); }},
+       [](YamlObject& s, Config& c) {
+         colourKeys().read(s, c.colour);
+         checkBalanceReference(s, c);
+       }},
       // Over the rig file's vehicle, before what follows it.
       {"vehicle", [] { return vehicleKeys().docs(); }, nullptr,
        [](YamlObject& s, Config& c) { c.vehicle = readVehicle(s); }},
       {"render", [] { return renderKeys().docs(); }, renderDefaults,
        [](YamlObject& s, Config& c) {
          readRender(s, c.render);
-         checkSplitCamera(s, c);
+         checkNamesACamera(s, "split_camera", c.render.splitCamera, c);
        }},
       {"mesh", [] { return meshKeys().docs(); }, meshDefaults,
        [](YamlObject& s, Config& c) { readMesh(s, c.mesh); }},

@@ -250,6 +250,10 @@ const ConfigKeys<ColourCorrectionConfig>& colourKeys() {
       Key::flag("balance", poisson(&Settings::balance),
                 "poisson: each camera's gains first, fitted over the seams' ground, taking every "
                 "camera to the cameras' average; the field then corrects what is left"),
+      Key::text("balance_reference", poisson(&Settings::balanceReference),
+                "the camera whose colour the balance takes the others to (its gains stay 1); "
+                "none: the cameras' average",
+                Shown::kExample),
   };
   return kKeys;
 }

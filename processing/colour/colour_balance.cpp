@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -13,14 +14,27 @@ namespace {
 // conditioned.
 constexpr double kAnchorWeight = 1e3;
 
+// The index of the camera named `name`; none for no name.
+std::optional<std::size_t> cameraNamed(const std::vector<std::string>& names,
+                                       std::string_view name) {
+  if (name.empty()) return std::nullopt;
+  const auto found = std::ranges::find(names, name);
+  if (found == names.end()) {
+    throw std::invalid_argument(
+        fmt::format("the balance's reference: no camera is named '{}'", name));
+  }
+  return static_cast<std::size_t>(found - names.begin());
+}
+
 }  // namespace
 
 ColourBalance::ColourBalance(std::vector<std::string> cameraNames, double minGain, double maxGain,
-                             double smoothing)
+                             double smoothing, std::string_view reference)
     : names_(std::move(cameraNames)),
       minGain_(minGain),
       maxGain_(maxGain),
       smoothing_(smoothing),
+      reference_(cameraNamed(names_, reference)),
       gains_(names_.size(), cv::Vec3f(1, 1, 1)),
       logGains_(names_.size(), cv::Vec3d(0, 0, 0)),
       fitted_(names_.size(), 0),
@@ -42,10 +56,12 @@ void ColourBalance::update(std::span<const CameraPairRatio> pairs,
     fitted_[pair.a] = fitted_[pair.b] = 1;
   }
   const auto fittedCount = std::count(fitted_.begin(), fitted_.end(), 1);
-  if (fittedCount < 2) return;
+  // Without its reference, a set cannot say where the others go.
+  if (fittedCount < 2 || (reference_ && fitted_[*reference_] == 0)) return;
   // Per channel: minimize sum_pairs w (x_a - x_b - r)^2 + anchor (sum over fitted cameras x)^2,
-  // x = log gain, r = log(b / a): after the balance g_a a = g_b b, so x_a - x_b = r. Cameras not
-  // fitted get a row of their own that keeps them at 0 (their gains are left as they are).
+  // x = log gain, r = log(b / a): after the balance g_a a = g_b b, so x_a - x_b = r. With a
+  // reference camera the anchor is its own x^2 instead. Cameras not fitted get a row of their own
+  // that keeps them at 0 (their gains are left as they are).
   normal_.setTo(0);
   rhs_.setTo(0);
   const auto at = [&](std::size_t i, std::size_t j) -> double& {
@@ -65,10 +81,12 @@ void ColourBalance::update(std::span<const CameraPairRatio> pairs,
   for (std::size_t i = 0; i < n; ++i) {
     if (fitted_[i] == 0) {
       at(i, i) = 1;
-      continue;
-    }
-    for (std::size_t j = 0; j < n; ++j) {
-      if (fitted_[j] != 0) at(i, j) += kAnchorWeight;
+    } else if (reference_) {
+      if (i == *reference_) at(i, i) += kAnchorWeight;
+    } else {
+      for (std::size_t j = 0; j < n; ++j) {
+        if (fitted_[j] != 0) at(i, j) += kAnchorWeight;
+      }
     }
   }
   if (!cv::solve(normal_, rhs_, solution_, cv::DECOMP_CHOLESKY)) return;

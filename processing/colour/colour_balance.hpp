@@ -5,7 +5,8 @@
 // neighbour's tint (a pinkish camera turns the band beside it pink). The balance instead takes
 // every camera to the cameras' average: the mean over the cameras of each channel's log gain is 0,
 // so the panorama's brightness and its grey-world neutral stay where the cameras have them on
-// average, and no camera's tint wins.
+// average, and no camera's tint wins. Or, where the user names one (a camera whose colour is known
+// to be right), to that camera: its gains stay 1, and a set without it changes no gains.
 //
 // The fit is least squares over the pairs of cameras that share ground: for each pair, the
 // median over its measured seam blocks of log(level b / level a) per channel (robust to objects
@@ -14,9 +15,12 @@
 // an exposure change is followed within a few sets; a camera missing from a set keeps its gains.
 // Gains outside [minGain, maxGain] are clamped and said once per camera.
 
+#include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -33,9 +37,10 @@ struct CameraPairRatio {
 
 class ColourBalance {
  public:
-  // Camera names are for the notes.
+  // Camera names are for the notes. `reference`: the name of the camera the others are taken to;
+  // empty: their average. Throws std::invalid_argument for a name none of the cameras has.
   ColourBalance(std::vector<std::string> cameraNames, double minGain, double maxGain,
-                double smoothing);
+                double smoothing, std::string_view reference = {});
 
   // Fits this set's gains from the pairs measured in it; `present[c]` false: camera c is not in
   // the set (its gains stay, and it does not count towards the average). A camera present but in
@@ -50,6 +55,7 @@ class ColourBalance {
  private:
   std::vector<std::string> names_;
   double minGain_, maxGain_, smoothing_;
+  std::optional<std::size_t> reference_;
   std::vector<cv::Vec3f> gains_;
   std::vector<cv::Vec3d> logGains_;  // smoothed, before clamping
   bool first_ = true;

@@ -87,7 +87,8 @@ PoissonColourCorrection::PoissonColourCorrection(const Rig& rig, const PanoramaS
     std::vector<std::string> names;
     for (const auto& camera : rig.cameras) names.push_back(camera.name);
     balance_ = std::make_unique<ColourBalance>(std::move(names), settings.minGain, settings.maxGain,
-                                               settings.balanceSmoothing);
+                                               settings.balanceSmoothing,
+                                               settings.balanceReference);
     pairRatios_.resize(domain.seams.size());
     present_.resize(rig.cameras.size());
   }

@@ -73,6 +73,8 @@ struct ColourCorrectionSettings {
   // ground, take the cameras to their average, and the field corrects what is left.
   bool balance = false;
   double balanceSmoothing = 0.8;  // the previous set's share of the balance's gains, 0..0.99
+  // The camera the balance takes the others to, by name; empty: the cameras' average.
+  std::string balanceReference;
 
   bool operator==(const ColourCorrectionSettings&) const = default;
 };

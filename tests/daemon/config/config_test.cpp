@@ -65,6 +65,25 @@ TEST_F(ConfigTest, ColourCorrectionSettingsAreRead) {
               HasSubstr("colour_correction.field: expected one of 'multiplicative' 'additive'"));
 }
 
+// The balance's reference names one of the rig's cameras, and is the balance's only.
+TEST_F(ConfigTest, TheBalanceReferenceIsACameraOfTheBalance) {
+  const auto with = [&](std::string_view colour) {
+    return dir_.write("config.yaml", std::string(kGoodConfig) +
+                                         "colour_correction: " + std::string(colour) + "\n");
+  };
+  EXPECT_EQ(
+      loadConfig(with("{balance: true, balance_reference: left}")).colour.poisson.balanceReference,
+      "left");
+  EXPECT_EQ(loadConfig(with("{balance: true}")).colour.poisson.balanceReference, "");
+  const auto roof = errorsOf(with("{balance: true, balance_reference: roof}"));
+  ASSERT_EQ(roof.size(), 1u) << ::testing::PrintToString(roof);
+  EXPECT_THAT(roof[0], HasSubstr("colour_correction.balance_reference: no camera is named 'roof'"));
+  const auto alone = errorsOf(with("{balance_reference: left}"));
+  ASSERT_EQ(alone.size(), 1u) << ::testing::PrintToString(alone);
+  EXPECT_THAT(alone[0], HasSubstr("colour_correction.balance_reference: is the balance's: it needs "
+                                  "balance: true"));
+}
+
 TEST_F(ConfigTest, SurroundOutputsTakeTheirOwnViewOrTheRenderDefault) {
   const Config config = loadConfig(configWith("  height_px: 360\n", R"(  height_px: 360
   view: top

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -53,6 +54,29 @@ TEST(ColourBalance, UndoesEachCamerasFactorsAndKeepsTheirAverage) {
     }
   }
   EXPECT_TRUE(balance.notesOfLastUpdate().empty());
+}
+
+// A reference camera the user names (colour_correction.balance_reference): its gains stay 1 and
+// every other camera takes its colour; a set without it cannot say where the others go, so none
+// changes.
+TEST(ColourBalance, WithAReferenceEveryCameraTakesThatCamerasColour) {
+  ColourBalance balance(kNames, 0.25, 4.0, 0.0, "back");
+  balance.update(ringPairs(kFactors), kAll);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(balance.gains()[2][c], 1.0, 1e-3) << "channel " << c;
+    for (std::size_t k = 0; k < 4; ++k) {
+      EXPECT_NEAR(balance.gains()[k][c] * kFactors[k][c], kFactors[2][c], 1e-3)
+          << "camera " << k << ", channel " << c;
+    }
+  }
+  const std::vector<cv::Vec3f> fitted = balance.gains();
+  std::array<cv::Vec3f, 4> changed = kFactors;
+  changed[0] *= 1.2F;
+  const std::array<std::uint8_t, 4> withoutBack{1, 1, 0, 1};
+  balance.update(ringPairs(changed), withoutBack);
+  EXPECT_EQ(balance.gains(), fitted);
+
+  EXPECT_THROW(ColourBalance(kNames, 0.25, 4.0, 0.0, "roof"), std::invalid_argument);
 }
 
 TEST(ColourBalance, AMissingCameraKeepsItsGainsAndTheOthersStillAgree) {
