@@ -45,6 +45,35 @@ std::string watchLines(const PipelineReport& report) {
   return out;
 }
 
+// The colour correction's lines: what the balance does to each camera, and each seam's step.
+std::string colourLines(const PipelineReport& report) {
+  if (!report.colour) return {};
+  const ColourReport& colour = *report.colour;
+  std::string out = colour.balanced ? "colour: poisson after the balance" : "colour: poisson";
+  for (std::size_t c = 0; c < colour.balanceGains.size() && c < report.cameras.size(); ++c) {
+    const auto& gains = colour.balanceGains[c];
+    fmt::format_to(std::back_inserter(out), "{} {} x{:.2f} {:.2f} {:.2f} (B G R)",
+                   c == 0 ? ";" : ",", report.cameras[c].name, gains[0], gains[1], gains[2]);
+  }
+  out += '\n';
+  for (const auto& seam : colour.seams) {
+    fmt::format_to(std::back_inserter(out),
+                   "colour seam {}: step {:.1f} -> {:.1f} levels, {} of {} blocks clamped",
+                   seam.name, seam.stepUncorrected, seam.stepCorrected, seam.clampedBlocks,
+                   seam.blocks);
+    if (seam.leftAsItWas) {
+      out += "; left as it was (correcting it made it worse)";
+    } else if (seam.blocksLeftAsTheyWere > 0) {
+      fmt::format_to(std::back_inserter(out),
+                     "; {} blocks left as they were (correcting them "
+                     "made them worse)",
+                     seam.blocksLeftAsTheyWere);
+    }
+    out += '\n';
+  }
+  return out;
+}
+
 double milliseconds(std::chrono::nanoseconds duration) {
   return std::chrono::duration<double, std::milli>(duration).count();
 }
@@ -184,6 +213,7 @@ std::string statusText(const PipelineReport& report) {
                    viewSwitchWithLimits(*report.viewSwitch));
   }
   out += watchLines(report);
+  out += colourLines(report);
   for (std::size_t c = 0; c < report.cameras.size(); ++c) {
     const auto& camera = report.cameras[c];
     fmt::format_to(std::back_inserter(out),

@@ -68,6 +68,25 @@ struct MountWatchReport {
   double cpuSeconds = 0;        // of its own thread
 };
 
+// One seam of the colour correction, as the last set left it.
+struct ColourSeamReport {
+  std::string name;  // "front/right": the seam's source camera, then its target
+  // Median over its measured blocks of the mean over channels of |target - source|, in levels.
+  double stepUncorrected = 0, stepCorrected = 0;
+  int blocks = 0, clampedBlocks = 0;  // clamped: the field hit gain_range there
+  // Stretches the correction would have made worse than none, left as they were.
+  int blocksLeftAsTheyWere = 0;
+  bool leftAsItWas = false;  // the whole seam
+};
+
+// The colour correction (colour_correction.method: poisson), as the last set left it.
+struct ColourReport {
+  bool balanced = false;  // colour_correction.balance
+  std::vector<ColourSeamReport> seams;
+  // With the balance, per camera (the report's cameras' order), its B G R gains.
+  std::vector<std::array<float, 3>> balanceGains;
+};
+
 struct CameraReport {
   std::string name;
   capture::CameraHealth health = capture::CameraHealth::kOk;
@@ -100,6 +119,7 @@ struct PipelineReport {
       healthChanges;                           // every one so far, in order; `at`: stream time
   std::vector<SeamReport> seams;               // the drift watch's; empty when it is off
   std::optional<MountWatchReport> mountWatch;  // with calibration_watch.correct: suggest
+  std::optional<ColourReport> colour;          // with colour_correction.method: poisson
   std::array<DurationHistogram, kStageCount> stages;  // per frame set that went through the stage
   DurationHistogram latency;  // a frame's capture to its picture handed to an output
   // From the run's start to its first picture handed to an output; empty before.

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <optional>
 #include <span>
+#include <string>
+#include <utility>
 
 #include <spdlog/spdlog.h>
 
@@ -152,6 +154,28 @@ void PanoramaStage::correct(ViewPicture& view, const FrameWork& work, cv::Mat& p
     if (faults[c] != nullptr) view.ownership_.markFaulty(picture, c);
   }
   if (i420 != nullptr) processing::bgrToI420(picture, *i420, pool_);
+}
+
+void PanoramaStage::report(PipelineReport& report) const {
+  if (!poisson_) return;
+  ColourReport colour;
+  colour.balanced = poisson_->settings().balance;
+  const auto name = [&](std::size_t camera) -> const std::string& {
+    return rig_.cameras.at(camera).name;
+  };
+  for (const auto& seam : poisson_->seams()) {
+    colour.seams.push_back({.name = name(seam.source) + "/" + name(seam.target),
+                            .stepUncorrected = seam.stepUncorrected,
+                            .stepCorrected = seam.stepCorrected,
+                            .blocks = seam.blocks,
+                            .clampedBlocks = seam.clampedBlocks,
+                            .blocksLeftAsTheyWere = seam.droppedBlocks,
+                            .leftAsItWas = seam.dropped});
+  }
+  for (const cv::Vec3f& gains : poisson_->cameraGains()) {
+    colour.balanceGains.push_back({gains[0], gains[1], gains[2]});
+  }
+  report.colour = std::move(colour);
 }
 
 }  // namespace surroundd::daemon

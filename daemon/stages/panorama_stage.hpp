@@ -40,6 +40,8 @@ class PanoramaStage final : public PipelineStage {
   // colour correction (it follows the pictures over time; views gathered through their own LUTs
   // apply it).
   void process(FrameWork& work, StageTimes& times) override;
+  // The Poisson correction's seams and balance gains as the last set left them.
+  void report(PipelineReport& report) const override;
 
   // The corrected panorama of the last set that needed it, reused for every set; of lut().size.
   const cv::Mat& picture() const { return panorama_; }

@@ -149,6 +149,29 @@ TEST(PipelineReport, TheCalibrationWatchShowsEachSeamAndTheDriftingCamera) {
               ::testing::HasSubstr("surroundd_camera_calibration_drifting{camera=\"back\"} 0\n"));
 }
 
+// The colour correction says what it did at each seam, and where it left a seam or some of its
+// blocks as they were because correcting them made them worse; with the balance, each camera's
+// gains.
+TEST(PipelineReport, TheColourCorrectionSaysWhereItLeftASeamAsItWas) {
+  PipelineReport report = sampleReport();
+  EXPECT_THAT(statusText(report), ::testing::Not(::testing::HasSubstr("colour")));
+  report.colour =
+      ColourReport{.balanced = true,
+                   .seams = {{"front/right", 12.3, 2.1, 40, 2, 3, false},
+                             {"back/right", 3.5, 3.5, 20, 0, 20, true}},
+                   .balanceGains = {{1.02F, 0.98F, 1.0F}, {0.9F, 1.0F, 1.1F}, {1.0F, 1.0F, 1.0F}}};
+  const std::string text = statusText(report);
+  EXPECT_THAT(text, ::testing::HasSubstr("colour: poisson after the balance; front x1.02 0.98 1.00 "
+                                         "(B G R), right x0.90 1.00 1.10 (B G R), back x1.00 1.00 "
+                                         "1.00 (B G R)\n"));
+  EXPECT_THAT(text, ::testing::HasSubstr(
+                        "colour seam front/right: step 12.3 -> 2.1 levels, 2 of 40 blocks clamped; "
+                        "3 blocks left as they were (correcting them made them worse)\n"));
+  EXPECT_THAT(text, ::testing::HasSubstr("colour seam back/right: step 3.5 -> 3.5 levels, 0 of 20 "
+                                         "blocks clamped; left as it was (correcting it made it "
+                                         "worse)\n"));
+}
+
 // A suggested mount correction, and a camera turned past what a correction may make: the status
 // and the metrics tell them apart.
 TEST(PipelineReport, AMountTurnedPastTheBoundIsAFaultNotASuggestion) {

@@ -6,7 +6,10 @@
 
 #include "daemon/stages/panorama_stage.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -147,6 +150,44 @@ outputs:
   stage.gather(*view, picture);
   stage.correct(*view, work, picture, nullptr);
   EXPECT_LT(meanDifference(picture, stage.picture()), 0.5);
+}
+
+// What the report shows of the correction: every seam by its cameras' names, with its steps, and
+// the balance's gains per camera.
+TEST_F(PanoramaStageTest, ReportsEachSeamOfTheCorrectionAndTheBalancesGains) {
+  const Config balanced = testing::seamsConfig(dir_, "0", R"(rig: {file: rig.yaml}
+panorama: {width_px: 1024, height_px: 512, cache_dir: lut-cache}
+colour_correction: {balance: true}
+outputs:
+  - {type: snapshot, stream: panorama, path: picture.png}
+)");
+  PanoramaStage stage(balanced, pool_);
+  PipelineReport before;
+  stage.report(before);
+  ASSERT_TRUE(before.colour.has_value());
+  ASSERT_NE(process(stage, true, false).panorama, nullptr);
+  PipelineReport report;
+  stage.report(report);
+  ASSERT_TRUE(report.colour.has_value());
+  EXPECT_TRUE(report.colour->balanced);
+  ASSERT_GE(report.colour->seams.size(), testing::kSeamsCameras.size());  // at least a ring
+  for (const auto& seam : report.colour->seams) {
+    const auto slash = seam.name.find('/');
+    ASSERT_NE(slash, std::string::npos) << seam.name;
+    for (const std::string& camera : {seam.name.substr(0, slash), seam.name.substr(slash + 1)}) {
+      EXPECT_NE(std::ranges::find(testing::kSeamsCameras, camera), testing::kSeamsCameras.end())
+          << seam.name;
+    }
+    EXPECT_GT(seam.blocks, 0) << seam.name;
+    EXPECT_LE(seam.stepCorrected, seam.stepUncorrected + 0.5) << seam.name;
+  }
+  EXPECT_TRUE(std::ranges::any_of(report.colour->seams, [](const auto& seam) {
+    return seam.stepCorrected < seam.stepUncorrected / 2;
+  })) << "no seam was corrected";
+  ASSERT_EQ(report.colour->balanceGains.size(), testing::kSeamsCameras.size());
+  EXPECT_TRUE(std::ranges::any_of(report.colour->balanceGains, [](const auto& gains) {
+    return std::abs(gains[1] - 1.0F) > 0.02F;
+  })) << "the generated cameras' exposures differ";
 }
 
 TEST(StreamOutputStage, NeedsThePanoramaWhereAnOutputShowsIt) {
