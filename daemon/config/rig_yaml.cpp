@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <fstream>
 #include <numbers>
 #include <set>
 #include <span>
@@ -11,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "capture/sequence_pattern.hpp"
+#include "common/atomic_file.hpp"
 #include "common/camera_limit.hpp"
 #include "daemon/config/camera_calibration_yaml.hpp"
 #include "daemon/config/camera_source_yaml.hpp"
@@ -165,14 +165,8 @@ void emitCamera(YAML::Emitter& out, const RigCamera& camera, const std::filesyst
     }
     out << YAML::EndMap;
   }
-  const auto angles = processing::mountAnglesFromRotation(c.pose.rotation);
   out << YAML::Key << "mount" << YAML::Value << YAML::Flow << YAML::BeginMap;
-  out << YAML::Key << "x_m" << YAML::Value << c.pose.position[0];
-  out << YAML::Key << "y_m" << YAML::Value << c.pose.position[1];
-  out << YAML::Key << "z_m" << YAML::Value << c.pose.position[2];
-  out << YAML::Key << "yaw_deg" << YAML::Value << angles.yawDeg;
-  out << YAML::Key << "pitch_deg" << YAML::Value << angles.pitchDeg;
-  out << YAML::Key << "roll_deg" << YAML::Value << angles.rollDeg;
+  emitMountFields(out, c.pose);
   out << YAML::EndMap;
   if (camera.frozenCheck != FrozenCheck::kAuto) {
     out << YAML::Key << "health" << YAML::Value << YAML::Flow << YAML::BeginMap;
@@ -184,6 +178,16 @@ void emitCamera(YAML::Emitter& out, const RigCamera& camera, const std::filesyst
 }
 
 }  // namespace
+
+void emitMountFields(YAML::Emitter& out, const processing::Pose& pose) {
+  const auto angles = processing::mountAnglesFromRotation(pose.rotation);
+  out << YAML::Key << "x_m" << YAML::Value << pose.position[0];
+  out << YAML::Key << "y_m" << YAML::Value << pose.position[1];
+  out << YAML::Key << "z_m" << YAML::Value << pose.position[2];
+  out << YAML::Key << "yaw_deg" << YAML::Value << angles.yawDeg;
+  out << YAML::Key << "pitch_deg" << YAML::Value << angles.pitchDeg;
+  out << YAML::Key << "roll_deg" << YAML::Value << angles.rollDeg;
+}
 
 void emitLensFields(YAML::Emitter& out, const processing::Intrinsics& lens) {
   const bool fisheye = lens.model == LensModel::kFisheye;
@@ -263,15 +267,11 @@ void writeRigFile(const std::filesystem::path& file, std::span<const RigCamera> 
     throw ConfigError({fmt::format("{}: not written: {} is not a finite number (NaN or infinite)",
                                    file.string(), *where)});
   }
-  // Written beside and renamed, so a reader never sees half a rig.
-  const auto partial = std::filesystem::path(file.string() + ".part");
-  {
-    std::ofstream stream(partial, std::ios::trunc);
-    stream << out.c_str() << '\n';
-    if (!stream.flush())
-      throw ConfigError({fmt::format("{}: cannot write the file", partial.string())});
+  try {
+    writeFileAtomically(file, std::string(out.c_str()) + "\n");
+  } catch (const std::runtime_error& e) {
+    throw ConfigError({e.what()});
   }
-  std::filesystem::rename(partial, file);
 }
 
 }  // namespace surroundd::daemon

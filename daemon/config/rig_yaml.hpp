@@ -102,6 +102,8 @@ std::optional<std::string> lensFieldCutWarning(const processing::CameraCalibrati
 // The keys of one `lens:` map (model, size, intrinsics), into a map the caller has begun. Doubles
 // round-trip exactly at the emitter's precision 17.
 void emitLensFields(YAML::Emitter& out, const processing::Intrinsics& lens);
+// The keys of one `mount:` map (position, then yaw, pitch and roll), likewise.
+void emitMountFields(YAML::Emitter& out, const processing::Pose& pose);
 
 // Writes a rig file that loadRigFile reads back to the same calibration (doubles round-trip
 // exactly). Source paths are written relative to the file's folder when they lie inside it.

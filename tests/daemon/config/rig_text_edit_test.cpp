@@ -1,8 +1,8 @@
-// editRigText (tools/calibrate/rig_text_edit.hpp) on a rig file as people keep them: comments
+// editRigText (daemon/config/rig_text_edit.hpp) on a rig file as people keep them: comments
 // everywhere, block and flow styles, keys of their own. Only the edited values change; every
 // other byte is as it was, and the result reads as the edit says.
 
-#include "tools/calibrate/rig_text_edit.hpp"
+#include "daemon/config/rig_text_edit.hpp"
 
 #include <array>
 #include <stdexcept>
@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
-namespace surroundd::calibrate {
+namespace surroundd::daemon {
 namespace {
 
 using ::testing::HasSubstr;
@@ -134,4 +134,4 @@ TEST(RigTextEdit, WhatCannotBeEditedInPlaceIsNamed) {
 }
 
 }  // namespace
-}  // namespace surroundd::calibrate
+}  // namespace surroundd::daemon

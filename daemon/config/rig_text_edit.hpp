@@ -13,7 +13,7 @@
 #include <string>
 #include <string_view>
 
-namespace surroundd::calibrate {
+namespace surroundd::daemon {
 
 struct RigTextEdit {
   std::string camera;     // its `name:`
@@ -25,4 +25,4 @@ struct RigTextEdit {
 std::string editRigText(const std::string& text, const std::string& key,
                         std::span<const RigTextEdit> edits, std::string_view comment);
 
-}  // namespace surroundd::calibrate
+}  // namespace surroundd::daemon

@@ -1,4 +1,4 @@
-#include "tools/calibrate/rig_text_edit.hpp"
+#include "daemon/config/rig_text_edit.hpp"
 
 #include <algorithm>
 #include <iterator>
@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
-namespace surroundd::calibrate {
+namespace surroundd::daemon {
 namespace {
 
 // Just past the flow collection ('{' or '[') that starts at `begin`. Quoted strings are skipped
@@ -159,4 +159,4 @@ std::string editRigText(const std::string& text, const std::string& key,
   return edited;
 }
 
-}  // namespace surroundd::calibrate
+}  // namespace surroundd::daemon
