@@ -46,6 +46,7 @@ Pipeline::Pipeline(const Config& config, RunStart start)
       {.cameras = cameras_, .synchronizer = synchronizer_, .pool = pool_, .renderer = renderer_});
   stages_ = std::move(list.stages);
   views_ = list.views;
+  mounts_ = list.mounts;
   if (views_ != nullptr) outputs_.setRenderer(&views_->context());
   openOutputs(config);
   if (views_ != nullptr) {

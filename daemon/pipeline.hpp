@@ -44,6 +44,7 @@
 namespace surroundd::daemon {
 
 class SurroundRenderer;
+class MountCorrections;
 class SurroundViews;
 
 struct RunSummary {
@@ -103,6 +104,9 @@ class Pipeline {
   // The vehicle's signals as they are now, for the guidelines the surround views draw.
   void setVehicleSignals(const vehicle::VehicleSignals& signals);
   PipelineReport report() const;
+  // The calibration watch's mount corrections (daemon/mount_corrections.hpp); null where the
+  // panorama is not made.
+  MountCorrections* mountCorrections() { return mounts_; }
   // Whether any output (or recording) works: with none, the run records nothing (a full disk),
   // and the service stops feeding the watchdog and says so in its status. A failed output is
   // retried (PipelineOutputs).
@@ -147,6 +151,7 @@ class Pipeline {
   // The stage that draws the surround views, in the list too: their outputs are opened and
   // redrawn through it. Null when no output shows one.
   SurroundViews* views_ = nullptr;
+  MountCorrections* mounts_ = nullptr;
   PipelineOutputs outputs_;
   StageTimes times_;
   std::array<cv::Mat, kMaxCameras> bgrBuffers_;  // FrameWork::bgr()'s, one per camera

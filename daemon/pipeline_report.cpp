@@ -38,9 +38,14 @@ std::string watchLines(const PipelineReport& report) {
   if (report.mountWatch) {
     fmt::format_to(std::back_inserter(out),
                    "mount refinement: {} sets compared, {} comparisons in the last solution, "
-                   "{:.1f} s of CPU\n",
+                   "{:.1f} s of CPU{}\n",
                    report.mountWatch->setsCompared, report.mountWatch->comparisons,
-                   report.mountWatch->cpuSeconds);
+                   report.mountWatch->cpuSeconds,
+                   report.mountWatch->applying
+                       ? fmt::format("; corrections applied {}, taken back {}{}",
+                                     report.mountWatch->applied, report.mountWatch->reverted,
+                                     report.mountWatch->checking ? " (the last being checked)" : "")
+                       : std::string());
   }
   return out;
 }
@@ -361,7 +366,7 @@ std::string prometheusText(const PipelineReport& report) {
   if (report.mountWatch) {
     family(out, "camera_mount_correction_deg", "gauge",
            "The mount angle change the calibration watch suggests for the camera "
-           "(calibration_watch.correct: suggest); absent where none is worth applying.");
+           "(calibration_watch.correct: suggest or apply); absent where none is worth applying.");
     for (const auto& camera : report.cameras) {
       if (!camera.mountSuggestion || camera.mountSuggestion->fault) continue;
       const auto& change = camera.mountSuggestion->changeDeg;

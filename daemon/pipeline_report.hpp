@@ -46,8 +46,8 @@ struct SeamReport {
   double distanceM = 0;           // of the compared ground from the vehicle's centre
   double response = 0;
   bool misaligned = false;
-  // With calibration_watch.correct: suggest, where the suggested mounts would put it, over the
-  // ground compared since start.
+  // With calibration_watch.correct: suggest or apply, where the suggested mounts would put it, over
+  // the ground compared since start.
   std::optional<double> suggestedCm{};
 };
 
@@ -66,6 +66,10 @@ struct MountWatchReport {
   std::size_t setsCompared = 0;
   std::size_t comparisons = 0;  // of ground patches, kept in the last solution
   double cpuSeconds = 0;        // of its own thread
+  bool applying = false;        // correct: apply
+  // Corrections made and taken back, and whether the last is being checked.
+  std::size_t applied = 0, reverted = 0;
+  bool checking = false;
 };
 
 // One seam of the colour correction, as the last set left it.
@@ -118,7 +122,7 @@ struct PipelineReport {
   std::vector<capture::HealthChange>
       healthChanges;                           // every one so far, in order; `at`: stream time
   std::vector<SeamReport> seams;               // the drift watch's; empty when it is off
-  std::optional<MountWatchReport> mountWatch;  // with calibration_watch.correct: suggest
+  std::optional<MountWatchReport> mountWatch;  // with calibration_watch.correct: suggest, apply
   std::optional<ColourReport> colour;          // with colour_correction.method: poisson
   std::array<DurationHistogram, kStageCount> stages;  // per frame set that went through the stage
   DurationHistogram latency;  // a frame's capture to its picture handed to an output

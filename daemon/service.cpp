@@ -2,12 +2,17 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <thread>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <malloc.h>
 #include <spdlog/spdlog.h>
 
+#include "daemon/config/rig_update.hpp"
 #include "daemon/config/view_rules.hpp"
+#include "daemon/mount_corrections.hpp"
 #include "render/outputs/image_file.hpp"
 #include "render/view_camera.hpp"
 
@@ -213,6 +218,49 @@ ControlReply Service::reload() {
   }
 }
 
+ControlReply Service::calibration(Pipeline& pipeline, const std::string& what) {
+  if (what.empty() || what == "status") {
+    return ControlReply::success(calibrationText(pipeline.report()));
+  }
+  MountCorrections* mounts = pipeline.mountCorrections();
+  if (mounts == nullptr) {
+    return ControlReply::failure("no calibration watch runs: no output shows the panorama");
+  }
+  if (what == "revert") return ControlReply::success(mounts->revert());
+  const auto corrected = mounts->correctedMounts();
+  if (corrected.empty()) {
+    return ControlReply::failure(
+        "no mount corrected since the run started (or was last accepted): nothing to accept");
+  }
+  if (!config_.rigFile) {
+    return ControlReply::failure(
+        fmt::format("{} writes its cameras inline, not in a rig file: nothing is written; "
+                    "surroundctl calibration status shows the mounts to copy",
+                    config_.file.string()));
+  }
+  const std::filesystem::path& rig = *config_.rigFile;
+  const std::filesystem::path before = rig.string() + ".before-accept";
+  try {
+    std::filesystem::copy_file(rig, before, std::filesystem::copy_options::overwrite_existing);
+    updateRigMounts(rig, corrected,
+                    "corrected from the road by surroundd's calibration watch, accepted");
+  } catch (const std::exception& e) {
+    spdlog::error("calibration accept: {}", e.what());
+    return ControlReply::failure(fmt::format("the rig is left as it was: {}", e.what()));
+  }
+  mounts->accepted();
+  std::vector<std::string> names;
+  names.reserve(corrected.size());
+  for (const auto& mount : corrected) names.push_back(fmt::format("'{}'", mount.first));
+  spdlog::info(
+      "calibration accept: camera {}'s corrected mount written into {} (the file before: "
+      "{})",
+      fmt::join(names, ", "), rig.string(), before.string());
+  return ControlReply::success(
+      fmt::format("wrote the corrected mount of camera {} into {} (the file before: {})\n",
+                  fmt::join(names, ", "), rig.string(), before.string()));
+}
+
 ControlAnswer Service::answer(Pipeline& pipeline, const ControlRequest& request) {
   using Kind = ControlRequest::Kind;
   switch (request.kind) {
@@ -222,7 +270,7 @@ ControlAnswer Service::answer(Pipeline& pipeline, const ControlRequest& request)
     case Kind::kMetrics:
       return ControlReply::success(prometheusText(pipeline.report()));
     case Kind::kCalibration:
-      return ControlReply::success(calibrationText(pipeline.report()));
+      return calibration(pipeline, request.argument);
     case Kind::kView: {
       const auto view = render::parseViewKind(request.argument);
       if (!view) {

@@ -58,6 +58,8 @@ class Service final : public PipelineObserver {
   ControlAnswer answer(Pipeline& pipeline, const ControlRequest& request);
   // Reads the config file again; a good config becomes pending and ends the run.
   ControlReply reload();
+  // `surroundctl calibration status|accept|revert`.
+  ControlReply calibration(Pipeline& pipeline, const std::string& what);
   // Switches the surround outputs when the view rule that holds has changed.
   void followViewRules(Pipeline& pipeline, std::chrono::steady_clock::time_point now);
   std::string vehicleStatus(std::chrono::steady_clock::time_point now) const;

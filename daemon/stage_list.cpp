@@ -63,7 +63,7 @@ StageList buildStages(const Config& config, const StageSources& sources) {
   const bool surround = config.shows(OutputStream::kSurround);
   if (surround || config.shows(OutputStream::kPanorama)) {
     auto& panorama = add(std::make_unique<PanoramaStage>(config, sources.pool));
-    add(std::make_unique<CalibrationWatchStage>(config, panorama.rig()));
+    list.mounts = &add(std::make_unique<CalibrationWatchStage>(config, panorama));
     if (surround) {
       auto& views = add(std::make_unique<SurroundStage>(config, std::move(*sources.renderer.get()),
                                                         panorama, cameraFormatOf(sources.cameras)));

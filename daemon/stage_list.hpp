@@ -10,6 +10,7 @@
 #include "capture/synchronizer.hpp"
 #include "common/work_pool.hpp"
 #include "daemon/config/config.hpp"
+#include "daemon/mount_corrections.hpp"
 #include "daemon/pipeline_stage.hpp"
 #include "daemon/stages/surround_renderer.hpp"
 #include "daemon/surround_views.hpp"
@@ -30,6 +31,8 @@ struct StageList {
   std::vector<std::unique_ptr<PipelineStage>> stages;
   // The stage that draws the surround views, where an output shows them; else null.
   SurroundViews* views = nullptr;
+  // The calibration watch's mount corrections, where it watches; else null.
+  MountCorrections* mounts = nullptr;
 };
 
 // Throws what each stage's set-up throws (std::runtime_error naming the config, RenderError).

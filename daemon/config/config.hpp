@@ -257,8 +257,9 @@ struct CalibrationWatchConfig {
   double intervalS = 5;    // of stream time; 0: off
   double thresholdCm = 5;  // a seam whose cameras put the ground further apart is misaligned
   // Whether the watch also works out the mounts that would bring the seams together
-  // (processing/calibration/mount_refinement.hpp), and says them.
-  enum class Correct { kOff, kSuggest };
+  // (processing/calibration/mount_refinement.hpp), and says them (suggest), or also corrects the
+  // panorama with them (apply).
+  enum class Correct { kOff, kSuggest, kApply };
   Correct correct = Correct::kOff;
   double compareEveryS = 1;  // of stream time: how often a set's ground patches are compared
 

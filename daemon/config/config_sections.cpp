@@ -394,15 +394,17 @@ const ConfigKeys<CalibrationWatchConfig>& calibrationWatchKeys() {
                   "whose every measured seam is, is calibration drifting"),
       Key::choice("correct", &CalibrationWatchConfig::correct,
                   {{"off", CalibrationWatchConfig::Correct::kOff},
-                   {"suggest", CalibrationWatchConfig::Correct::kSuggest}},
+                   {"suggest", CalibrationWatchConfig::Correct::kSuggest},
+                   {"apply", CalibrationWatchConfig::Correct::kApply}},
                   "suggest: also work out, from the ground two cameras share while the car "
                   "drives, how each camera's mount would have to turn to bring its seams "
                   "together, and say it (status, metrics, log); surround-calibrate refine "
-                  "--update-rig writes it"),
+                  "--update-rig writes it. apply: also correct the panorama with it, once two "
+                  "solutions in a row agree, and go back should the seams not come together"),
       Key::number("compare_every_s", &CalibrationWatchConfig::compareEveryS,
                   {0.1, 3600.0, false, "seconds"},
-                  "with correct: suggest, how often (stream time) a set's ground is compared; "
-                  "each comparison costs tens of milliseconds on a thread of its own"),
+                  "with correct: suggest or apply, how often (stream time) a set's ground is "
+                  "compared; each comparison costs tens of milliseconds on a thread of its own"),
   };
   return kKeys;
 }

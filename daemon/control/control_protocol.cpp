@@ -28,29 +28,35 @@ ParsedRequest parseControlRequest(std::string_view line) {
   const auto space = line.find(' ');
   const std::string_view command = line.substr(0, space);
   const std::string_view argument = space == std::string_view::npos ? "" : line.substr(space + 1);
+  enum class Argument { kNone, kRequired, kOptional };
   struct Known {
     std::string_view name;
     Kind kind;
-    bool takesArgument;
+    Argument argument;
   };
-  constexpr std::array<Known, 7> kCommands{{{"status", Kind::kStatus, false},
-                                            {"metrics", Kind::kMetrics, false},
-                                            {"calibration", Kind::kCalibration, false},
-                                            {"view", Kind::kView, true},
-                                            {"signal", Kind::kSignal, true},
-                                            {"snapshot", Kind::kSnapshot, false},
-                                            {"reload", Kind::kReload, false}}};
+  constexpr std::array<Known, 7> kCommands{
+      {{"status", Kind::kStatus, Argument::kNone},
+       {"metrics", Kind::kMetrics, Argument::kNone},
+       {"calibration", Kind::kCalibration, Argument::kOptional},
+       {"view", Kind::kView, Argument::kRequired},
+       {"signal", Kind::kSignal, Argument::kRequired},
+       {"snapshot", Kind::kSnapshot, Argument::kNone},
+       {"reload", Kind::kReload, Argument::kNone}}};
   const auto* known = std::ranges::find(kCommands, command, &Known::name);
   if (known == kCommands.end()) {
     return {{},
-            fmt::format("unknown request '{}' (status, metrics, calibration, view NAME, signal "
-                        "ITEMS, snapshot, reload)",
+            fmt::format("unknown request '{}' (status, metrics, calibration [status|accept|"
+                        "revert], view NAME, signal ITEMS, snapshot, reload)",
                         command)};
   }
-  if (known->takesArgument && argument.empty()) {
+  if (known->argument == Argument::kRequired && argument.empty()) {
     return {{}, fmt::format("'{}' needs an argument", command)};
   }
-  if (!known->takesArgument && space != std::string_view::npos) {
+  if (known->kind == Kind::kCalibration && !argument.empty() && argument != "status" &&
+      argument != "accept" && argument != "revert") {
+    return {{}, fmt::format("'calibration' takes status, accept or revert, not '{}'", argument)};
+  }
+  if (known->argument == Argument::kNone && space != std::string_view::npos) {
     return {{}, fmt::format("'{}' takes no argument", command)};
   }
   return {{known->kind, std::string(argument)}, {}};

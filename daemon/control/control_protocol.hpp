@@ -11,6 +11,9 @@
 //                        indicator=left" (vehicle/vehicle_signals.hpp)
 //   snapshot          -> the newest output picture as a PNG
 //   reload            -> reads the config file again; a bad one is rejected, the old one runs on
+//   calibration [status] -> the calibration watch alone
+//   calibration accept   -> writes the mounts it corrected into the rig file
+//   calibration revert   -> takes its corrections back
 // Reply: "ok <body bytes>\n" then the body, or "error <message>\n".
 //
 // Errors: parsing gives a message for the client (never throws); the client functions throw

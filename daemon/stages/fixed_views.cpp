@@ -13,11 +13,19 @@
 namespace surroundd::daemon {
 
 FixedViews::FixedViews(const Config& config, bool enabled, PanoramaStage& panorama)
-    : enabled_(enabled), panorama_(panorama), splitCamera_(splitCameraOf(config)) {}
+    : enabled_(enabled),
+      panorama_(panorama),
+      splitCamera_(splitCameraOf(config)),
+      generation_(panorama.generation()) {}
 
 FixedViews::View* FixedViews::ready(PipelineOutputs::PictureOutput& output) {
   render::SurroundView& view = *output.view;
   if (!enabled_ || output.sink->presentsViews() || !view.settlesStill()) return nullptr;
+  if (generation_ != panorama_.generation()) {
+    // Made through the old mounts; a build under way finishes unread.
+    views_.clear();
+    generation_ = panorama_.generation();
+  }
   const ViewKind kind = view.view();
   const auto key = std::pair{static_cast<const render::SurroundView*>(&view), kind};
   const auto known = views_.find(key);
@@ -53,7 +61,10 @@ FixedViews::View* FixedViews::ready(PipelineOutputs::PictureOutput& output) {
 
 bool FixedViews::shown(const PipelineOutputs::PictureOutput& output) const {
   const render::SurroundView& view = *output.view;
-  if (!enabled_ || output.sink->presentsViews() || view.moves()) return false;
+  if (!enabled_ || output.sink->presentsViews() || view.moves() ||
+      generation_ != panorama_.generation()) {
+    return false;
+  }
   const auto known = views_.find({&view, view.view()});
   return known != views_.end() && known->second.picturer;
 }

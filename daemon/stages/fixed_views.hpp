@@ -9,13 +9,15 @@
 // laid where it shows no panorama and the split view's camera picture scaled into its half, then
 // it is corrected and the guidelines laid over it; for an output that encodes it, it is converted
 // to I420 in the correction's pass (processing/stitch/i420_picture.hpp). Its output gets it in the
-// same set. Kept for when the output shows that view again.
+// same set. Kept for when the output shows that view again, until the panorama is remounted
+// (PanoramaStage::generation()): then each is mapped and composed again.
 //
 // Not with the GPU backend: a GPU draws a fixed view faster than the CPU gathers it.
 // Threads: the renderer's context's, which is the pipeline thread.
 
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <future>
 #include <map>
 #include <memory>
@@ -88,6 +90,7 @@ class FixedViews {
   PanoramaStage& panorama_;
   std::size_t splitCamera_;
   bool tablesAfterFirstPicture_ = false;  // prepare() without waiting: no table started yet
+  std::uint64_t generation_;              // of the panorama's tables the views were made from
   // Per output's view (its address; each lives as long as the pipeline) and the kind it shows.
   std::map<std::pair<const render::SurroundView*, ViewKind>, View> views_;
 };

@@ -40,7 +40,7 @@ std::unique_ptr<render::GpuStitcher> stitcherFor(const PanoramaStage& panorama,
 
 GpuPanorama::GpuPanorama(const Config& config, const render::EglContext& gl,
                          PanoramaStage& panorama, PixelFormat cameraFormat)
-    : panorama_(panorama) {
+    : panorama_(panorama), generation_(panorama.generation()) {
   auto [gpu, why] = gpuBackendOf(config, gl);
   if (gpu) {
     try {
@@ -70,7 +70,10 @@ GLuint GpuPanorama::stitch(render::GpuTimer& timer) {
     spdlog::info("processing: the frames come in {}, not {}: the GPU stitch is set up for them",
                  toString(format), toString(stitcher_->format()));
     stitcher_ = stitcherFor(panorama_, format);
+  } else if (generation_ != panorama_.generation()) {
+    stitcher_ = stitcherFor(panorama_, format);
   }
+  generation_ = panorama_.generation();
   {
     const render::GpuTimer::Scope timed(&timer, render::GpuStep::kUpload);
     stitcher_->upload(panorama_.frames(), panorama_.dmabufs());

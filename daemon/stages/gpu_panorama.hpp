@@ -7,6 +7,7 @@
 //
 // Threads: the renderer's context's, which is the pipeline thread.
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -36,8 +37,8 @@ class GpuPanorama {
   // part).
   bool stitches(const FrameWork& work) const;
   // Stitches the set the panorama stage was last given, its upload and stitch timed by `timer`,
-  // and returns the texture it is in. Frames held in another format than the last set's get a
-  // stitch set up for them first.
+  // and returns the texture it is in. Frames held in another format than the last set's, or a
+  // panorama remounted since (PanoramaStage::generation()), get a stitch set up for them first.
   GLuint stitch(render::GpuTimer& timer);
   // Why the GPU stitch cannot import camera frames from their DMABUFs (render/dmabuf_import.hpp);
   // empty when it can.
@@ -52,6 +53,7 @@ class GpuPanorama {
   std::unique_ptr<render::GpuStitcher> stitcher_;  // none: the CPU stitches
   std::string importRefusal_;
   std::vector<char> importSaid_;  // per camera: 0 nothing said, 1 imported, 2 uploaded
+  std::uint64_t generation_;      // of the panorama's tables the stitch was set up for
 };
 
 }  // namespace surroundd::daemon

@@ -75,7 +75,10 @@ void MountCorrectionWorker::run(const std::stop_token& stop) {
     const std::lock_guard lock(mutex_);
     ++state_.setsCompared;
     state_.cpuSeconds += cpu;
-    if (solved) state_.result = std::move(solved);
+    if (solved) {
+      state_.result = std::move(solved);
+      ++state_.solutions;
+    }
     busy_ = false;
   }
 }

@@ -28,7 +28,8 @@ namespace surroundd::daemon {
 struct MountCorrectionState {
   std::optional<processing::MountRefinementResult> result;  // none until enough ground was seen
   std::size_t setsCompared = 0;
-  double cpuSeconds = 0;  // the worker's own, so far
+  std::size_t solutions = 0;  // solved so far: a new one each time it grows
+  double cpuSeconds = 0;      // the worker's own, so far
 };
 
 class MountCorrectionWorker {

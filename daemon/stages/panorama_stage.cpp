@@ -3,13 +3,13 @@
 #include <algorithm>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
 #include <spdlog/spdlog.h>
 
 #include "daemon/config/panorama_setup.hpp"
-#include "daemon/pipeline_ends.hpp"
 #include "processing/colour/camera_gains.hpp"
 #include "processing/stitch/i420_picture.hpp"
 #include "processing/stitch/view_lut.hpp"
@@ -17,38 +17,49 @@
 namespace surroundd::daemon {
 
 PanoramaStage::PanoramaStage(const Config& config, WorkPool& pool)
-    : pool_(pool),
-      rig_(rigOf(config, pool)),
-      lut_(obtainPanoramaLut(config, rig_, pool)),
-      stitcher_(lut_, pool),
-      ownership_(lut_),
+    : config_(config),
+      pool_(pool),
+      tables_(std::make_shared<PanoramaTables>(config, rigOf(config, pool), pool, pool)),
       corrected_(config.cameras.size()),
       stitched_(config.cameras.size()),
       dmabufs_(config.cameras.size()),
       // Black until a set needs it stitched: an output may be handed it before (at the run's end).
-      panorama_(lut_.size, CV_8UC3, cv::Scalar::all(0)) {
-  setUpColourCorrection(config, pool);
+      panorama_(tables_->lut.size, CV_8UC3, cv::Scalar::all(0)) {}
+
+PanoramaStage::~PanoramaStage() = default;
+
+void PanoramaStage::remount(processing::Rig rig) {
+  // One core: the other goes on with the sets. A build replaced by a later one finishes unread.
+  std::packaged_task<std::shared_ptr<PanoramaTables>()> build(
+      [this, rig = std::move(rig)]() mutable {
+        WorkPool caller(1);
+        return std::make_shared<PanoramaTables>(config_, std::move(rig), caller, pool_);
+      });
+  remount_ = build.get_future();
+  builds_.emplace_back(std::move(build));
 }
 
-void PanoramaStage::setUpColourCorrection(const Config& config, WorkPool& pool) {
-  const processing::ColourCorrectionSettings& settings = config.colour.poisson;
-  if (config.colour.method == ColourMethod::kGain) {
-    gains_ = std::make_unique<processing::GainCompensation>(lut_, pool, settings.minGain,
-                                                            settings.maxGain, cameraNames(config));
-    spdlog::info("colour correction: global gain compensation");
-  } else if (config.colour.method == ColourMethod::kPoisson) {
-    poisson_ = std::make_unique<processing::PoissonColourCorrection>(rig_, panoramaSettings(config),
-                                                                     lut_, settings, pool);
-    for (const auto& note : poisson_->notes()) spdlog::warn("colour correction: {}", note);
-    spdlog::info("colour correction: Poisson, {} region(s) at scale {:g}, solver {}",
-                 poisson_->domain().regions.size(), settings.scale, poisson_->solverNames());
+void PanoramaStage::takeRemountedTables() {
+  if (!remount_.valid() ||
+      remount_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+    return;
+  }
+  try {
+    tables_ = remount_.get();
+    ++generation_;
+    spdlog::info("panorama: the look-up table for the cameras' new mounts is in use");
+  } catch (const std::exception& e) {
+    spdlog::error(
+        "panorama: the corrected mounts cannot make a panorama ({}); they stay as they "
+        "were",
+        e.what());
   }
 }
 
 const cv::Mat& PanoramaStage::blackFrame(std::size_t camera, PixelFormat format) {
   std::vector<cv::Mat>& frames = blackFrames_[static_cast<std::size_t>(format)];
   if (frames.empty()) {
-    for (const auto& size : lut_.cameraSizes) frames.push_back(blackPicture(format, size));
+    for (const auto& size : tables_->lut.cameraSizes) frames.push_back(blackPicture(format, size));
   }
   return frames[camera];
 }
@@ -81,51 +92,57 @@ PixelFormat PanoramaStage::gatherFrames(FrameWork& work) {
 }
 
 void PanoramaStage::process(FrameWork& work, StageTimes& times) {
+  takeRemountedTables();
+  PanoramaTables& tables = *tables_;
   format_ = gatherFrames(work);
   const bool wanted = work.needed(Need::kPanorama);
-  if (wanted) stitcher_.stitch(stitched_, format_, panorama_);
+  if (wanted) tables.stitcher.stitch(stitched_, format_, panorama_);
   times.lap(Stage::kStitch);
-  if (poisson_) {
-    poisson_->update(corrected_, format_);
-    for (const auto& note : poisson_->notesOfLastUpdate()) {
+  if (tables.poisson) {
+    tables.poisson->update(corrected_, format_);
+    for (const auto& note : tables.poisson->notesOfLastUpdate()) {
       spdlog::warn("colour correction: {}", note);
     }
-    if (wanted) poisson_->apply(panorama_);
-  } else if (gains_) {
-    gains_->update(corrected_, format_);
-    for (const auto& note : gains_->notesOfLastUpdate()) {
+    if (wanted) tables.poisson->apply(panorama_);
+  } else if (tables.gains) {
+    tables.gains->update(corrected_, format_);
+    for (const auto& note : tables.gains->notesOfLastUpdate()) {
       spdlog::warn("colour correction: {}", note);
     }
-    if (wanted) gains_->apply(panorama_);
+    if (wanted) tables.gains->apply(panorama_);
   }
   for (std::size_t c = 0; c < work.set.cameraCount && wanted; ++c) {
-    if (work.faults[c] != nullptr) ownership_.markFaulty(panorama_, c);
+    if (work.faults[c] != nullptr) tables.ownership.markFaulty(panorama_, c);
   }
   if (wanted) work.panorama = &panorama_;
   times.lap(Stage::kCorrect);
 }
 
-PanoramaStage::ViewPicture::ViewPicture(const PanoramaStage& stage,
-                                        const cv::Mat& panoramaPositions, WorkPool& pool)
-    : lut_(processing::composeViewLut(stage.lut_, panoramaPositions, pool)),
-      stitcher_(lut_, stage.pool_),
+PanoramaStage::ViewPicture::ViewPicture(const PanoramaTables& tables,
+                                        const cv::Mat& panoramaPositions, WorkPool& compose,
+                                        WorkPool& pool)
+    : lut_(processing::composeViewLut(tables.lut, panoramaPositions, compose)),
+      stitcher_(lut_, pool),
       ownership_(lut_) {
-  if (stage.poisson_) fieldSamples_ = stage.poisson_->viewSamples(panoramaPositions);
+  if (tables.poisson) fieldSamples_ = tables.poisson->viewSamples(panoramaPositions);
 }
 
 std::future<std::unique_ptr<PanoramaStage::ViewPicture>> PanoramaStage::buildView(
     cv::Mat panoramaPositions) {
   // One core: the other goes on with the sets. The positions are this thread's alone from here.
+  // The tables it is made from stay while it is made, also should a remount replace them here.
   std::packaged_task<std::unique_ptr<ViewPicture>()> build(
-      [this, positions = std::move(panoramaPositions)] {
+      [this, tables = std::shared_ptr<const PanoramaTables>(tables_), generation = generation_,
+       positions = std::move(panoramaPositions)] {
         const auto start = std::chrono::steady_clock::now();
         WorkPool caller(1);
-        auto view = std::make_unique<ViewPicture>(*this, positions, caller);
+        auto view = std::make_unique<ViewPicture>(*tables, positions, caller, pool_);
         view->composedIn_ = std::chrono::steady_clock::now() - start;
+        view->generation_ = generation;
         return view;
       });
   auto built = build.get_future();
-  viewBuilds_.emplace_back(std::move(build));
+  builds_.emplace_back(std::move(build));
   return built;
 }
 
@@ -136,19 +153,24 @@ void PanoramaStage::gather(ViewPicture& view, cv::Mat& picture) {
 
 void PanoramaStage::correct(ViewPicture& view, const FrameWork& work, cv::Mat& picture,
                             cv::Mat* i420) {
-  if (poisson_ && !poisson_->cameraGains().empty()) {
-    processing::applyCameraGains(picture, view.lut_, poisson_->cameraGains(), pool_);
+  if (view.generation_ != generation_) {
+    throw std::logic_error("a view made before the mounts were corrected: build it again");
+  }
+  const auto& poisson = tables_->poisson;
+  const auto& gains = tables_->gains;
+  if (poisson && !poisson->cameraGains().empty()) {
+    processing::applyCameraGains(picture, view.lut_, poisson->cameraGains(), pool_);
   }
   const auto faults = std::span(work.faults).first(work.set.cameraCount);
   const bool anyFaulty = std::ranges::any_of(faults, [](const char* f) { return f != nullptr; });
-  if (poisson_ && i420 != nullptr && !anyFaulty) {
-    poisson_->applyAt(view.fieldSamples_, picture, *i420);
+  if (poisson && i420 != nullptr && !anyFaulty) {
+    poisson->applyAt(view.fieldSamples_, picture, *i420);
     return;
   }
-  if (poisson_) {
-    poisson_->applyAt(view.fieldSamples_, picture);
-  } else if (gains_) {
-    gains_->apply(picture, view.lut_);
+  if (poisson) {
+    poisson->applyAt(view.fieldSamples_, picture);
+  } else if (gains) {
+    gains->apply(picture, view.lut_);
   }
   for (std::size_t c = 0; c < faults.size(); ++c) {
     if (faults[c] != nullptr) view.ownership_.markFaulty(picture, c);
@@ -157,13 +179,14 @@ void PanoramaStage::correct(ViewPicture& view, const FrameWork& work, cv::Mat& p
 }
 
 void PanoramaStage::report(PipelineReport& report) const {
-  if (!poisson_) return;
+  const auto& poisson = tables_->poisson;
+  if (!poisson) return;
   ColourReport colour;
-  colour.balanced = poisson_->settings().balance;
+  colour.balanced = poisson->settings().balance;
   const auto name = [&](std::size_t camera) -> const std::string& {
-    return rig_.cameras.at(camera).name;
+    return tables_->rig.cameras.at(camera).name;
   };
-  for (const auto& seam : poisson_->seams()) {
+  for (const auto& seam : poisson->seams()) {
     colour.seams.push_back({.name = name(seam.source) + "/" + name(seam.target),
                             .stepUncorrected = seam.stepUncorrected,
                             .stepCorrected = seam.stepCorrected,
@@ -172,7 +195,7 @@ void PanoramaStage::report(PipelineReport& report) const {
                             .blocksLeftAsTheyWere = seam.droppedBlocks,
                             .leftAsItWas = seam.dropped});
   }
-  for (const cv::Vec3f& gains : poisson_->cameraGains()) {
+  for (const cv::Vec3f& gains : poisson->cameraGains()) {
     colour.balanceGains.push_back({gains[0], gains[1], gains[2]});
   }
   report.colour = std::move(colour);

@@ -35,8 +35,14 @@ TEST(ControlProtocol, ParsesTheRequestsAndSaysWhatIsWrongWithOthers) {
   EXPECT_EQ(parseControlRequest("snapshot").request.kind, Kind::kSnapshot);
   EXPECT_EQ(parseControlRequest("reload").request.kind, Kind::kReload);
   EXPECT_EQ(parseControlRequest("calibration").request.kind, Kind::kCalibration);
+  for (const std::string what : {"status", "accept", "revert"}) {
+    const auto calibration = parseControlRequest("calibration " + what);
+    EXPECT_TRUE(calibration.error.empty()) << calibration.error;
+    EXPECT_EQ(calibration.request.kind, Kind::kCalibration);
+    EXPECT_EQ(calibration.request.argument, what);
+  }
   EXPECT_THAT(parseControlRequest("calibration now").error,
-              HasSubstr("'calibration' takes no argument"));
+              HasSubstr("'calibration' takes status, accept or revert, not 'now'"));
   const auto view = parseControlRequest("view top");
   EXPECT_TRUE(view.error.empty());
   EXPECT_EQ(view.request.kind, Kind::kView);
@@ -146,9 +152,10 @@ TEST_F(ControlServerTest, RequestsRoundTripThroughThePipelineThread) {
 }
 
 TEST_F(ControlServerTest, MisbehavingClientsGetAnErrorAndTheServerGoesOn) {
-  EXPECT_EQ(exchange(path_, "shutdown\n", false),
-            "error unknown request 'shutdown' (status, metrics, calibration, view NAME, signal "
-            "ITEMS, snapshot, reload)\n");
+  EXPECT_EQ(
+      exchange(path_, "shutdown\n", false),
+      "error unknown request 'shutdown' (status, metrics, calibration [status|accept|revert], "
+      "view NAME, signal ITEMS, snapshot, reload)\n");
   EXPECT_EQ(exchange(path_, std::string(10000, 'x'), false),
             fmt::format("error request longer than {} bytes\n", kMaxRequestBytes));
   EXPECT_EQ(exchange(path_, "status", true), "error the request ended without a newline\n");

@@ -211,6 +211,14 @@ TEST(PipelineReport, AMountTurnedPastTheBoundIsAFaultNotASuggestion) {
             "+0.2° (±0.05°)\n"
             "camera back: no drift seen, mount has turned yaw +8.0°, pitch +0.1°, roll +0.0° "
             "(±0.04°): past the 5° a correction may make, check its mount\n");
+  // correct: apply says what it made and took back.
+  report.mountWatch->applying = true;
+  report.mountWatch->applied = 2;
+  report.mountWatch->reverted = 1;
+  report.mountWatch->checking = true;
+  EXPECT_THAT(calibrationText(report),
+              ::testing::HasSubstr("2.5 s of CPU; corrections applied 2, taken back 1 (the last "
+                                   "being checked)\n"));
 }
 
 // A switch of view: its first picture, then the new view settled, held to the first picture's

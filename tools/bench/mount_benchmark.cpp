@@ -14,6 +14,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "capture/file_source.hpp"
+#include "processing/calibration/agreed_corrections.hpp"
 #include "processing/calibration/mount_refinement.hpp"
 #include "tools/bench/recording_truth.hpp"
 
@@ -91,6 +92,11 @@ void report(const std::filesystem::path& folder) {
   double nextS = 0;
   std::optional<double> firstS;   // of a correction worth applying to the knocked camera
   std::optional<double> withinS;  // of one within 0.1 degrees of its mount after the turn
+  // correct: apply's: two solutions in a row agree on it.
+  processing::AgreedCorrections agreements;
+  std::optional<double> appliedS;
+  double appliedError = 0;
+  std::size_t falseCorrections = 0;
   std::optional<processing::MountRefinementResult> last;
   for (int k = 0;; ++k) {
     bool all = true;
@@ -107,6 +113,16 @@ void report(const std::filesystem::path& folder) {
     ++compared;
     if (!solved) continue;
     last = solved;
+    for (const std::size_t c : agreements.add(*solved, truth.rig)) {
+      if (!knock || c != knock->camera || t < knock->atS) {
+        ++falseCorrections;
+        continue;
+      }
+      if (appliedS) continue;
+      appliedS = t;
+      appliedError = degreesBetween(solved->cameras[c].applied(truth.rig.cameras[c].pose).rotation,
+                                    knock->after);
+    }
     for (std::size_t c = 0; c < solved->cameras.size(); ++c) {
       const auto& correction = solved->cameras[c];
       if (solved->verdict(c) != processing::CorrectionVerdict::kOffered) continue;
@@ -128,15 +144,18 @@ void report(const std::filesystem::path& folder) {
   const double sets = static_cast<double>(std::max<std::size_t>(compared, 1));
   fmt::print(
       "  {} sets compared over {:.0f} s, {:.1f} ms of CPU each ({:.1f} % of one core at "
-      "one a second), {} false alarms\n",
+      "one a second), {} false alarms, {} corrections correct: apply would make wrongly\n",
       compared, static_cast<double>(compared) * kCompareEveryS, 1e3 * cpu / sets,
-      100 * cpu / sets / kCompareEveryS, falseAlarms);
+      100 * cpu / sets / kCompareEveryS, falseAlarms, falseCorrections);
   if (knock) {
     const auto after = [&](const std::optional<double>& s) {
       return s ? fmt::format("{:.0f} s after the turn", *s - knock->atS) : std::string("never");
     };
     fmt::print("  knocked camera: a correction worth applying {}, within 0.1 deg {}\n",
                after(firstS), after(withinS));
+    fmt::print("  correct: apply makes it {}{}\n", after(appliedS),
+               appliedS ? fmt::format(", {:.2f} deg from its mount after the turn", appliedError)
+                        : std::string());
   }
   if (last) {
     for (const auto& seam : last->seams) {

@@ -27,7 +27,13 @@ commands:
   metrics           the same and more in Prometheus text format
   calibration status  the calibration watch: each seam's ground misalignment, the mount
                     refinement's work, each camera's drift and the mount correction suggested
-                    (calibration_watch.correct: suggest) or the fault found
+                    (calibration_watch.correct: suggest or apply) or the fault found, and the
+                    corrections applied and taken back (apply)
+  calibration accept  write the mounts calibration_watch.correct: apply corrected into the rig
+                    file, in place (comments kept; the file before kept beside it as
+                    FILE.before-accept)
+  calibration revert  take the corrections back: the mounts the run started with (or last
+                    accepted), and only suggestions from then on
   view NAME         switch the surround outputs to top, 360, orbit, split or rear
   signal NAME=VALUE...  the vehicle's signals, for vehicles whose signals come from other
                     software: gear=P|R|N|D steering_deg=DEG (the wheel, + left) speed_kmh=KMH
@@ -84,9 +90,12 @@ int main(int argc, char** argv) {
     if (i + 2 > argc) return usage("signal needs NAME=VALUE items");
     for (int k = i + 1; k < argc; ++k) request += fmt::format(" {}", argv[k]);
   } else if (command == "calibration") {
-    if (i + 2 != argc || std::string_view(argv[i + 1]) != "status") {
-      return usage("calibration needs 'status'");
+    const std::string_view what = i + 2 == argc ? argv[i + 1] : "";
+    if (what != "status" && what != "accept" && what != "revert") {
+      return usage("calibration needs 'status', 'accept' or 'revert'");
     }
+    // "calibration" alone is the status, as surroundd has always taken it.
+    if (what != "status") request += fmt::format(" {}", what);
   } else if (command == "snapshot") {
     if (i + 2 != argc) return usage("snapshot needs one FILE");
     snapshotFile = argv[i + 1];
