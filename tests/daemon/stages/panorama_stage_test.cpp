@@ -23,10 +23,12 @@
 namespace surroundd::daemon {
 namespace {
 
-Config seamsConfig(const testing::TempDir& dir, const std::string& stream) {
+// `extra`: sections of the config's own.
+Config panoramaConfig(const testing::TempDir& dir, const std::string& stream,
+                      const std::string& extra = "") {
   return testing::seamsConfig(dir, "0", R"(rig: {file: rig.yaml}
 panorama: {width_px: 1024, height_px: 512, cache_dir: lut-cache}
-outputs:
+)" + extra + R"(outputs:
   - {type: snapshot, stream: )" + stream + R"(, path: picture.png}
 )");
 }
@@ -71,7 +73,7 @@ class PanoramaStageTest : public ::testing::Test {
   }
 
   const testing::TempDir dir_;
-  const Config config_ = seamsConfig(dir_, "panorama");
+  const Config config_ = panoramaConfig(dir_, "panorama");
   WorkPool pool_{1};
   const testing::SeamsFirstFrames frames_;
   std::array<cv::Mat, kMaxCameras> bgrBuffers_;
@@ -118,12 +120,7 @@ TEST_F(PanoramaStageTest, AsksTheLaterStagesAfterTheEarlierOnesFoundAFaultyCamer
 // a view gathered through a LUT of its own alike: a view that samples the panorama pixel for
 // pixel is the panorama, within the field's bilinear sampling (the panorama's is bicubic).
 TEST_F(PanoramaStageTest, AViewIsBalancedAsThePanoramaIs) {
-  const Config balanced = testing::seamsConfig(dir_, "0", R"(rig: {file: rig.yaml}
-panorama: {width_px: 1024, height_px: 512, cache_dir: lut-cache}
-colour_correction: {balance: true}
-outputs:
-  - {type: snapshot, stream: panorama, path: picture.png}
-)");
+  const Config balanced = panoramaConfig(dir_, "panorama", "colour_correction: {balance: true}\n");
   PanoramaStage plain(config_, pool_);
   PanoramaStage stage(balanced, pool_);
   ASSERT_NE(process(plain, true, false).panorama, nullptr);
@@ -155,12 +152,7 @@ outputs:
 // What the report shows of the correction: every seam by its cameras' names, with its steps, and
 // the balance's gains per camera.
 TEST_F(PanoramaStageTest, ReportsEachSeamOfTheCorrectionAndTheBalancesGains) {
-  const Config balanced = testing::seamsConfig(dir_, "0", R"(rig: {file: rig.yaml}
-panorama: {width_px: 1024, height_px: 512, cache_dir: lut-cache}
-colour_correction: {balance: true}
-outputs:
-  - {type: snapshot, stream: panorama, path: picture.png}
-)");
+  const Config balanced = panoramaConfig(dir_, "panorama", "colour_correction: {balance: true}\n");
   PanoramaStage stage(balanced, pool_);
   PipelineReport before;
   stage.report(before);
@@ -196,7 +188,7 @@ TEST(StreamOutputStage, NeedsThePanoramaWhereAnOutputShowsIt) {
   const capture::FrameSet set;
   std::array<cv::Mat, kMaxCameras> bgrBuffers;
   for (const std::string stream : {"panorama", "mosaic"}) {
-    const Config config = seamsConfig(dir, stream);
+    const Config config = panoramaConfig(dir, stream);
     PipelineOutputs outputs(30, false);
     outputs.addPicture(config.outputs.at(0), picture.size(), &picture, nullptr);
     const FrameWork work{.set = set, .bgrBuffers = bgrBuffers, .outputs = outputs};
