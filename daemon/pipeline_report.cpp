@@ -390,6 +390,14 @@ std::string prometheusText(const PipelineReport& report) {
            "CPU time of the calibration watch's mount refinement thread.");
     fmt::format_to(std::back_inserter(out), "surroundd_mount_refinement_cpu_seconds_total {:.3f}\n",
                    report.mountWatch->cpuSeconds);
+    if (report.mountWatch->applying) {
+      family(out, "mount_corrections_total", "counter",
+             "Mount corrections the calibration watch made (correct: apply), and took back.");
+      fmt::format_to(std::back_inserter(out),
+                     "surroundd_mount_corrections_total{{outcome=\"applied\"}} {}\n"
+                     "surroundd_mount_corrections_total{{outcome=\"taken_back\"}} {}\n",
+                     report.mountWatch->applied, report.mountWatch->reverted);
+    }
   }
   family(out, "sync_skew_seconds", "gauge", "Mean newest-minus-oldest timestamp within a set.");
   fmt::format_to(std::back_inserter(out), "surroundd_sync_skew_seconds {:.6f}\n",

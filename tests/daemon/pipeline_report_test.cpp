@@ -219,6 +219,10 @@ TEST(PipelineReport, AMountTurnedPastTheBoundIsAFaultNotASuggestion) {
   EXPECT_THAT(calibrationText(report),
               ::testing::HasSubstr("2.5 s of CPU; corrections applied 2, taken back 1 (the last "
                                    "being checked)\n"));
+  EXPECT_THAT(prometheusText(report),
+              ::testing::HasSubstr("surroundd_mount_corrections_total{outcome=\"applied\"} 2\n"
+                                   "surroundd_mount_corrections_total{outcome=\"taken_back\"} "
+                                   "1\n"));
 }
 
 // A switch of view: its first picture, then the new view settled, held to the first picture's

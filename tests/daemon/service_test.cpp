@@ -15,11 +15,10 @@
 #include <opencv2/imgproc.hpp>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <yaml-cpp/yaml.h>
 
 #include "daemon/config/rig_yaml.hpp"
 #include "daemon/control/control_protocol.hpp"
-#include "processing/calibration/mount_refinement.hpp"
+#include "tests/daemon/service_test_support.hpp"
 #include "tests/support/child_process.hpp"
 #include "tests/support/http_client.hpp"
 #include "tests/support/notify_socket.hpp"
@@ -29,110 +28,6 @@ namespace surroundd::daemon {
 namespace {
 
 using ::testing::HasSubstr;
-using namespace std::chrono_literals;
-
-// A function: a static path's construction could throw before main (cert-err58-cpp).
-std::filesystem::path recording() {
-  return std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_small";
-}
-
-class ServiceTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    // The recording's rig, looping: the daemon runs until it is told to stop.
-    auto cameras = loadRigFile(recording() / "rig.yaml");
-    for (auto& camera : cameras) camera.replayedFile()->loop = true;
-    writeRigFile(dir_ / "rig.yaml", cameras, "looping replay");
-    std::filesystem::remove_all(socket_.parent_path());
-  }
-  void TearDown() override { std::filesystem::remove_all(socket_.parent_path()); }
-
-  std::filesystem::path writeConfig(std::string_view outputs, std::string_view extra = "") const {
-    return dir_.write("config.yaml", fmt::format(R"(rig: {{file: rig.yaml}}
-pipeline: {{threads: 2}}
-panorama: {{width_px: 512, height_px: 256, cache_dir: lut-cache}}
-render: {{width_px: 320, height_px: 240, view: orbit}}
-control: {{socket: {}}}
-{}
-outputs:
-{})",
-                                                 socket_.string(), extra, outputs));
-  }
-
-  std::unique_ptr<testing::ChildProcess> start(const std::filesystem::path& config,
-                                               std::vector<std::string> environment = {}) const {
-    return std::make_unique<testing::ChildProcess>(
-        std::vector<std::string>{SURROUNDD_EXECUTABLE, "--config", config.string()},
-        dir_ / "log.txt", std::move(environment));
-  }
-
-  // As a patient client: a "busy ... try again" (the pipeline thread gave no answer within the
-  // server's 10 s, as while it builds a view's table under a sanitizer on a loaded machine) is
-  // asked again, twice at most.
-  ControlReply request(std::string_view line) const {
-    ControlReply reply = sendControlRequest(socket_, line, 20s);
-    for (int again = 0; again < 2 && !reply.ok && reply.body.find("try again") != std::string::npos;
-         ++again) {
-      reply = sendControlRequest(socket_, line, 20s);
-    }
-    return reply;
-  }
-
-  // Frame sets of the running pipeline, from `status` (waits for the socket to appear).
-  std::uint64_t frameSets(testing::ChildProcess& surroundd) const {
-    for (auto deadline = std::chrono::steady_clock::now() + 30s;
-         std::chrono::steady_clock::now() < deadline && surroundd.running();
-         std::this_thread::sleep_for(50ms)) {
-      if (!std::filesystem::exists(socket_)) continue;
-      const auto reply = request("status");
-      std::smatch match;
-      if (reply.ok && std::regex_search(reply.body, match, std::regex("^([0-9]+) frame sets"))) {
-        return std::stoull(match[1]);
-      }
-    }
-    ADD_FAILURE() << "no status from surroundd: " << surroundd.output();
-    return 0;
-  }
-  // Waits until surroundd's log says `text`, at most 30 s.
-  static void waitForLog(testing::ChildProcess& surroundd, std::string_view text) {
-    for (auto deadline = std::chrono::steady_clock::now() + 30s;
-         surroundd.output().find(text) == std::string::npos; std::this_thread::sleep_for(20ms)) {
-      if (std::chrono::steady_clock::now() > deadline || !surroundd.running()) {
-        ADD_FAILURE() << "surroundd never logged '" << text << "': " << surroundd.output();
-        return;
-      }
-    }
-  }
-  // The start-up time in `status`, checked to lie between 0 and the time since `since` (when the
-  // test started what it counts from) and to have its limits beside it.
-  void expectFirstPictureWithin(std::string_view from,
-                                std::chrono::steady_clock::time_point since) const {
-    const auto status = request("status");
-    const double upTo =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-    std::smatch match;
-    ASSERT_TRUE(std::regex_search(
-        status.body, match,
-        std::regex(fmt::format(R"(first picture: ([0-9.]+) s after the {} started \(FMVSS 111: <= )"
-                               R"(2\.0 s, (not )?met; target <= 1\.0 s, (not )?met\))",
-                               from))))
-        << status.body;
-    EXPECT_GT(std::stod(match[1]), 0);
-    EXPECT_LT(std::stod(match[1]), upTo);
-  }
-  // Waits until the pipeline has gone through at least `sets` frame sets.
-  void waitForSets(testing::ChildProcess& surroundd, std::uint64_t sets) const {
-    const auto deadline = std::chrono::steady_clock::now() + 30s;
-    while (frameSets(surroundd) < sets && std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::sleep_for(50ms);
-    }
-  }
-
-  testing::TempDir dir_;
-  // Short: a socket path must fit in 108 bytes.
-  std::filesystem::path socket_ =
-      std::filesystem::temp_directory_path() / fmt::format("sd-svc-{}", ::getpid()) / "c.sock";
-};
 
 // Issue 50: no program had --version ("'--version' needs a value"), and -c FILE and
 // --config=FILE were refused. Every program says its version and the optional parts built in.
@@ -461,72 +356,6 @@ TEST_F(ServiceTest, DegradedWhileNoOutputWorks) {
   surroundd->signal(SIGTERM);
   EXPECT_EQ(surroundd->wait(), 1) << "an output failed in this run: " << surroundd->output();
   EXPECT_FALSE(std::filesystem::is_empty(dir_ / "out"));
-}
-
-// Issue 48: the generated fisheye drive, looping, under a rig that says its back camera's yaw is
-// 2 degrees more than it was. With calibration_watch.correct: apply the watch corrects it while the
-// daemon runs; `surroundctl calibration accept` then writes the corrected mount into the rig file
-// in place (the file before kept beside it) and nothing else; a second accept has nothing to
-// write, and a revert nothing to take back.
-TEST_F(ServiceTest, ACorrectionAppliedOnTheRoadIsAcceptedIntoTheRigFile) {
-  const auto drive = std::filesystem::path(SURROUNDD_FIXTURE_DIR) / "synth_drive_fisheye_hd";
-  auto cameras = loadRigFile(drive / "rig.yaml");
-  const YAML::Node truth = YAML::LoadFile((drive / "ground_truth.yaml").string());
-  for (std::size_t c = 0; c < cameras.size(); ++c) {
-    cameras[c].replayedFile()->loop = true;
-    cameras[c].bodyMask = BodyMaskConfig{BodyMaskConfig::Mode::kReplace,
-                                         drive / truth["cameras"][c]["body_mask"].as<std::string>(),
-                                         {}};
-  }
-  const processing::Pose trueBack = cameras[2].calibration.pose;
-  auto& back = cameras[2].calibration.pose;
-  auto angles = processing::mountAnglesFromRotation(back.rotation);
-  angles.yawDeg += 2;
-  back.rotation = processing::rotationFromMountAngles(angles);
-  writeRigFile(dir_ / "rig.yaml", cameras, "the drive's, its back camera's yaw 2 degrees off");
-  const std::string rigBefore = testing::fileBytes(dir_ / "rig.yaml");
-  auto surroundd = start(
-      writeConfig("  - {type: snapshot, stream: panorama, path: out/panorama.png, at_s: 1000}",
-                  "capture: {pacing: as_fast_as_possible}\n"
-                  "calibration_watch: {interval_s: 0.5, correct: apply, compare_every_s: 0.5}"));
-
-  std::string status;
-  for (auto deadline = std::chrono::steady_clock::now() + 120s;
-       std::chrono::steady_clock::now() < deadline && surroundd->running();
-       std::this_thread::sleep_for(200ms)) {
-    if (!std::filesystem::exists(socket_)) continue;
-    status = request("calibration").body;
-    if (status.find("corrections applied 1, taken back 0\n") != std::string::npos) break;
-  }
-  ASSERT_THAT(status, HasSubstr("corrections applied 1, taken back 0\n")) << surroundd->output();
-
-  testing::ChildProcess accept(
-      {SURROUNDCTL_EXECUTABLE, "--socket", socket_.string(), "calibration", "accept"},
-      dir_ / "accept.txt");
-  EXPECT_EQ(accept.wait(), 0) << accept.output();
-  EXPECT_THAT(accept.output(), HasSubstr("wrote the corrected mount of camera 'back' into"));
-  EXPECT_EQ(testing::fileBytes(dir_ / "rig.yaml.before-accept"), rigBefore);
-  const auto accepted = loadRigFile(dir_ / "rig.yaml");
-  ASSERT_EQ(accepted.size(), cameras.size());
-  for (std::size_t c = 0; c < accepted.size(); ++c) {
-    const processing::Pose& expected = c == 2 ? trueBack : cameras[c].calibration.pose;
-    const auto off = processing::mountAngleChange(expected, accepted[c].calibration.pose);
-    EXPECT_LT(std::abs(off.yawDeg) + std::abs(off.pitchDeg) + std::abs(off.rollDeg),
-              c == 2 ? 0.3 : 1e-9)
-        << accepted[c].calibration.name;
-  }
-  EXPECT_THAT(testing::fileBytes(dir_ / "rig.yaml"),
-              HasSubstr("# corrected from the road by surroundd's calibration watch, accepted"));
-
-  const auto again = request("calibration accept");
-  EXPECT_FALSE(again.ok);
-  EXPECT_THAT(again.body, HasSubstr("nothing to accept"));
-  const auto revert = request("calibration revert");
-  EXPECT_TRUE(revert.ok) << revert.body;
-  EXPECT_THAT(revert.body, HasSubstr("nothing to take back"));
-
-  surroundd->signal(SIGTERM);
-  EXPECT_EQ(surroundd->wait(), 0) << surroundd->output();
 }
 
 }  // namespace
