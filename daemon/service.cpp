@@ -233,10 +233,19 @@ ControlReply Service::calibration(Pipeline& pipeline, const std::string& what) {
         "no mount corrected since the run started (or was last accepted): nothing to accept");
   }
   if (!config_.rigFile) {
+    std::vector<std::string> blocks;
+    for (const auto& [name, pose] : corrected) {
+      const auto angles = processing::mountAnglesFromRotation(pose.rotation);
+      blocks.push_back(fmt::format(
+          "camera '{}': mount: {{x_m: {:.4f}, y_m: {:.4f}, z_m: {:.4f}, yaw_deg: {:.3f}, "
+          "pitch_deg: {:.3f}, roll_deg: {:.3f}}}",
+          name, pose.position[0], pose.position[1], pose.position[2], angles.yawDeg,
+          angles.pitchDeg, angles.rollDeg));
+    }
     return ControlReply::failure(
-        fmt::format("{} writes its cameras inline, not in a rig file: nothing is written; "
-                    "surroundctl calibration status shows the mounts to copy",
-                    config_.file.string()));
+        fmt::format("{} writes its cameras inline, not in a rig file: nothing is written; copy "
+                    "them: {}",
+                    config_.file.string(), fmt::join(blocks, "; ")));
   }
   const std::filesystem::path& rig = *config_.rigFile;
   const std::filesystem::path before = rig.string() + ".before-accept";
