@@ -80,7 +80,8 @@ class PanoramaStage final : public PipelineStage {
   // remount while one is being built takes its place. `rig`'s cameras are the stage's, body masks
   // included.
   void remount(processing::Rig rig);
-  // Whether a remount is being built.
+  // Whether a remount was asked for and is not yet in use (being built, or made and waiting for
+  // the next set); false again once taken, or once its build failed.
   bool remounting() const { return remount_.valid(); }
   // Changes each time remounted tables are taken into use: rig(), lut() and the colour field are
   // new, and what was built from the old ones is to be built again.
